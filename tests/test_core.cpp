@@ -1,0 +1,34 @@
+#include <sphshell/core/error.hpp>
+#include <sphshell/core/frame.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <limits>
+
+using namespace sphshell;
+
+TEST_CASE("Error messages name the parameter and its value", "[core]") {
+  CHECK_THROWS_WITH(detail::require_positive("thickness", -0.5),
+                    Catch::Contains("thickness") && Catch::Contains("-0.5"));
+  CHECK_THROWS_AS(detail::require_finite("E", std::numeric_limits<double>::quiet_NaN()), Error);
+  CHECK_THROWS_WITH(detail::require_open_interval("nu", 0.5, -1.0, 0.5),
+                    Catch::Contains("nu") && Catch::Contains("0.5"));
+  CHECK_NOTHROW(detail::require_half_open_interval("Dc", 1.0, 0.0, 1.0));
+  CHECK_THROWS_AS(detail::require_half_open_interval("Dc", 0.0, 0.0, 1.0), Error);
+}
+
+TEST_CASE("Tangent frames are right-handed and orthonormal", "[core]") {
+  const TangentFrame plate = tangent_frame(Vector3(0, 0, 2));
+  CHECK(plate.e1.isApprox(Vector3::UnitX()));
+  CHECK(plate.e2.isApprox(Vector3::UnitY()));
+  for (const Vector3& normal : {Vector3(1, 0, 0), Vector3(0.3, -0.4, 0.5), Vector3(-1, 1e-3, 0)}) {
+    const TangentFrame frame = tangent_frame(normal);
+    CHECK(std::abs(frame.e1.dot(frame.e2)) < 1e-15);
+    CHECK(std::abs(frame.e1.dot(frame.normal)) < 1e-15);
+    CHECK(std::abs(frame.e1.norm() - 1.0) < 1e-15);
+    CHECK(frame.e1.cross(frame.e2).isApprox(frame.normal, 1e-14));
+    CHECK(frame.normal.isApprox(normal.normalized(), 1e-14));
+  }
+  CHECK_THROWS_WITH(tangent_frame(Vector3::Zero()), Catch::Contains("normal"));
+}
