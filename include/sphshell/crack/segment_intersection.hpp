@@ -6,6 +6,9 @@
 // matter, so the orientation test returns an exact sign: a wrong sign on a
 // nearly collinear pair would let particles interact through a crack (or cut a
 // pair that should see its neighbour), depending on round-off.
+// The exact fallback relies on IEEE round-to-nearest semantics: -ffast-math
+// (or -fassociative-math) lets the compiler cancel its error terms and voids
+// the guarantee. Fused multiply-add contraction is harmless.
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/frame.hpp>
