@@ -45,7 +45,7 @@ inline void two_product(double x, double y, double& product, double& error) {
 // (Shewchuk 1997): the determinant is rewritten as six products of input
 // coordinates, each split exactly into two doubles, and the twelve terms are
 // accumulated into a non-overlapping expansion whose largest component carries
-// the sign of the exact sum. Slow (~100 flops) but only reached when the
+// the sign of the exact sum. Slow (a few hundred flops) but only reached when the
 // floating-point filter in orientation() cannot decide.
 inline double orientation_exact(const Vector2& a, const Vector2& b, const Vector2& p) {
   const double factors[6][2] = {{b.x(), p.y()},  {-b.x(), a.y()}, {-a.x(), p.y()},
