@@ -96,8 +96,21 @@ class Section<Global, Law> {
     coupling_metric_.setZero();
     coupling_metric_.template topRightCorner<3, 3>() = 2.0 * xi / (std::sqrt(3.0) * d * d * d);
     coupling_metric_.template bottomLeftCorner<3, 3>() = 2.0 * xi / (std::sqrt(3.0) * d * d * d);
-    uncoupled_flow_ = stiffness_ * uncoupled_metric_;
-    coupling_flow_ = stiffness_ * coupling_metric_;
+
+    // Γ and Ξ share the eigenvectors q_i (design §2.4), so the 6×6 return decouples
+    // into three 2×2 systems in (N·q_i, M·q_i); ΓΞ q_i = λ_i q_i.
+    modal_basis_ << 1.0 / std::sqrt(2.0), 1.0 / std::sqrt(2.0), 0.0,
+                    1.0 / std::sqrt(2.0), -1.0 / std::sqrt(2.0), 0.0,
+                    0.0, 0.0, 1.0;
+    for (int i = 0; i < 3; ++i) {
+      const Vector3 q = modal_basis_.col(i);
+      mises_eigenvalues_[std::size_t(i)] = q.dot(xi * q);
+      flow_eigenvalues_[std::size_t(i)] = q.dot(gamma * xi * q);
+    }
+    section_stiffness_ << d, 0.0, 0.0, d * d * d / 12.0;
+    uncoupled_modal_metric_ << 1.0 / (d * d), 0.0, 0.0, 16.0 / (d * d * d * d);
+    coupling_modal_metric_ << 0.0, 2.0 / (std::sqrt(3.0) * d * d * d),
+                              2.0 / (std::sqrt(3.0) * d * d * d), 0.0;
 
     if constexpr (Law::has_plasticity) {
       initial_yield_stress_ = law.parameters().sigma_y0;
@@ -215,6 +228,11 @@ class Section<Global, Law> {
 
   ReturnResult plastic_return(const Vector6& trial, double sigma_y_n) const {
     const double tolerance = 1e-12 * sigma_y_n * sigma_y_n;
+    // Pure bending or pure tension: the trial is on the ridge and s = 0 keeps it there.
+    if (std::abs(coupling_term(trial)) <= tolerance) {
+      const ReturnResult uncoupled = return_onto(trial, sigma_y_n, 0.0);
+      if (std::abs(coupling_term(uncoupled.resultants)) <= tolerance) return uncoupled;
+    }
     const double first_side = coupling_term(trial) >= 0.0 ? 1.0 : -1.0;
     const ReturnResult first = return_onto(trial, sigma_y_n, first_side);
     double first_coupling = coupling_term(first.resultants);
@@ -247,35 +265,55 @@ class Section<Global, Law> {
     throw Error("sphshell: Global resultant return map did not find the Ilyushin ridge");
   }
 
-  // Closest-point return onto xᵀÂ_s x = σs² for a fixed coupling sign s ∈ [−1, 1].
+  // Closest-point return onto xᵀÂ_s x = σs² for a fixed coupling coefficient
+  // s ∈ [−1, 1], solved mode by mode: y_i = (I + c λ_i K S_s)⁻¹ y_i* with
+  // y_i = (N·q_i, M·q_i), K = diag(d, d³/12), S_s the 2×2 metric, c = d Δε̄p/σs.
   ReturnResult return_onto(const Vector6& trial, double sigma_y_n, double s) const {
-    const Matrix6 metric = uncoupled_metric_ + s * coupling_metric_;
-    const Matrix6 flow = uncoupled_flow_ + s * coupling_flow_;
+    const Matrix2 metric = uncoupled_modal_metric_ + s * coupling_modal_metric_;
+    const Matrix2 flow = section_stiffness_ * metric;
+    Eigen::Matrix<double, 2, 3> modal_trial;
+    modal_trial.row(0) = (modal_basis_.transpose() * trial.template head<3>()).transpose();
+    modal_trial.row(1) = (modal_basis_.transpose() * trial.template tail<3>()).transpose();
+    Eigen::Matrix<double, 2, 3> modal = modal_trial;
     const double d = thickness_;
     const double hardening = hardening_modulus_;
-    Vector6 x = trial;
     auto residual = [&](double d_eps_p, double& derivative) {
       const double sigma_y = sigma_y_n + hardening * d_eps_p;
       const double c = d * d_eps_p / sigma_y;
-      const Eigen::PartialPivLU<Matrix6> lu(Matrix6::Identity() + c * flow);
-      x = lu.solve(trial);
-      const Vector6 dx_dc = -lu.solve(flow * x);
       const double dc_dp = d * sigma_y_n / (sigma_y * sigma_y);
-      derivative = 2.0 * x.dot(metric * dx_dc) * dc_dp - 2.0 * sigma_y * hardening;
-      return x.dot(metric * x) - sigma_y * sigma_y;
+      double g = -sigma_y * sigma_y;
+      derivative = -2.0 * sigma_y * hardening;
+      for (int i = 0; i < 3; ++i) {
+        const double lambda = flow_eigenvalues_[std::size_t(i)];
+        const double weight = mises_eigenvalues_[std::size_t(i)];
+        const Matrix2 inverse = (Matrix2::Identity() + c * lambda * flow).inverse();
+        const Vector2 y = inverse * modal_trial.col(i);
+        const Vector2 dy_dc = -inverse * (lambda * flow * y);
+        modal.col(i) = y;
+        g += weight * y.dot(metric * y);
+        derivative += 2.0 * weight * y.dot(metric * dy_dc) * dc_dp;
+      }
+      return g;
+    };
+    auto resultants_of = [&]() {
+      Vector6 x;
+      x << modal_basis_ * modal.row(0).transpose(), modal_basis_ * modal.row(1).transpose();
+      return x;
     };
 
     double derivative = 0.0;
     if (residual(0.0, derivative) <= 0.0) return {trial, 0.0};
     // Bracket [lower, upper] with g(lower) > 0 > g(upper); upper < 0 means not found yet.
     double lower = 0.0, upper = -1.0, d_eps_p = 0.0;
-    const double growth_step = std::sqrt(trial.dot(metric * trial)) / law_.youngs_modulus();
+    const double growth_step =
+        std::sqrt(trial.dot((uncoupled_metric_ + s * coupling_metric_) * trial)) /
+        law_.youngs_modulus();
     for (int iteration = 0; iteration < 200; ++iteration) {
       const double g = residual(d_eps_p, derivative);
       const double sigma_y = sigma_y_n + hardening * d_eps_p;
-      if (std::abs(g) <= 1e-13 * sigma_y * sigma_y) return {x, d_eps_p};
+      if (std::abs(g) <= 1e-13 * sigma_y * sigma_y) return {resultants_of(), d_eps_p};
       if (g > 0.0) lower = d_eps_p; else upper = d_eps_p;
-      if (upper >= 0.0 && upper - lower <= 1e-15 * upper) return {x, d_eps_p};
+      if (upper >= 0.0 && upper - lower <= 1e-15 * upper) return {resultants_of(), d_eps_p};
       double next = derivative < 0.0 ? d_eps_p - g / derivative : -1.0;
       const bool outside = !(next > lower) || (upper >= 0.0 && !(next < upper));
       if (outside) next = upper >= 0.0 ? 0.5 * (lower + upper) : 2.0 * lower + growth_step;
@@ -299,7 +337,10 @@ class Section<Global, Law> {
   double thickness_;
   Matrix6 stiffness_, compliance_;
   Matrix6 uncoupled_metric_, coupling_metric_;
-  Matrix6 uncoupled_flow_, coupling_flow_;
+  Matrix3 modal_basis_;
+  std::array<double, 3> mises_eigenvalues_{};
+  std::array<double, 3> flow_eigenvalues_{};
+  Matrix2 section_stiffness_, uncoupled_modal_metric_, coupling_modal_metric_;
   double initial_yield_stress_ = std::numeric_limits<double>::infinity();
   double hardening_modulus_ = 0.0;
   double damage_threshold_ = 0.0;
