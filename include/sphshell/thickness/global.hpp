@@ -4,9 +4,8 @@
 // points; the section works on the resultants directly:
 //   N = d Γ e (membrane),   M = d³/12 Γ κ (bending),
 // and, for plastic laws, resultant plasticity on the approximate Ilyushin yield surface
-// used by Crisfield (1974) for thin steel shells (also e.g. Crisfield, Non-linear Finite
-// Element Analysis of Solids and Structures, vol. 1, 1991, §6; Skallerud's SINTEF report
-// STF22 F98671, 1998):
+// of Crisfield (1974, "On an approximate yield criterion for thin steel shells", TRRL,
+// Crowthorne; the paper cites it for the global model's resultant algorithm, §2.2):
 //   F = Q_t + Q_m + |Q_tm|/√3 = 1,
 //   Q_t = NᵀΞN/N0²,  Q_m = MᵀΞM/M0²,  Q_tm = NᵀΞM/(N0 M0),  N0 = σs d,  M0 = σs d²/4.
 // It is exact for pure tension (N0) and pure bending (M0) of a Mises section and
