@@ -218,13 +218,15 @@ TEST_CASE("thickness Global membrane plasticity equals the integral model", "[th
     for (int step = 0; step < 300; ++step) {
       const Resultants a = global.update(global_state, direction, StrainVoigt::Zero());
       const Resultants b = integral.update(integral_state, direction, StrainVoigt::Zero());
-      REQUIRE((a.membrane - b.membrane).norm() <= 1e-9 * b.membrane.norm());
+      // Loose enough for any converged return map, far below the 3× error of an
+      // inconsistently scaled flow (design §2.4).
+      REQUIRE((a.membrane - b.membrane).norm() <= 1e-7 * b.membrane.norm());
     }
   }
   CHECK(global.equivalent_plastic_strain(global_state, 0) ==
-        Approx(integral.equivalent_plastic_strain(integral_state, 1)).epsilon(1e-9));
+        Approx(integral.equivalent_plastic_strain(integral_state, 1)).epsilon(1e-7));
   CHECK(global.equivalent_stress(global_state, 0) ==
-        Approx(integral.equivalent_stress(integral_state, 1)).epsilon(1e-9));
+        Approx(integral.equivalent_stress(integral_state, 1)).epsilon(1e-7));
 }
 
 TEST_CASE("thickness Global damage is monotone, bounded by Dc and fails at eps_c", "[thickness]") {
@@ -265,9 +267,10 @@ TEST_CASE("thickness integral damage: a stress point fails only when every point
     auto state = section.initial_state();
     for (int step = 0; step < 4000; ++step)
       section.update(state, StrainVoigt::Zero(), StrainVoigt(0.5, -0.25, 0.0));
-    CHECK(section.damage(state, 0) == 0.24);
-    CHECK(section.damage(state, 2) == 0.24);
+    CHECK(section.damage(state, 0) == Approx(0.24).margin(1e-12));
+    CHECK(section.damage(state, 2) == Approx(0.24).margin(1e-12));
     CHECK(section.damage(state, 1) == 0.0);
+    CHECK(section.resultants(state).moment.norm() == 0.0);
     CHECK_FALSE(section.all_failed(state));
   }
   SECTION("tension fails them all") {
