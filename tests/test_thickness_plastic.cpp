@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <random>
 #include <sstream>
 
@@ -232,8 +233,9 @@ TEST_CASE("thickness Global membrane plasticity equals the integral model", "[th
 TEST_CASE("thickness Global damage is monotone, bounded by Dc and fails at eps_c", "[thickness]") {
   const Section<Global, law::LemaitreDamage> section(damaging, d);
   auto state = section.initial_state();
-  double previous_D = 0.0;
+  double previous_D = 0.0, previous_eps_p = 0.0;
   int step = 0;
+  int damaged_returns = 0;
   for (; step < 100000 && !section.all_failed(state); ++step) {
     const StrainVoigt curvature = (step / 500) % 2 == 0 ? StrainVoigt(0.4, -0.2, 0.0)
                                                         : StrainVoigt(-0.1, 0.05, 0.0);
@@ -248,16 +250,34 @@ TEST_CASE("thickness Global damage is monotone, bounded by Dc and fails at eps_c
       const double expected = state.eps_p <= 0.02 ? 0.0 : 0.24 * (state.eps_p - 0.02) / 0.35;
       REQUIRE(D == Approx(expected).margin(1e-12));
       REQUIRE(section.ilyushin_function(state) <= 1.0 + 1e-10);
+      if (state.eps_p > previous_eps_p) {
+        // σ̄_I = (1 − D) σs after every return.
+        REQUIRE(section.equivalent_stress(state, 0) ==
+                Approx((1.0 - D) * state.sigma_y).epsilon(1e-10));
+        if (D > 0.0) ++damaged_returns;
+      }
     }
     previous_D = D;
+    previous_eps_p = state.eps_p;
   }
   REQUIRE(section.all_failed(state));
+  CHECK(damaged_returns > 100);
   CHECK(state.eps_p >= 0.37);
   CHECK(section.damage(state, 0) == 0.24);
   const Resultants after = section.update(state, StrainVoigt(1e-3, 0, 0), StrainVoigt(1, 0, 0));
   CHECK(after.membrane.norm() == 0.0);
   CHECK(after.moment.norm() == 0.0);
   CHECK(section.elastic_energy(state) == 0.0);
+}
+
+TEST_CASE("thickness Global rejects non-finite strain increments", "[thickness]") {
+  const Section<Global, law::J2Plasticity> section(hardening, d);
+  auto state = section.initial_state();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_AS(section.update(state, StrainVoigt(nan, 0, 0), StrainVoigt::Zero()),
+                  sphshell::Error);
+  CHECK_THROWS_AS(section.update(state, StrainVoigt::Zero(), StrainVoigt(0, 0, nan)),
+                  sphshell::Error);
 }
 
 TEST_CASE("thickness integral damage: a stress point fails only when every point has",
