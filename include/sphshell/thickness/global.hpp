@@ -234,10 +234,10 @@ class Section<Global, Law> {
     }
     const double first_side = coupling_term(trial) >= 0.0 ? 1.0 : -1.0;
     const ReturnResult first = return_onto(trial, sigma_y_n, first_side);
-    double first_coupling = coupling_term(first.resultants);
+    const double first_coupling = coupling_term(first.resultants);
     if (first_side * first_coupling >= -tolerance) return first;
     const ReturnResult second = return_onto(trial, sigma_y_n, -first_side);
-    double second_coupling = coupling_term(second.resultants);
+    const double second_coupling = coupling_term(second.resultants);
     if (-first_side * second_coupling >= -tolerance) return second;
 
     // Ridge: the coupling term changes sign between s = first_side and −first_side.
