@@ -1,0 +1,113 @@
+#pragma once
+// Section<Rule, Law>: the material state of one stress point through the thickness
+// and its integration into resultants, eq. (2.8)-(2.9):
+//   T = Σ_k σ_k A_k,   M = Σ_k σ_k ζ_k A_k.
+// This primary template serves every integral rule (Gauss<N>, Simpson<N>); global.hpp
+// specializes it for the resultant model Global. The strain at height ζ is the
+// mid-surface strain plus ζ times the curvature (eq. 2.1-2.2, linear part), so a
+// curvature κ > 0 stretches the fibres at ζ > 0.
+
+#include <sphshell/core/error.hpp>
+#include <sphshell/core/types.hpp>
+#include <sphshell/thickness/thickness.hpp>
+
+#include <array>
+#include <cstddef>
+
+namespace sphshell::thickness {
+
+template <class Rule, class Law>
+class Section {
+  static_assert(check_thickness_rule<Rule>());
+  static_assert(Rule::num_points >= 1,
+                "sphshell::thickness::Section: a rule with num_points = 0 needs its own "
+                "Section specialization (as Global has)");
+
+ public:
+  static constexpr int num_points = Rule::num_points;
+  static constexpr int output_points = Rule::num_points;
+  // Contiguous per stress point so the loop over integral points stays in cache.
+  using State = std::array<typename Law::State, std::size_t(num_points)>;
+
+  Section(const Law& law, double thickness) : law_(law), thickness_(thickness) {
+    sphshell::detail::require_positive("thickness", thickness);
+    for (int k = 0; k < num_points; ++k) {
+      zeta_[std::size_t(k)] = Rule::zeta(k, thickness);
+      weight_[std::size_t(k)] = Rule::weight(k, thickness);
+    }
+  }
+
+  State initial_state() const {
+    State state;
+    state.fill(law_.initial_state());
+    return state;
+  }
+
+  // Δε(ζ_k) = Δe + ζ_k Δκ at every integral point (Voigt, engineering shear), then the
+  // new total resultants.
+  Resultants update(State& state, const StrainVoigt& d_membrane_strain,
+                    const StrainVoigt& d_curvature) const {
+    for (int k = 0; k < num_points; ++k) {
+      const StrainVoigt d_strain = d_membrane_strain + zeta_[std::size_t(k)] * d_curvature;
+      law_.update(state[std::size_t(k)], d_strain);
+    }
+    return resultants(state);
+  }
+
+  Resultants resultants(const State& state) const {
+    Resultants result;
+    for (int k = 0; k < num_points; ++k) {
+      const StressVoigt& stress = state[std::size_t(k)].stress;
+      result.membrane += weight_[std::size_t(k)] * stress;
+      result.moment += (weight_[std::size_t(k)] * zeta_[std::size_t(k)]) * stress;
+    }
+    return result;
+  }
+
+  double equivalent_stress(const State& state, int k) const {
+    return law_.equivalent_stress(point(state, k));
+  }
+  double equivalent_plastic_strain(const State& state, int k) const {
+    return law_.equivalent_plastic_strain(point(state, k));
+  }
+  double damage(const State& state, int k) const { return law_.damage(point(state, k)); }
+
+  // A stress point is damaged (section 2.4 of the paper, rule 1) once every one of its
+  // integral points has failed.
+  bool all_failed(const State& state) const {
+    for (const auto& point_state : state)
+      if (!law_.failed(point_state)) return false;
+    return true;
+  }
+
+  // Per unit mid-surface area: ∫ w(ζ) dζ with the rule's weights.
+  double elastic_energy(const State& state) const {
+    double energy = 0.0;
+    for (int k = 0; k < num_points; ++k)
+      energy += weight_[std::size_t(k)] * law_.elastic_energy_density(state[std::size_t(k)]);
+    return energy;
+  }
+
+  double zeta(int k) const { return zeta_[checked(k)]; }
+  double weight(int k) const { return weight_[checked(k)]; }
+  double thickness() const { return thickness_; }
+  const Law& law() const { return law_; }
+
+ private:
+  static std::size_t checked(int k) {
+    if (k < 0 || k >= num_points)
+      sphshell::detail::invalid_parameter("integral point index", k,
+                                          "must lie in [0, num_points)");
+    return std::size_t(k);
+  }
+  static const typename Law::State& point(const State& state, int k) {
+    return state[checked(k)];
+  }
+
+  Law law_;
+  double thickness_;
+  std::array<double, std::size_t(num_points)> zeta_{};
+  std::array<double, std::size_t(num_points)> weight_{};
+};
+
+}  // namespace sphshell::thickness
