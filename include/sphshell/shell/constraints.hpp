@@ -1,0 +1,112 @@
+#pragma once
+// Kinematic conditions on particles: fixed or prescribed translation
+// components, fixed rotation components (clamped, simply supported, symmetry
+// planes), and prescribed motions.
+//
+// Each constrained particle keeps the projectors onto its free translation and
+// rotation subspaces; the solver projects velocities onto them and adds the
+// prescribed part. Constraint directions are fixed in space.
+
+#include <sphshell/core/error.hpp>
+#include <sphshell/core/types.hpp>
+
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
+namespace sphshell::detail {
+
+// Prescribed motion of a set of particles: the velocity to impose along
+// `direction` (or the full velocity when direction is zero) at time t over the
+// step dt, given the particle's reference position.
+class PrescribedMotion {
+ public:
+  virtual ~PrescribedMotion() = default;
+  // Returns the imposed velocity (a full vector; only its component in the
+  // constrained subspace is used).
+  virtual Vector3 velocity(int particle, const Vector3& reference_position, double t,
+                           double dt) const = 0;
+};
+
+template <class DisplacementFunction>
+class PrescribedDisplacement final : public PrescribedMotion {
+ public:
+  explicit PrescribedDisplacement(DisplacementFunction displacement)
+      : displacement_(std::move(displacement)) {}
+  // Central difference: the velocity that carries u(t) to u(t + dt) exactly.
+  Vector3 velocity(int, const Vector3& x, double t, double dt) const override {
+    return (displacement_(x, t + dt) - displacement_(x, t)) / dt;
+  }
+
+ private:
+  DisplacementFunction displacement_;
+};
+
+template <class VelocityFunction>
+class PrescribedVelocity final : public PrescribedMotion {
+ public:
+  explicit PrescribedVelocity(VelocityFunction velocity) : velocity_(std::move(velocity)) {}
+  Vector3 velocity(int, const Vector3& x, double t, double dt) const override {
+    return velocity_(x, t + 0.5 * dt);
+  }
+
+ private:
+  VelocityFunction velocity_;
+};
+
+struct ParticleConstraint {
+  Matrix3 free_translation = Matrix3::Identity();
+  Matrix3 free_rotation = Matrix3::Identity();
+  std::vector<const PrescribedMotion*> motions;  // summed, each projected on the fixed subspace
+};
+
+class Constraints {
+ public:
+  void fix_translation(int particle, const Vector3& direction) {
+    restrict(entry(particle).free_translation, direction, "translation direction");
+  }
+  void fix_rotation(int particle, const Vector3& axis) {
+    restrict(entry(particle).free_rotation, axis, "rotation axis");
+  }
+  void fix_all_translations(int particle) { entry(particle).free_translation.setZero(); }
+  void fix_all_rotations(int particle) { entry(particle).free_rotation.setZero(); }
+  void add_motion(int particle, const PrescribedMotion* motion) {
+    entry(particle).motions.push_back(motion);
+  }
+  template <class Motion>
+  const PrescribedMotion* own(std::unique_ptr<Motion> motion) {
+    owned_.push_back(std::move(motion));
+    return owned_.back().get();
+  }
+
+  bool empty() const { return particles_.empty(); }
+  const std::vector<int>& particles() const { return particles_; }
+  const ParticleConstraint& at(std::size_t k) const { return entries_[k]; }
+
+ private:
+  ParticleConstraint& entry(int particle) {
+    auto found = index_.find(particle);
+    if (found != index_.end()) return entries_[found->second];
+    index_[particle] = entries_.size();
+    particles_.push_back(particle);
+    entries_.emplace_back();
+    return entries_.back();
+  }
+  // Removes `direction` from the free subspace P: P ← P − (P c)(P c)ᵀ/|P c|².
+  static void restrict(Matrix3& free, const Vector3& direction, const char* name) {
+    if (!direction.allFinite() || direction.norm() == 0.0)
+      invalid_parameter(name, direction.transpose(), "must be finite and non-zero");
+    const Vector3 projected = free * direction.normalized();
+    const double length = projected.norm();
+    if (length < 1e-12) return;  // already fixed
+    const Vector3 c = projected / length;
+    free -= c * c.transpose();
+  }
+
+  std::vector<int> particles_;
+  std::vector<ParticleConstraint> entries_;
+  std::unordered_map<int, std::size_t> index_;
+  std::vector<std::unique_ptr<PrescribedMotion>> owned_;
+};
+
+}  // namespace sphshell::detail

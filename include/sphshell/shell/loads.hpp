@@ -1,0 +1,98 @@
+#pragma once
+// External loads on particles: pressure (uniform or p(X, t), follower or fixed
+// direction), point forces, and ready-made time functions.
+//
+// Each load is type-erased once (one virtual call per load per step); its loop
+// over particles calls the user's callable inline.
+
+#include <sphshell/core/error.hpp>
+#include <sphshell/core/types.hpp>
+
+#include <cmath>
+#include <memory>
+#include <utility>
+#include <vector>
+
+namespace sphshell {
+
+namespace time_function {
+// f(t) = 1 from t_start on (a step load).
+struct Step {
+  double t_start = 0.0;
+  double operator()(double t) const { return t >= t_start ? 1.0 : 0.0; }
+};
+// f(t) rises linearly from 0 at t_start to 1 at t_start + rise_time, then stays 1.
+struct Ramp {
+  double rise_time;
+  double t_start = 0.0;
+  double operator()(double t) const {
+    if (t <= t_start) return 0.0;
+    return t >= t_start + rise_time ? 1.0 : (t - t_start) / rise_time;
+  }
+};
+}  // namespace time_function
+
+// Which way a pressure pushes.
+enum class PressureDirection {
+  follower,  // along the current director (follows the deforming shell)
+  fixed      // along the reference normal
+};
+
+namespace detail {
+
+// Sign convention: a positive pressure acts on the face the normal points out
+// of and pushes the shell against its normal, f = −p A n (for a spherical cap
+// with outward normals, positive pressure is inward).
+struct LoadContext {
+  double time;
+  const std::vector<Vector3>& reference_position;
+  const std::vector<Vector3>& reference_normal;
+  const std::vector<Vector3>& director;
+  const std::vector<double>& area;
+  std::vector<Vector3>& force;
+};
+
+class Load {
+ public:
+  virtual ~Load() = default;
+  virtual void apply(LoadContext& context) const = 0;
+};
+
+template <class PressureFunction>
+class PressureLoad final : public Load {
+ public:
+  PressureLoad(std::vector<int> particles, PressureFunction pressure, PressureDirection direction)
+      : particles_(std::move(particles)), pressure_(std::move(pressure)), direction_(direction) {}
+  void apply(LoadContext& c) const override {
+    for (int i : particles_) {
+      const double p = pressure_(c.reference_position[i], c.time);
+      const Vector3& n =
+          direction_ == PressureDirection::follower ? c.director[i] : c.reference_normal[i];
+      c.force[i] -= p * c.area[i] * n;
+    }
+  }
+
+ private:
+  std::vector<int> particles_;
+  PressureFunction pressure_;
+  PressureDirection direction_;
+};
+
+template <class TimeFunction>
+class PointForceLoad final : public Load {
+ public:
+  PointForceLoad(std::vector<int> particles, Vector3 force, TimeFunction time_function)
+      : particles_(std::move(particles)), force_(force), time_function_(std::move(time_function)) {}
+  void apply(LoadContext& c) const override {
+    const Vector3 f = time_function_(c.time) * force_;
+    for (int i : particles_) c.force[i] += f;
+  }
+
+ private:
+  std::vector<int> particles_;
+  Vector3 force_;
+  TimeFunction time_function_;
+};
+
+}  // namespace detail
+}  // namespace sphshell

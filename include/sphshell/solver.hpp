@@ -1,0 +1,671 @@
+#pragma once
+// Solver<Approx, Rule, Material, Crack>: explicit dynamics of an SPH shell
+// (design.md §2, the paper's Table 2 program flow).
+//
+// Each step: strains at the integration points from the current particle
+// positions and directors → material update through the thickness rule →
+// resultants → internal forces and moments on the particles → central
+// difference update of velocities, positions and directors.
+//
+// Integration points are the stress points (membrane, bending and transverse
+// shear) and, for stability, the particles themselves (design.md §2.3): the
+// membrane and bending work is shared between the two sets, and the particles
+// add a small, softened transverse-shear term. This removes the spurious
+// zero-energy modes of stress-point-only quadrature without shear locking.
+
+#include <sphshell/approx/approx.hpp>
+#include <sphshell/core/error.hpp>
+#include <sphshell/core/frame.hpp>
+#include <sphshell/core/types.hpp>
+#include <sphshell/crack/crack.hpp>
+#include <sphshell/crack/none.hpp>
+#include <sphshell/material/material.hpp>
+#include <sphshell/shell/constraints.hpp>
+#include <sphshell/shell/kinematics.hpp>
+#include <sphshell/shell/loads.hpp>
+#include <sphshell/shell/model.hpp>
+#include <sphshell/thickness/section.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace sphshell {
+
+struct SolverOptions {
+  double density = 7850.0;  // ρ, kg/m³
+  // Geometrically nonlinear (Green strain, paper §3.2) or linear (§3.1) analysis.
+  bool nonlinear = true;
+  // The time step is safety_factor × the stable bound (see stable_time_step()).
+  double safety_factor = 0.8;
+  // A user time step (s); 0 selects safety_factor × the bound. A step above the
+  // bound is refused.
+  double time_step = 0.0;
+  // Mass-proportional damping coefficient c (1/s): M a = f − c M v. For
+  // quasi-static solutions by dynamic relaxation; 0 for dynamics.
+  double damping = 0.0;
+  // Support radius of the approximation in units of the particle spacing.
+  double support_radius_factor = 2.0;
+  // Rotary inertia ρ d³/12 A is multiplied by this (≥ 1), as explicit FE shell
+  // codes do to lift the shear–rotation frequency limit on thin shells.
+  double rotary_inertia_scale = 1.0;
+  double shear_correction = 5.0 / 6.0;  // κs of the elastic transverse shear
+  // Particle integration (design.md §2.3): share of the membrane and bending
+  // work carried by the particles (the stress points carry the rest), and the
+  // particles' transverse-shear weight (fraction of their area) with its
+  // stiffness softened by d² / (d² + softening Δ²).
+  double particle_integration_share = 0.5;
+  double particle_shear_weight = 0.01;
+  double particle_shear_softening = 0.01;
+  // Print a progress line every this many steps (0: quiet).
+  long progress_interval = 0;
+  // A run stops with an error when |energy balance| exceeds this fraction of
+  // the largest energy in play (after the first steps).
+  double energy_tolerance = 0.5;
+};
+
+struct EnergyReport {
+  double kinetic = 0.0;
+  double internal = 0.0;             // work done on the shell's material (elastic + dissipated)
+  double elastic = 0.0;              // recoverable part of internal
+  double plastic_dissipation = 0.0;  // internal − elastic
+  double external_work = 0.0;        // loads and prescribed motions
+  double damping_work = 0.0;         // removed by mass-proportional damping
+  // Zero up to time-discretization error: kinetic + internal + damping − external.
+  double balance() const { return kinetic + internal + damping_work - external_work; }
+};
+
+template <class Approx, class Rule, class Material, class Crack = crack::None>
+class Solver {
+  static_assert(approx::is_approximation<Approx>::value,
+                "Solver: the first parameter must be an approximation policy (approx::MLS<Kernel> or approx::NSPH<Kernel>)");
+  static_assert(thickness::is_thickness_rule<Rule>,
+                "Solver: the second parameter must be a thickness rule (thickness::Gauss<N>, thickness::Simpson<N> or thickness::Global)");
+  static_assert(material::is_material_law<Material>::value,
+                "Solver: the third parameter must be a material law (material::Elastic, J2Plasticity or LemaitreDamage)");
+  static_assert(crack::is_crack_policy<Crack>::value,
+                "Solver: the fourth parameter must be a crack policy (crack::None or crack::LineSegments)");
+
+ public:
+  using Section = thickness::Section<Rule, Material>;
+  using SectionState = typename Section::State;
+  using MaterialParameters = typename Material::Parameters;
+
+  Solver(ShellModel model, const MaterialParameters& parameters, SolverOptions options = {})
+      : model_(std::move(model)),
+        law_(parameters),
+        section_(law_, model_.thickness()),
+        options_(options) {
+    validate_options();
+    initialize_particles();
+    initialize_integration_points();
+    stable_time_step_ = compute_stable_time_step();
+    if (options_.time_step > 0.0) {
+      if (options_.time_step > stable_time_step_)
+        detail::invalid_parameter("time_step", options_.time_step,
+                                  "exceeds the stable bound " + to_string(stable_time_step_) + " s");
+      time_step_ = options_.time_step;
+    } else {
+      time_step_ = options_.safety_factor * stable_time_step_;
+    }
+  }
+
+  // Boundary conditions on particle sets.
+  void clamp(const ParticleSet& set) {
+    for (int i : checked(set)) {
+      constraints_.fix_all_translations(i);
+      constraints_.fix_all_rotations(i);
+    }
+  }
+  // Translations fixed, rotations free ("soft" simple support).
+  void simply_support(const ParticleSet& set) {
+    for (int i : checked(set)) constraints_.fix_all_translations(i);
+  }
+  // Translations fixed and the director kept from tilting along the edge
+  // ("hard" simple support of Mindlin plates): fixes rotation about n × t.
+  void simply_support_hard(const ParticleSet& set, const Vector3& edge_tangent) {
+    for (int i : checked(set)) {
+      constraints_.fix_all_translations(i);
+      constraints_.fix_rotation(i, model_.particle_normal[i].cross(edge_tangent));
+    }
+  }
+  // Mirror symmetry about a plane (given by its normal) through the particles:
+  // no translation across the plane and no rotation tilting the director out of it.
+  void symmetry_plane(const ParticleSet& set, const Vector3& plane_normal) {
+    for (int i : checked(set)) {
+      constraints_.fix_translation(i, plane_normal);
+      constraints_.fix_rotation(i, model_.particle_normal[i].cross(plane_normal));
+    }
+  }
+  void fix_translation(const ParticleSet& set, const Vector3& direction) {
+    for (int i : checked(set)) constraints_.fix_translation(i, direction);
+  }
+  void fix_rotation(const ParticleSet& set, const Vector3& axis) {
+    for (int i : checked(set)) constraints_.fix_rotation(i, axis);
+  }
+  // Prescribed displacement u(X, t) (a Vector3 from the reference position and
+  // time) imposed on all three translations of the set.
+  template <class DisplacementFunction>
+  void prescribe_displacement(const ParticleSet& set, DisplacementFunction displacement) {
+    add_motion(set, std::make_unique<detail::PrescribedDisplacement<DisplacementFunction>>(
+                        std::move(displacement)));
+  }
+  // Prescribed velocity v(X, t) imposed on all three translations of the set.
+  template <class VelocityFunction>
+  void prescribe_velocity(const ParticleSet& set, VelocityFunction velocity) {
+    add_motion(set, std::make_unique<detail::PrescribedVelocity<VelocityFunction>>(
+                        std::move(velocity)));
+  }
+
+  // Loads. Pressure p(X, t) in Pa (see loads.hpp for the sign convention).
+  template <class PressureFunction>
+  void add_pressure(const ParticleSet& set, PressureFunction pressure,
+                    PressureDirection direction = PressureDirection::follower) {
+    loads_.push_back(std::make_unique<detail::PressureLoad<PressureFunction>>(
+        checked(set), std::move(pressure), direction));
+  }
+  template <class TimeFunction = time_function::Step>
+  void add_uniform_pressure(const ParticleSet& set, double pressure, TimeFunction time = {},
+                            PressureDirection direction = PressureDirection::follower) {
+    detail::require_finite("pressure", pressure);
+    add_pressure(
+        set, [pressure, time](const Vector3&, double t) { return pressure * time(t); }, direction);
+  }
+  template <class TimeFunction = time_function::Step>
+  void add_point_force(const ParticleSet& set, const Vector3& force, TimeFunction time = {}) {
+    if (!force.allFinite()) detail::invalid_parameter("point force", force.transpose(), "must be finite");
+    loads_.push_back(std::make_unique<detail::PointForceLoad<TimeFunction>>(checked(set), force,
+                                                                              std::move(time)));
+  }
+
+  // One explicit step of size time_step().
+  void step() {
+    if (!forces_current_) compute_internal_forces();
+    const double dt = steps_ == 0 ? 0.5 * time_step_ : time_step_;  // leapfrog start-up
+    apply_external_loads(time_);
+    advance_velocities(dt);
+    advance_configuration();
+    time_ += time_step_;
+    ++steps_;
+    forces_current_ = false;
+    compute_internal_forces();
+    check_stability();
+    if (options_.progress_interval > 0 && steps_ % options_.progress_interval == 0) print_progress();
+  }
+
+  // Steps until time t_end, calling observer(*this) after every step.
+  template <class Observer>
+  void run_until(double t_end, Observer&& observer) {
+    detail::require_finite("t_end", t_end);
+    while (time_ < t_end - 0.5 * time_step_) {
+      step();
+      observer(*this);
+    }
+  }
+  void run_until(double t_end) {
+    run_until(t_end, [](const Solver&) {});
+  }
+
+  double time() const { return time_; }
+  long steps() const { return steps_; }
+  double time_step() const { return time_step_; }
+  double stable_time_step() const { return stable_time_step_; }
+  const ShellModel& model() const { return model_; }
+  const Material& material() const { return law_; }
+  const SolverOptions& options() const { return options_; }
+
+  std::size_t particle_count() const { return position_.size(); }
+  const std::vector<Vector3>& positions() const { return position_; }
+  const std::vector<Vector3>& directors() const { return director_; }
+  const std::vector<Vector3>& velocities() const { return velocity_; }
+  const std::vector<Vector3>& angular_velocities() const { return angular_velocity_; }
+  Vector3 displacement(int particle) const {
+    return position_[particle] - model_.particle_position[particle];
+  }
+  // Rotation vector taking the reference director to the current one.
+  Vector3 rotation(int particle) const {
+    const Vector3& from = model_.particle_normal[particle];
+    const Vector3& to = director_[particle];
+    const Vector3 axis = from.cross(to);
+    const double sine = axis.norm();
+    if (sine < 1e-300) return Vector3::Zero();
+    return axis / sine * std::atan2(sine, from.dot(to));
+  }
+  const std::vector<double>& masses() const { return mass_; }
+  const std::vector<double>& rotary_inertias() const { return rotary_inertia_; }
+  const std::vector<Vector3>& internal_forces() const { return internal_force_; }
+  // ∂Π/∂d_j: the internal generalized force on each director.
+  const std::vector<Vector3>& internal_director_forces() const { return internal_director_force_; }
+
+  // Sets positions and directors (e.g. for a restart or a test); velocities are
+  // kept. Internal forces are recomputed from the material states at the next step.
+  void set_configuration(std::vector<Vector3> positions, std::vector<Vector3> directors) {
+    if (positions.size() != position_.size() || directors.size() != director_.size())
+      detail::invalid_parameter("configuration size", positions.size(), "must equal the particle count");
+    position_ = std::move(positions);
+    director_ = std::move(directors);
+    for (Vector3& d : director_) d.normalize();
+    compute_internal_forces();
+  }
+
+  // Per stress point, per thickness output point k (integral point; one for Global).
+  static constexpr int output_points = Section::output_points;
+  std::size_t stress_point_count() const { return model_.stress_point_count(); }
+  double equivalent_stress(int stress_point, int k) const {
+    return section_.equivalent_stress(state_[stress_point], k);
+  }
+  double equivalent_plastic_strain(int stress_point, int k) const {
+    return section_.equivalent_plastic_strain(state_[stress_point], k);
+  }
+  double damage(int stress_point, int k) const { return section_.damage(state_[stress_point], k); }
+  const StressVoigt& membrane_force(int stress_point) const { return membrane_[stress_point]; }
+  const StressVoigt& bending_moment(int stress_point) const { return moment_[stress_point]; }
+
+  EnergyReport energy() const {
+    EnergyReport report;
+    report.kinetic = kinetic_energy_;
+    report.internal = internal_energy_;
+    double elastic = 0.0;
+    for (std::size_t p = 0; p < state_.size(); ++p)
+      elastic += membrane_bending_weight_[p] * section_.elastic_energy(state_[p]) +
+                 0.5 * shear_weight_[p] * shear_[p].squaredNorm();
+    report.elastic = elastic;
+    report.plastic_dissipation = internal_energy_ - elastic;
+    report.external_work = external_work_;
+    report.damping_work = damping_work_;
+    return report;
+  }
+
+ private:
+  void validate_options() const {
+    detail::require_positive("density", options_.density);
+    detail::require_half_open_interval("safety_factor", options_.safety_factor, 0.0, 1.0);
+    detail::require_nonnegative("time_step", options_.time_step);
+    detail::require_nonnegative("damping", options_.damping);
+    detail::require_positive("support_radius_factor", options_.support_radius_factor);
+    if (!(options_.rotary_inertia_scale >= 1.0) || !std::isfinite(options_.rotary_inertia_scale))
+      detail::invalid_parameter("rotary_inertia_scale", options_.rotary_inertia_scale, "must be finite and >= 1");
+    detail::require_half_open_interval("shear_correction", options_.shear_correction, 0.0, 1.0);
+    if (!(options_.particle_integration_share >= 0.0 && options_.particle_integration_share < 1.0))
+      detail::invalid_parameter("particle_integration_share", options_.particle_integration_share,
+                                "must lie in [0, 1)");
+    detail::require_nonnegative("particle_shear_weight", options_.particle_shear_weight);
+    detail::require_nonnegative("particle_shear_softening", options_.particle_shear_softening);
+    detail::require_positive("energy_tolerance", options_.energy_tolerance);
+  }
+
+  ParticleSet checked(const ParticleSet& set) const {
+    if (set.empty()) detail::invalid_parameter("particle set size", 0, "must not be empty");
+    for (int i : set)
+      if (i < 0 || static_cast<std::size_t>(i) >= model_.particle_count())
+        detail::invalid_parameter("particle index", i, "out of range");
+    return set;
+  }
+
+  template <class Motion>
+  void add_motion(const ParticleSet& set, std::unique_ptr<Motion> motion) {
+    const detail::PrescribedMotion* owned = constraints_.own(std::move(motion));
+    for (int i : checked(set)) {
+      constraints_.fix_all_translations(i);
+      constraints_.add_motion(i, owned);
+    }
+  }
+
+  static std::string to_string(double value) {
+    std::ostringstream out;
+    out.precision(6);
+    out << value;
+    return out.str();
+  }
+
+  void initialize_particles() {
+    const std::size_t n = model_.particle_count();
+    const double d = model_.thickness();
+    position_ = model_.particle_position;
+    director_ = model_.particle_normal;
+    velocity_.assign(n, Vector3::Zero());
+    angular_velocity_.assign(n, Vector3::Zero());
+    mass_.resize(n);
+    rotary_inertia_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      mass_[i] = options_.density * d * model_.particle_area[i];
+      rotary_inertia_[i] =
+          options_.rotary_inertia_scale * options_.density * d * d * d / 12.0 * model_.particle_area[i];
+    }
+    internal_force_.assign(n, Vector3::Zero());
+    internal_director_force_.assign(n, Vector3::Zero());
+    external_force_.assign(n, Vector3::Zero());
+  }
+
+  // Shape functions at the stress points (group 0) and at the particles (group
+  // 1), built once in the reference configuration (total Lagrangian).
+  void initialize_integration_points() {
+    const double spacing = model_.maximum_spacing();
+    smoothing_length_ =
+        options_.support_radius_factor * spacing / Approx::kernel_type::support_radius_factor;
+    std::vector<TangentFrame> stress_frames, particle_frames;
+    for (const Vector3& normal : model_.stress_point_normal) stress_frames.push_back(tangent_frame(normal));
+    for (const Vector3& normal : model_.particle_normal) particle_frames.push_back(tangent_frame(normal));
+    shape_[0] = Approx::build(model_.particle_position, model_.particle_area,
+                              model_.stress_point_position, stress_frames, smoothing_length_);
+    const bool particles_integrate =
+        options_.particle_integration_share > 0.0 || options_.particle_shear_weight > 0.0;
+    if (particles_integrate)
+      shape_[1] = Approx::build(model_.particle_position, model_.particle_area,
+                                model_.particle_position, particle_frames, smoothing_length_);
+
+    const std::size_t stress_points = model_.stress_point_count();
+    const std::size_t particle_points = particles_integrate ? model_.particle_count() : 0;
+    point_offset_ = {0, stress_points};
+    const std::size_t total = stress_points + particle_points;
+    const double d = model_.thickness();
+    const double shear_modulus = law_.youngs_modulus() / (2.0 * (1.0 + law_.poisson_ratio()));
+    const double shear_stiffness = options_.shear_correction * shear_modulus * d;
+
+    membrane_bending_weight_.resize(total);
+    shear_weight_.resize(total);
+    for (std::size_t p = 0; p < stress_points; ++p) {
+      membrane_bending_weight_[p] =
+          (1.0 - options_.particle_integration_share) * model_.stress_point_area[p];
+      shear_weight_[p] = model_.stress_point_area[p] * shear_stiffness;
+    }
+    for (std::size_t i = 0; i < particle_points; ++i) {
+      const double local_spacing = std::sqrt(model_.particle_area[i]);
+      const double softening =
+          d * d / (d * d + options_.particle_shear_softening * local_spacing * local_spacing);
+      membrane_bending_weight_[stress_points + i] =
+          options_.particle_integration_share * model_.particle_area[i];
+      shear_weight_[stress_points + i] =
+          options_.particle_shear_weight * model_.particle_area[i] * shear_stiffness * softening;
+    }
+    reference_.resize(total);
+    for (int group = 0; group < 2; ++group)
+      for (std::size_t row = 0; row < point_count(group); ++row)
+        reference_[point_offset_[group] + row] = gather(group, row, position_, director_);
+
+    state_.assign(total, section_.initial_state());
+    membrane_strain_.assign(total, StrainVoigt::Zero());
+    curvature_.assign(total, StrainVoigt::Zero());
+    shear_.assign(total, Vector2::Zero());
+    membrane_.assign(total, StressVoigt::Zero());
+    moment_.assign(total, StressVoigt::Zero());
+    work_increment_.assign(total, 0.0);
+    build_slot_transpose();
+  }
+
+  std::size_t point_count(int group) const {
+    return group == 0 ? shape_[0].rows() : (point_offset_[1] == 0 ? 0 : shape_[1].rows());
+  }
+  std::size_t total_points() const { return state_.size(); }
+
+  // Maps every particle to the shape-function slots that reference it, so the
+  // force gather is a deterministic per-particle sum (no atomics, identical
+  // results for any thread count).
+  void build_slot_transpose() {
+    slot_offset_ = {0, shape_[0].neighbour.size()};
+    const std::size_t slots = shape_[0].neighbour.size() + shape_[1].neighbour.size();
+    slot_force_.assign(slots, Vector3::Zero());
+    slot_director_force_.assign(slots, Vector3::Zero());
+    std::vector<std::size_t> count(model_.particle_count() + 1, 0);
+    auto for_each_slot = [&](auto&& visit) {
+      for (int group = 0; group < 2; ++group) {
+        const approx::ShapeFunctions& shape = shape_[group];
+        for (std::size_t row = 0; row < point_count(group); ++row)
+          for (std::size_t s = shape.row_begin[row]; s < shape.row_begin[row] + shape.row_size[row]; ++s)
+            visit(shape.neighbour[s], slot_offset_[group] + s);
+      }
+    };
+    for_each_slot([&](int particle, std::size_t) { ++count[particle + 1]; });
+    for (std::size_t i = 1; i < count.size(); ++i) count[i] += count[i - 1];
+    particle_slot_begin_ = count;
+    particle_slots_.resize(count.back());
+    for_each_slot([&](int particle, std::size_t slot) { particle_slots_[count[particle]++] = slot; });
+  }
+
+  shell::SurfaceGradients gather(int group, std::size_t row, const std::vector<Vector3>& x,
+                                 const std::vector<Vector3>& d) const {
+    const approx::ShapeFunctions& shape = shape_[group];
+    shell::SurfaceGradients g;
+    const std::size_t end = shape.row_begin[row] + shape.row_size[row];
+    for (std::size_t s = shape.row_begin[row]; s < end; ++s) {
+      const int j = shape.neighbour[s];
+      g.a1 += shape.dphi_d1[s] * x[j];
+      g.a2 += shape.dphi_d2[s] * x[j];
+      g.n += shape.phi[s] * d[j];
+      g.n1 += shape.dphi_d1[s] * d[j];
+      g.n2 += shape.dphi_d2[s] * d[j];
+    }
+    return g;
+  }
+
+  // Strains → material update → resultants → forces on the slots of one point.
+  void integrate_point(int group, std::size_t row) {
+    const std::size_t p = point_offset_[group] + row;
+    const shell::SurfaceGradients current = gather(group, row, position_, director_);
+    const shell::SurfaceGradients& reference = reference_[p];
+    const shell::Strains strains = options_.nonlinear ? shell::green_strains(current, reference)
+                                                      : shell::linear_strains(current, reference);
+    const StrainVoigt d_membrane = strains.membrane - membrane_strain_[p];
+    const StrainVoigt d_curvature = strains.curvature - curvature_[p];
+    const Vector2 d_shear = strains.shear - shear_[p];
+    const thickness::Resultants resultants = section_.update(state_[p], d_membrane, d_curvature);
+    const double w = membrane_bending_weight_[p];
+    // Trapezoidal work of the generalized stresses over the strain increment;
+    // the elastic shear force is shear_weight_ × γ (the weight holds κs G d A).
+    work_increment_[p] =
+        w * (0.5 * (membrane_[p] + resultants.membrane).dot(d_membrane) +
+             0.5 * (moment_[p] + resultants.moment).dot(d_curvature)) +
+        shear_weight_[p] * 0.5 * (shear_[p] + strains.shear).dot(d_shear);
+    membrane_strain_[p] = strains.membrane;
+    curvature_[p] = strains.curvature;
+    shear_[p] = strains.shear;
+    membrane_[p] = resultants.membrane;
+    moment_[p] = resultants.moment;
+
+    const shell::WeightedStresses weighted{w * resultants.membrane, w * resultants.moment,
+                                           shear_weight_[p] * strains.shear};
+    const shell::ConjugateForces f =
+        shell::conjugate_forces(options_.nonlinear ? current : reference, weighted);
+    const approx::ShapeFunctions& shape = shape_[group];
+    const std::size_t end = shape.row_begin[row] + shape.row_size[row];
+    for (std::size_t s = shape.row_begin[row]; s < end; ++s) {
+      const std::size_t slot = slot_offset_[group] + s;
+      slot_force_[slot] = shape.dphi_d1[s] * f.a1 + shape.dphi_d2[s] * f.a2;
+      slot_director_force_[slot] = shape.phi[s] * f.n + shape.dphi_d1[s] * f.n1 + shape.dphi_d2[s] * f.n2;
+    }
+  }
+
+  void compute_internal_forces() {
+    for (int group = 0; group < 2; ++group) {
+      const long rows = static_cast<long>(point_count(group));
+#pragma omp parallel for schedule(static)
+      for (long row = 0; row < rows; ++row) integrate_point(group, static_cast<std::size_t>(row));
+    }
+    const long particles = static_cast<long>(model_.particle_count());
+#pragma omp parallel for schedule(static)
+    for (long i = 0; i < particles; ++i) {
+      Vector3 force = Vector3::Zero(), director_force = Vector3::Zero();
+      for (std::size_t k = particle_slot_begin_[i]; k < particle_slot_begin_[i + 1]; ++k) {
+        force += slot_force_[particle_slots_[k]];
+        director_force += slot_director_force_[particle_slots_[k]];
+      }
+      internal_force_[i] = force;
+      internal_director_force_[i] = director_force;
+    }
+    for (double work : work_increment_) internal_energy_ += work;
+    std::fill(work_increment_.begin(), work_increment_.end(), 0.0);
+    forces_current_ = true;
+  }
+
+  void apply_external_loads(double t) {
+    std::fill(external_force_.begin(), external_force_.end(), Vector3::Zero());
+    detail::LoadContext context{t, model_.particle_position, model_.particle_normal, director_,
+                                model_.particle_area, external_force_};
+    for (const auto& load : loads_) load->apply(context);
+  }
+
+  // v^{n+½} = v^{n−½} + dt M⁻¹ (f_ext − f_int) with mass-proportional damping
+  // taken at the mid-step velocity; then the kinematic conditions.
+  void advance_velocities(double dt) {
+    const std::size_t n = position_.size();
+    const double c = options_.damping;
+    const double keep = (1.0 - 0.5 * c * dt) / (1.0 + 0.5 * c * dt);
+    const double gain = dt / (1.0 + 0.5 * c * dt);
+    old_velocity_ = velocity_;
+    old_angular_velocity_ = angular_velocity_;
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vector3 force = external_force_[i] - internal_force_[i];
+      velocity_[i] = keep * velocity_[i] + gain * force / mass_[i];
+      // Moment of the director forces: δΠ = g·δd with δd = δθ × d gives d × g.
+      const Vector3 moment = -director_[i].cross(internal_director_force_[i]);
+      Vector3 omega = keep * angular_velocity_[i] + gain * moment / rotary_inertia_[i];
+      angular_velocity_[i] = omega - omega.dot(director_[i]) * director_[i];  // no drilling
+    }
+    // Velocity the unconstrained update produced, for the reaction work below.
+    std::vector<Vector3>& free_velocity = scratch_;
+    free_velocity = velocity_;
+    for (std::size_t k = 0; k < constraints_.particles().size(); ++k) {
+      const int i = constraints_.particles()[k];
+      const detail::ParticleConstraint& constraint = constraints_.at(k);
+      Vector3 prescribed = Vector3::Zero();
+      for (const detail::PrescribedMotion* motion : constraint.motions)
+        prescribed += motion->velocity(i, model_.particle_position[i], time_, dt);
+      velocity_[i] = constraint.free_translation * velocity_[i] +
+                     (Matrix3::Identity() - constraint.free_translation) * prescribed;
+      const Vector3 omega = constraint.free_rotation * angular_velocity_[i];
+      angular_velocity_[i] = omega - omega.dot(director_[i]) * director_[i];
+    }
+    // Energy: the work of each force over the step is f · dt · (v^{n−½} + v^{n+½})/2.
+    double external = 0.0, damping = 0.0, kinetic = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vector3 average = 0.5 * (old_velocity_[i] + velocity_[i]);
+      const Vector3 reaction = mass_[i] * (velocity_[i] - free_velocity[i]) / dt;
+      external += dt * (external_force_[i] + reaction).dot(average);
+      damping += dt * c * mass_[i] * average.squaredNorm() +
+                 dt * c * rotary_inertia_[i] *
+                     (0.5 * (old_angular_velocity_[i] + angular_velocity_[i])).squaredNorm();
+      kinetic += 0.5 * mass_[i] * velocity_[i].squaredNorm() +
+                 0.5 * rotary_inertia_[i] * angular_velocity_[i].squaredNorm();
+    }
+    external_work_ += external;
+    damping_work_ += damping;
+    kinetic_energy_ = kinetic;
+  }
+
+  // x^{n+1} = x^n + dt v^{n+½}; directors rotate by dt ω^{n+½} (Rodrigues).
+  void advance_configuration() {
+    const double dt = time_step_;
+    const std::size_t n = position_.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      position_[i] += dt * velocity_[i];
+      const Vector3 rotation = dt * angular_velocity_[i];
+      const double angle = rotation.norm();
+      if (angle > 0.0) {
+        const Vector3 axis = rotation / angle;
+        const Vector3& d = director_[i];
+        director_[i] = (d * std::cos(angle) + axis.cross(d) * std::sin(angle) +
+                        axis * axis.dot(d) * (1.0 - std::cos(angle)))
+                           .normalized();
+      }
+    }
+  }
+
+  // Stable step of the central difference scheme, dt ≤ 2/ω_max, with ω_max
+  // bounded from the wave speeds over the smallest spacing Δ:
+  //   membrane  ω_m² = 9 c_m² / Δ²,   c_m² = E / (ρ (1 − ν²)),
+  //   rotation  ω_r² = (12 κs G / (ρ d²) + 9 c_m² / Δ²) / s_I + 9 c_s² / Δ²,   c_s² = κs G / ρ,
+  // where the rotational line is the director's oscillator (transverse shear
+  // stiffness κs G d and bending stiffness E d³/(12(1−ν²)) over Δ², against the
+  // rotary inertia ρ d³/12 scaled by s_I) plus the shear wave it couples to.
+  // ω_max² = max(ω_m², ω_r²). The factor 9 covers the highest mode of a square
+  // grid with this approximation (8.0 measured for the membrane); the tests
+  // check the bound against the exact spectrum of the assembled system.
+  double compute_stable_time_step() const {
+    const double E = law_.youngs_modulus(), nu = law_.poisson_ratio();
+    const double rho = options_.density, d = model_.thickness();
+    const double G = E / (2.0 * (1.0 + nu));
+    const double spacing = model_.minimum_spacing();
+    const double membrane_speed_squared = E / (rho * (1.0 - nu * nu));
+    const double shear_speed_squared = options_.shear_correction * G / rho;
+    const double membrane = 9.0 * membrane_speed_squared / (spacing * spacing);
+    const double rotation =
+        (12.0 * shear_speed_squared / (d * d) + membrane) / options_.rotary_inertia_scale +
+        9.0 * shear_speed_squared / (spacing * spacing);
+    return 2.0 / std::sqrt(std::max(membrane, rotation));
+  }
+
+  void check_stability() {
+    const std::size_t n = position_.size();
+    for (std::size_t i = 0; i < n; ++i)
+      if (!position_[i].allFinite() || !director_[i].allFinite() || !internal_force_[i].allFinite())
+        fail_unstable("non-finite state at particle " + std::to_string(i));
+    const EnergyReport e = energy();
+    const double scale = std::max({std::abs(e.external_work), e.kinetic, std::abs(e.internal)});
+    if (steps_ > 20 && scale > 0.0 && std::abs(e.balance()) > options_.energy_tolerance * scale) {
+      std::ostringstream message;
+      message << "energy balance lost (kinetic " << e.kinetic << " J, internal " << e.internal
+              << " J, external work " << e.external_work << " J, balance " << e.balance()
+              << " J); reduce the time step or check the loads";
+      fail_unstable(message.str());
+    }
+  }
+
+  [[noreturn]] void fail_unstable(const std::string& what) const {
+    std::ostringstream message;
+    message.precision(6);
+    message << "sphshell: simulation unstable at step " << steps_ << ", t = " << time_ << " s: " << what;
+    throw Error(message.str());
+  }
+
+  void print_progress() const {
+    const EnergyReport e = energy();
+    std::ostringstream line;
+    line.precision(4);
+    line << "step " << steps_ << "  t = " << time_ << " s  kinetic " << e.kinetic << " J  internal "
+         << e.internal << " J  external " << e.external_work << " J  balance " << e.balance() << " J\n";
+    std::cout << line.str() << std::flush;
+  }
+
+  ShellModel model_;
+  Material law_;
+  Section section_;
+  SolverOptions options_;
+  double smoothing_length_ = 0.0;
+  double stable_time_step_ = 0.0;
+  double time_step_ = 0.0;
+  double time_ = 0.0;
+  long steps_ = 0;
+  bool forces_current_ = false;
+
+  std::vector<Vector3> position_, director_, velocity_, angular_velocity_;
+  std::vector<Vector3> old_velocity_, old_angular_velocity_, scratch_;
+  std::vector<double> mass_, rotary_inertia_;
+  std::vector<Vector3> internal_force_, internal_director_force_, external_force_;
+
+  std::array<approx::ShapeFunctions, 2> shape_;
+  std::array<std::size_t, 2> point_offset_{};
+  std::array<std::size_t, 2> slot_offset_{};
+  // Integration weights: area share for membrane and bending; area × κs G d
+  // (softened at particles) for transverse shear.
+  std::vector<double> membrane_bending_weight_, shear_weight_;
+  std::vector<shell::SurfaceGradients> reference_;
+  std::vector<SectionState> state_;
+  std::vector<StrainVoigt> membrane_strain_, curvature_;
+  std::vector<Vector2> shear_;
+  std::vector<StressVoigt> membrane_, moment_;
+  std::vector<double> work_increment_;
+  std::vector<Vector3> slot_force_, slot_director_force_;
+  std::vector<std::size_t> particle_slot_begin_, particle_slots_;
+
+  detail::Constraints constraints_;
+  std::vector<std::unique_ptr<detail::Load>> loads_;
+  double internal_energy_ = 0.0, external_work_ = 0.0, damping_work_ = 0.0, kinetic_energy_ = 0.0;
+};
+
+}  // namespace sphshell

@@ -1,0 +1,89 @@
+// Square plates under uniform static pressure, solved by dynamic relaxation
+// (mass-proportional damping), against the Mindlin plate values of design.md §4.
+#include <sphshell/approx/mls.hpp>
+#include <sphshell/kernel/cubic_spline.hpp>
+#include <sphshell/material/elastic.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/gauss.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <string>
+
+using namespace sphshell;
+
+namespace {
+
+using PlateSolver = Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<2>, material::Elastic>;
+
+enum class Support { clamped, simply_supported_hard };
+
+struct StaticResult {
+  double coefficient;  // w_centre D / (q L⁴)
+  double last_change;  // relative change of the coefficient over the last period
+};
+
+// L = 1 m, q = 1 kPa, linear analysis; damping 2ω₁ (near critical for the
+// fundamental mode, Kirchhoff frequency factors 35.99 clamped, 2π² simply
+// supported); rotary inertia scaled (the static answer does not depend on mass).
+StaticResult static_centre_deflection(int n, double slenderness, Support support, int periods) {
+  const double L = 1.0, d = L / slenderness, E = 210e9, nu = 0.3, rho = 7850.0, q = 1e3;
+  const double D = E * d * d * d / (12 * (1 - nu * nu));
+  const double frequency_factor = support == Support::clamped ? 35.99 : 2 * M_PI * M_PI;
+  const double omega = frequency_factor / (L * L) * std::sqrt(D / (rho * d));
+  SolverOptions options;
+  options.nonlinear = false;
+  options.density = rho;
+  options.damping = 2 * omega;
+  options.rotary_inertia_scale = 3.0;
+  PlateSolver solver(ShellModel::rectangular_plate(L, L, n, n, d), {E, nu}, options);
+  const ShellModel& model = solver.model();
+  if (support == Support::clamped) {
+    solver.clamp(model.set("boundary"));
+  } else {
+    solver.simply_support_hard(model.set("x_min"), Vector3::UnitY());
+    solver.simply_support_hard(model.set("x_max"), Vector3::UnitY());
+    solver.simply_support_hard(model.set("y_min"), Vector3::UnitX());
+    solver.simply_support_hard(model.set("y_max"), Vector3::UnitX());
+  }
+  ParticleSet all;
+  for (std::size_t i = 0; i < model.particle_count(); ++i) all.push_back(static_cast<int>(i));
+  solver.add_uniform_pressure(all, q, time_function::Step{}, PressureDirection::fixed);
+  const int centre = model.set("centre")[0];
+  const double period = 2 * M_PI / omega;
+  auto coefficient = [&] { return -solver.displacement(centre).z() * D / (q * L * L * L * L); };
+  solver.run_until((periods - 1) * period);
+  const double before = coefficient();
+  solver.run_until(periods * period);
+  return {coefficient(), std::abs(coefficient() - before) / coefficient()};
+}
+
+}  // namespace
+
+TEST_CASE("Clamped plate, L/d = 50: centre deflection vs Mindlin", "[solver][plate][validation]") {
+  const StaticResult result = static_centre_deflection(21, 50, Support::clamped, 6);
+  const double mindlin = 0.0012754;
+  WARN("clamped 21x21 L/d=50: w D/(q L^4) = " << result.coefficient << ", error "
+                                               << 100 * (result.coefficient / mindlin - 1) << " %");
+  CHECK(result.last_change < 1e-4);
+  CHECK(result.coefficient == Approx(mindlin).epsilon(0.04));
+}
+
+TEST_CASE("Clamped thick plate, L/d = 10: centre deflection vs Mindlin", "[solver][plate][validation]") {
+  const StaticResult result = static_centre_deflection(21, 10, Support::clamped, 6);
+  const double mindlin = 0.0015046;
+  WARN("clamped 21x21 L/d=10: w D/(q L^4) = " << result.coefficient << ", error "
+                                               << 100 * (result.coefficient / mindlin - 1) << " %");
+  CHECK(result.last_change < 1e-4);
+  CHECK(result.coefficient == Approx(mindlin).epsilon(0.04));
+}
+
+TEST_CASE("Hard simply supported plate, L/d = 50: centre deflection vs Mindlin", "[solver][plate][validation]") {
+  const StaticResult result = static_centre_deflection(21, 50, Support::simply_supported_hard, 8);
+  const double mindlin = 0.0040708;
+  WARN("simply supported 21x21 L/d=50: w D/(q L^4) = " << result.coefficient << ", error "
+                                                        << 100 * (result.coefficient / mindlin - 1) << " %");
+  CHECK(result.last_change < 1e-3);
+  CHECK(result.coefficient == Approx(mindlin).epsilon(0.02));
+}
