@@ -25,7 +25,7 @@ class CellList {
   // `radius` is the largest query radius; cells are at least that wide so
   // every neighbour lies in the 3×3×3 block around the query point's cell.
   CellList(const std::vector<Vector3>& points, double radius) {
-    detail::require_positive("neighbour search radius", radius);
+    sphshell::detail::require_positive("neighbour search radius", radius);
     const std::size_t count = points.size();
     if (count == 0) return;
     lower_ = points[0];
@@ -35,7 +35,7 @@ class CellList {
       if (!p.allFinite()) {
         std::ostringstream name;
         name << "coordinates of point " << i;
-        detail::invalid_parameter(name.str(), p.transpose(), "must be finite");
+        sphshell::detail::invalid_parameter(name.str(), p.transpose(), "must be finite");
       }
       lower_ = lower_.cwiseMin(p);
       upper = upper.cwiseMax(p);
@@ -93,7 +93,7 @@ class CellList {
   template <class Visit>
   void for_each_within(const Vector3& x, double radius, Visit&& visit) const {
     if (!(radius <= cell_size_))
-      detail::invalid_parameter("query radius", radius, "must not exceed the cell list's radius");
+      sphshell::detail::invalid_parameter("query radius", radius, "must not exceed the cell list's radius");
     if (cell_points_.empty()) return;
     const double radius_squared = radius * radius;
     const Cell centre = cell_coordinates_unclamped(x);

@@ -24,6 +24,9 @@
 
 namespace sphshell::approx::detail {
 
+using sphshell::detail::invalid_parameter;
+using sphshell::detail::require_positive;
+
 // Per-neighbour data of the row being built, kept between rows so the build
 // loop does not allocate. Only the first `count` entries are meaningful.
 struct RowWorkspace {
