@@ -60,16 +60,28 @@ struct MLS {
   static bool solve(const detail::RowWorkspace& ws, double h, double* phi, double* dphi_d1,
                     double* dphi_d2) {
     const double inverse_h = 1.0 / h;
-    Matrix3 moment = Matrix3::Zero();
-    Matrix3 dmoment_1 = Matrix3::Zero();
-    Matrix3 dmoment_2 = Matrix3::Zero();
+    // The three matrices are symmetric: accumulate their six distinct entries.
+    using Entries = Eigen::Matrix<double, 6, 1>;
+    Entries moment_entries = Entries::Zero();
+    Entries dmoment_1_entries = Entries::Zero();
+    Entries dmoment_2_entries = Entries::Zero();
     for (std::size_t k = 0; k < ws.count; ++k) {
-      const Vector3 p(1.0, ws.xi1[k] * inverse_h, ws.xi2[k] * inverse_h);
-      const Matrix3 outer = p * p.transpose();
-      moment.noalias() += ws.weight[k] * outer;
-      dmoment_1.noalias() += ws.dweight_d1[k] * outer;
-      dmoment_2.noalias() += ws.dweight_d2[k] * outer;
+      const double a = ws.xi1[k] * inverse_h;
+      const double b = ws.xi2[k] * inverse_h;
+      Entries outer;
+      outer << 1.0, a, b, a * a, a * b, b * b;
+      moment_entries += ws.weight[k] * outer;
+      dmoment_1_entries += ws.dweight_d1[k] * outer;
+      dmoment_2_entries += ws.dweight_d2[k] * outer;
     }
+    const auto symmetric = [](const Entries& e) {
+      Matrix3 m;
+      m << e(0), e(1), e(2), e(1), e(3), e(4), e(2), e(4), e(5);
+      return m;
+    };
+    const Matrix3 moment = symmetric(moment_entries);
+    Matrix3 dmoment_1 = symmetric(dmoment_1_entries);
+    Matrix3 dmoment_2 = symmetric(dmoment_2_entries);
     const Vector3 m0 = moment.col(0);
     dmoment_1.row(1) -= inverse_h * m0.transpose();
     dmoment_1.col(1) -= inverse_h * m0;

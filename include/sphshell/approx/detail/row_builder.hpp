@@ -187,12 +187,28 @@ ShapeFunctions build_all(const std::vector<Vector3>& particles,
   sf.shepard.assign(rows, 0);
   const auto row_count = static_cast<std::ptrdiff_t>(rows);
 
-#pragma omp parallel for schedule(static)
-  for (std::ptrdiff_t i = 0; i < row_count; ++i) {
-    std::size_t count = 0;
-    particle_cells.for_each_within(eval_positions[static_cast<std::size_t>(i)], support,
-                                   [&count](int, double) { ++count; });
-    sf.row_begin[static_cast<std::size_t>(i) + 1] = count;
+  // One search per row: each block of rows gathers its (sorted) neighbour
+  // lists in its own buffer, and the buffers are then copied into place.
+  std::ptrdiff_t block_count = 1;
+#ifdef _OPENMP
+  block_count = std::max(1, omp_get_max_threads());
+#endif
+  const auto block_first_row = [&](std::ptrdiff_t block) {
+    return static_cast<std::size_t>(block) * rows / static_cast<std::size_t>(block_count);
+  };
+  std::vector<std::vector<int>> gathered(static_cast<std::size_t>(block_count));
+#pragma omp parallel for schedule(static, 1)
+  for (std::ptrdiff_t block = 0; block < block_count; ++block) {
+    std::vector<int>& list = gathered[static_cast<std::size_t>(block)];
+    const std::size_t last = block_first_row(block + 1);
+    list.reserve((last - block_first_row(block)) * 16);
+    for (std::size_t row = block_first_row(block); row < last; ++row) {
+      const std::size_t first = list.size();
+      particle_cells.for_each_within(eval_positions[row], support,
+                                     [&list](int j, double) { list.push_back(j); });
+      std::sort(list.begin() + static_cast<std::ptrdiff_t>(first), list.end());
+      sf.row_begin[row + 1] = list.size() - first;
+    }
   }
   for (std::size_t r = 0; r < rows; ++r) sf.row_begin[r + 1] += sf.row_begin[r];
   const std::size_t slots = sf.row_begin[rows];
@@ -200,6 +216,13 @@ ShapeFunctions build_all(const std::vector<Vector3>& particles,
   sf.phi.resize(slots);
   sf.dphi_d1.resize(slots);
   sf.dphi_d2.resize(slots);
+#pragma omp parallel for schedule(static, 1)
+  for (std::ptrdiff_t block = 0; block < block_count; ++block) {
+    std::vector<int>& list = gathered[static_cast<std::size_t>(block)];
+    std::copy(list.begin(), list.end(),
+              sf.neighbour.begin() + static_cast<std::ptrdiff_t>(sf.row_begin[block_first_row(block)]));
+    std::vector<int>().swap(list);
+  }
 
   // Exceptions may not leave an OpenMP region; the one of the lowest row is
   // kept so the message does not depend on the thread count.
@@ -212,13 +235,6 @@ ShapeFunctions build_all(const std::vector<Vector3>& particles,
     for (std::ptrdiff_t i = 0; i < row_count; ++i) {
       const auto row = static_cast<std::size_t>(i);
       try {
-        const std::size_t begin = sf.row_begin[row];
-        std::size_t fill = begin;
-        particle_cells.for_each_within(eval_positions[row], support, [&](int j, double) {
-          sf.neighbour[fill++] = j;
-        });
-        std::sort(sf.neighbour.begin() + static_cast<std::ptrdiff_t>(begin),
-                  sf.neighbour.begin() + static_cast<std::ptrdiff_t>(fill));
         compute_row<Kernel, Method>(sf, row, particles, volumes, eval_positions[row],
                                     eval_frames[row], h, visible, ws);
       } catch (...) {
