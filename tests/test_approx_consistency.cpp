@@ -9,6 +9,10 @@
 #include <cmath>
 #include <functional>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 using namespace sphshell;
 using approx::MLS;
 using approx::NSPH;
@@ -21,6 +25,27 @@ static_assert(!approx::is_approximation_v<kernel::CubicSpline>);
 static_assert(approx::check_approximation<MLS<kernel::WendlandC2>>());
 
 namespace {
+// Has kernel_type and build but no rebuild_row.
+struct WithoutRebuild {
+  using kernel_type = kernel::CubicSpline;
+  template <class Visible = approx::AlwaysVisible>
+  static ShapeFunctions build(const std::vector<Vector3>&, const std::vector<double>&,
+                              const std::vector<Vector3>&, const std::vector<TangentFrame>&, double,
+                              Visible = {}) {
+    return {};
+  }
+};
+struct WithoutKernel : WithoutRebuild {
+  using kernel_type = double;
+};
+}  // namespace
+static_assert(approx::detail::has_build<WithoutRebuild>::value);
+static_assert(!approx::is_approximation_v<WithoutRebuild>);
+static_assert(!approx::detail::has_kernel_type<WithoutKernel>::value);
+
+namespace {
+
+constexpr double pi = 3.14159265358979323846;
 
 // Support radius 2 spacings for every kernel, as the solver uses.
 template <class Approximation>
@@ -170,7 +195,7 @@ void check_tangent_linear_field(const PointSets& sets, double h, bool values_too
 PointSets cylinder(bool at_particles) {
   const double radius = 0.1, length = 0.1;
   const int around = 64, along = 21;
-  const double dtheta = 2 * M_PI / around, dz = length / (along - 1);
+  const double dtheta = 2 * pi / around, dz = length / (along - 1);
   PointSets sets;
   const auto on_surface = [&](double theta, double z) {
     return Vector3(radius * std::cos(theta), radius * std::sin(theta), z);
@@ -216,7 +241,7 @@ TEMPLATE_TEST_CASE("Fields linear in the tangent coordinates are reproduced on c
     {
       INFO("cylinder");
       const PointSets sets = cylinder(at_particles);
-      const double spacing = 0.1 * 2 * M_PI / 64;
+      const double spacing = 0.1 * 2 * pi / 64;
       const double h = 2.0 * spacing / TestType::support_radius_factor;
       check_tangent_linear_field<MLS<TestType>>(sets, h, true);
       check_tangent_linear_field<NSPH<TestType>>(sets, h, false);

@@ -43,6 +43,7 @@ TEST_CASE("Cell list finds exactly the points a brute-force search finds", "[app
   for (int i = 0; i < 500; ++i) points.emplace_back(cloud(random), cloud(random), cloud(random));
   const double radius = 0.03;
   const CellList cells(points, radius);
+  CHECK_FALSE(cells.dense());  // a dense grid would hold 3.5 cells per point
   CHECK(cells.size() == points.size());
   std::vector<Vector3> queries(points.begin(), points.begin() + 300);
   for (int i = 0; i < 200; ++i) queries.emplace_back(cloud(random), cloud(random), 2 * cloud(random));
@@ -56,6 +57,29 @@ TEST_CASE("Cell list finds exactly the points a brute-force search finds", "[app
   }
   CHECK(total > queries.size());  // the comparison is not vacuous
   CHECK_THROWS_AS(cells.for_each_within(Vector3::Zero(), 2 * radius, [](int, double) {}), Error);
+}
+
+TEST_CASE("Cell list over a flat jittered sheet uses dense cells and finds the same points",
+          "[approx][neighbours]") {
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> jitter(-0.3e-2, 0.3e-2);
+  std::vector<Vector3> points;
+  for (int j = 0; j < 60; ++j)
+    for (int i = 0; i < 60; ++i)
+      points.emplace_back(i * 1e-2 + jitter(random), j * 1e-2 + jitter(random), 1e-4 * jitter(random));
+  const double radius = 2e-2;
+  const CellList cells(points, radius);
+  CHECK(cells.dense());
+  std::uniform_real_distribution<double> anywhere(-0.05, 0.65);
+  std::size_t total = 0;
+  for (int q = 0; q < 600; ++q) {
+    const Vector3 x = q < 300 ? points[std::size_t(q * 11)]
+                              : Vector3(anywhere(random), anywhere(random), 0.3 * jitter(random));
+    const auto expected = brute_force(points, x, radius);
+    total += expected.size();
+    CHECK(cell_list_query(cells, x, radius) == expected);
+  }
+  CHECK(total > 3000);
 }
 
 TEST_CASE("Cell list rejects invalid input and finds coincident points", "[approx][neighbours]") {

@@ -11,6 +11,9 @@
 // every evaluation point from the particles within
 // kernel_type::support_radius_factor · h; rebuild_row recomputes one row in
 // place from the neighbours stored in it (after a crack hides more pairs).
+// `visible(eval_index, particle)` says whether a pair interacts; build calls it
+// from several OpenMP threads at once, so it must be safe to call concurrently
+// (a const operator() reading shared data is).
 
 #include <sphshell/approx/shape_functions.hpp>
 #include <sphshell/core/frame.hpp>

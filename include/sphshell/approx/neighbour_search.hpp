@@ -1,12 +1,13 @@
 #pragma once
-// Fixed-radius neighbour search over 3-D points: a cell-linked list whose
-// occupied cells are found through a hash table.
+// Fixed-radius neighbour search over 3-D points: a cell-linked list.
 //
-// Shells are curved surfaces in 3-D, so a dense grid over the bounding box
-// would mostly hold empty cells (a thin cylinder: ~ (R/Δ)³ cells for ~ (R/Δ)²
-// points). Hashing only the occupied cells keeps memory O(N) for any shape;
-// building is O(N) (count, prefix sum, fill — no sort) and a query visits the
-// 27 cells around the point, each found in O(1) expected time.
+// Flat and mildly curved sheets use a dense array of cells over the bounding
+// box (at most 2 cells per point). Strongly curved shells would mostly fill such
+// an array with empty cells (a thin cylinder: ~ (R/Δ)³ cells for ~ (R/Δ)²
+// points), so then only the occupied cells are stored, found through a hash
+// table. Either way memory is O(N), building is O(N) (count, prefix sum,
+// fill — no sort) and a query visits the 27 cells around the point, each found
+// in O(1) (expected, for the hash).
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/types.hpp>
@@ -54,27 +55,38 @@ class CellList {
       cells_per_axis_[axis] =
           static_cast<std::int64_t>(std::floor((upper[axis] - lower_[axis]) * inverse_cell_size_)) + 1;
 
-    std::size_t table_size = 16;
-    while (table_size < 2 * count) table_size *= 2;
-    table_keys_.assign(table_size, empty_key);
-    table_cells_.assign(table_size, 0);
-
     std::vector<int> cell_of_point(count);
     std::vector<int> cell_count;
-    cell_count.reserve(count / 4 + 1);
-    for (std::size_t i = 0; i < count; ++i) {
-      const std::uint64_t key = pack(cell_coordinates(points[i]));
-      std::size_t slot = hash(key) & (table_size - 1);
-      while (table_keys_[slot] != empty_key && table_keys_[slot] != key)
-        slot = (slot + 1) & (table_size - 1);
-      if (table_keys_[slot] == empty_key) {
-        table_keys_[slot] = key;
-        table_cells_[slot] = static_cast<int>(cell_count.size());
-        cell_count.push_back(0);
+    const double dense_cells = double(cells_per_axis_[0]) * double(cells_per_axis_[1]) *
+                               double(cells_per_axis_[2]);
+    dense_ = dense_cells <= double(dense_cells_per_point * count + 1024);
+    if (dense_) {
+      cell_count.assign(static_cast<std::size_t>(dense_cells), 0);
+      for (std::size_t i = 0; i < count; ++i) {
+        const int cell = dense_index(cell_coordinates(points[i]));
+        cell_of_point[i] = cell;
+        ++cell_count[static_cast<std::size_t>(cell)];
       }
-      const int cell = table_cells_[slot];
-      cell_of_point[i] = cell;
-      ++cell_count[static_cast<std::size_t>(cell)];
+    } else {
+      std::size_t table_size = 16;
+      while (table_size < 2 * count) table_size *= 2;
+      table_keys_.assign(table_size, empty_key);
+      table_cells_.assign(table_size, 0);
+      cell_count.reserve(count / 4 + 1);
+      for (std::size_t i = 0; i < count; ++i) {
+        const std::uint64_t key = pack(cell_coordinates(points[i]));
+        std::size_t slot = hash(key) & (table_size - 1);
+        while (table_keys_[slot] != empty_key && table_keys_[slot] != key)
+          slot = (slot + 1) & (table_size - 1);
+        if (table_keys_[slot] == empty_key) {
+          table_keys_[slot] = key;
+          table_cells_[slot] = static_cast<int>(cell_count.size());
+          cell_count.push_back(0);
+        }
+        const int cell = table_cells_[slot];
+        cell_of_point[i] = cell;
+        ++cell_count[static_cast<std::size_t>(cell)];
+      }
     }
     cell_begin_.assign(cell_count.size() + 1, 0);
     for (std::size_t c = 0; c < cell_count.size(); ++c)
@@ -92,6 +104,9 @@ class CellList {
   }
 
   double radius() const { return radius_; }
+  // True when the cells are a dense array over the bounding box (flat or mildly
+  // curved sets), false when only occupied cells are stored in a hash table.
+  bool dense() const { return dense_; }
   std::size_t size() const { return cell_points_.size(); }
 
   // Calls visit(index, distance_squared) for every point with
@@ -109,7 +124,7 @@ class CellList {
         for (std::int64_t dz = -1; dz <= 1; ++dz) {
           const Cell cell{centre.x + dx, centre.y + dy, centre.z + dz};
           if (!in_range(cell)) continue;
-          const int index = find(pack(cell));
+          const int index = dense_ ? dense_index(cell) : find(pack(cell));
           if (index < 0) continue;
           const std::size_t end = static_cast<std::size_t>(cell_begin_[index + 1]);
           for (std::size_t k = static_cast<std::size_t>(cell_begin_[index]); k < end; ++k) {
@@ -149,6 +164,10 @@ class CellList {
   };
 
   static constexpr std::uint64_t empty_key = ~std::uint64_t{0};
+  // A dense array of cells is used when it costs at most this many cells per
+  // point: it needs no hashing and its cells are stored in spatial order, so
+  // consecutive queries hit the cache.
+  static constexpr std::size_t dense_cells_per_point = 2;
   static constexpr std::int64_t axis_cells = std::int64_t{1} << 21;
 
   Cell cell_coordinates_unclamped(const Vector3& p) const {
@@ -173,6 +192,9 @@ class CellList {
   bool in_range(const Cell& c) const {
     return c.x >= 0 && c.y >= 0 && c.z >= 0 && c.x < cells_per_axis_[0] &&
            c.y < cells_per_axis_[1] && c.z < cells_per_axis_[2];
+  }
+  int dense_index(const Cell& c) const {
+    return static_cast<int>((c.x * cells_per_axis_[1] + c.y) * cells_per_axis_[2] + c.z);
   }
   static std::uint64_t pack(const Cell& c) {
     return (std::uint64_t(c.x) << 42) | (std::uint64_t(c.y) << 21) | std::uint64_t(c.z);
@@ -216,6 +238,7 @@ class CellList {
   double inverse_cell_size_ = 1.0;
   double radius_ = 0.0;
   std::int64_t cells_per_axis_[3] = {0, 0, 0};
+  bool dense_ = false;
   std::vector<std::uint64_t> table_keys_;
   std::vector<int> table_cells_;
   std::vector<int> cell_begin_;
