@@ -20,6 +20,11 @@
 
 #ifdef _OPENMP
 #include <omp.h>
+// Without OpenMP the directives vanish instead of raising -Wunknown-pragmas in
+// user code.
+#define SPHSHELL_APPROX_OMP(directive) _Pragma(directive)
+#else
+#define SPHSHELL_APPROX_OMP(directive)
 #endif
 
 namespace sphshell::approx::detail {
@@ -197,7 +202,7 @@ ShapeFunctions build_all(const std::vector<Vector3>& particles,
     return static_cast<std::size_t>(block) * rows / static_cast<std::size_t>(block_count);
   };
   std::vector<std::vector<int>> gathered(static_cast<std::size_t>(block_count));
-#pragma omp parallel for schedule(static, 1)
+  SPHSHELL_APPROX_OMP("omp parallel for schedule(static, 1)")
   for (std::ptrdiff_t block = 0; block < block_count; ++block) {
     std::vector<int>& list = gathered[static_cast<std::size_t>(block)];
     const std::size_t last = block_first_row(block + 1);
@@ -216,7 +221,7 @@ ShapeFunctions build_all(const std::vector<Vector3>& particles,
   sf.phi.resize(slots);
   sf.dphi_d1.resize(slots);
   sf.dphi_d2.resize(slots);
-#pragma omp parallel for schedule(static, 1)
+  SPHSHELL_APPROX_OMP("omp parallel for schedule(static, 1)")
   for (std::ptrdiff_t block = 0; block < block_count; ++block) {
     std::vector<int>& list = gathered[static_cast<std::size_t>(block)];
     std::copy(list.begin(), list.end(),
@@ -228,17 +233,17 @@ ShapeFunctions build_all(const std::vector<Vector3>& particles,
   // kept so the message does not depend on the thread count.
   std::exception_ptr error;
   std::ptrdiff_t error_row = row_count;
-#pragma omp parallel
+  SPHSHELL_APPROX_OMP("omp parallel")
   {
     RowWorkspace ws;
-#pragma omp for schedule(static)
+    SPHSHELL_APPROX_OMP("omp for schedule(static)")
     for (std::ptrdiff_t i = 0; i < row_count; ++i) {
       const auto row = static_cast<std::size_t>(i);
       try {
         compute_row<Kernel, Method>(sf, row, particles, volumes, eval_positions[row],
                                     eval_frames[row], h, visible, ws);
       } catch (...) {
-#pragma omp critical(sphshell_approx_error)
+        SPHSHELL_APPROX_OMP("omp critical(sphshell_approx_error)")
         if (i < error_row) {
           error_row = i;
           error = std::current_exception();
@@ -279,3 +284,5 @@ void rebuild_one_row(ShapeFunctions& sf, std::size_t row, const std::vector<Vect
 }
 
 }  // namespace sphshell::approx::detail
+
+#undef SPHSHELL_APPROX_OMP
