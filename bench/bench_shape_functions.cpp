@@ -1,7 +1,9 @@
 // Building all shape functions of an n × n particle plate with stress points at
 // the cell centres (support radius 2 spacings). Per-point time and storage are
 // the figures to compare across sizes (linear scaling) and methods. Set
-// OMP_NUM_THREADS=1 for the single-thread figure.
+// OMP_NUM_THREADS=1 for the single-thread figure; on a machine shared with
+// other jobs, OMP_WAIT_POLICY=passive keeps spinning threads from distorting
+// the multi-thread figure.
 #include <sphshell/approx/all.hpp>
 #include <sphshell/kernel/all.hpp>
 

@@ -11,7 +11,9 @@ namespace sphshell::approx {
 // The first row_size[r] slots are the neighbours that take part (the visible
 // ones), sorted by particle index; the remaining slots keep the neighbours that
 // were hidden (Φ = ∇Φ = 0), so a row can be rebuilt in place later — when a
-// crack cuts more pairs — from its full geometric neighbour set.
+// crack cuts more pairs — from its full geometric neighbour set. Code that
+// shrinks a row itself should therefore permute slots rather than overwrite
+// neighbour indices.
 struct ShapeFunctions {
   std::vector<std::size_t> row_begin;    // size rows+1
   std::vector<int> row_size;             // used slots of row r (<= capacity)
