@@ -1,0 +1,288 @@
+#pragma once
+// What MLS and NSPH share: input checks, neighbour search, the compressed
+// layout, visibility filtering and the Shepard fallback. A method only turns
+// the weights of one row's visible neighbours into Φ and ∇Φ.
+
+#include <sphshell/approx/neighbour_search.hpp>
+#include <sphshell/approx/shape_functions.hpp>
+#include <sphshell/core/error.hpp>
+#include <sphshell/core/frame.hpp>
+#include <sphshell/core/types.hpp>
+#include <sphshell/kernel/kernel.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <exception>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#ifdef _OPENMP
+#include <omp.h>
+// Without OpenMP the directives vanish instead of raising -Wunknown-pragmas in
+// user code.
+#define SPHSHELL_APPROX_OMP(directive) _Pragma(directive)
+#else
+#define SPHSHELL_APPROX_OMP(directive)
+#endif
+
+namespace sphshell::approx::detail {
+
+using sphshell::detail::invalid_parameter;
+using sphshell::detail::require_positive;
+
+// Per-neighbour data of the row being built, kept between rows so the build
+// loop does not allocate. Only the first `count` entries are meaningful.
+struct RowWorkspace {
+  std::vector<int> ordered;              // visible neighbours first, then hidden ones
+  std::vector<double> xi1, xi2;          // tangent-plane coordinates of x_j − x
+  std::vector<double> weight;            // V_j W(|x_j − x|)
+  std::vector<double> dweight_d1, dweight_d2;  // its derivative w.r.t. the evaluation point along e1, e2
+  std::size_t count = 0;
+
+  void reserve(std::size_t n) {
+    if (ordered.size() >= n) return;
+    for (auto* v : {&xi1, &xi2, &weight, &dweight_d1, &dweight_d2}) v->resize(n);
+    ordered.resize(n);
+  }
+};
+
+// Two points of one set closer than this (relative to h) are "coincident".
+inline constexpr double coincidence_tolerance_factor = 1e-9;
+
+[[noreturn]] inline void throw_no_visible_neighbour(std::size_t eval_index) {
+  std::ostringstream message;
+  message << "sphshell: evaluation point " << eval_index
+          << " has no visible neighbour within the kernel support (shape functions undefined)";
+  throw Error(message.str());
+}
+
+inline void check_frame(const TangentFrame& frame, std::size_t eval_index) {
+  const double length = frame.normal.norm();
+  if (!(length > 0.0) || !std::isfinite(length) || !frame.e1.allFinite() ||
+      !frame.e2.allFinite() || !(frame.e1.norm() > 0.0) || !(frame.e2.norm() > 0.0)) {
+    std::ostringstream name;
+    name << "normal length of the frame of evaluation point " << eval_index;
+    invalid_parameter(name.str(), length, "a tangent frame needs finite, non-zero axes");
+  }
+}
+
+inline void check_volumes(const std::vector<double>& volumes) {
+  for (std::size_t j = 0; j < volumes.size(); ++j)
+    if (!(volumes[j] > 0.0) || !std::isfinite(volumes[j])) {
+      std::ostringstream name;
+      name << "volume of particle " << j;
+      invalid_parameter(name.str(), volumes[j], "must be finite and > 0");
+    }
+}
+
+inline void check_sizes(std::size_t particles, std::size_t volumes, std::size_t positions,
+                        std::size_t frames) {
+  if (particles != volumes) {
+    std::ostringstream value;
+    value << volumes << " volumes for " << particles << " particles";
+    invalid_parameter("particle_volumes.size()", value.str(), "one volume per particle");
+  }
+  if (positions != frames) {
+    std::ostringstream value;
+    value << frames << " frames for " << positions << " evaluation points";
+    invalid_parameter("eval_frames.size()", value.str(), "one frame per evaluation point");
+  }
+}
+
+// Fills one row from the candidate neighbours already stored in its slots
+// (sorted by particle index). Visible candidates are moved to the front in
+// index order, hidden ones follow with Φ = ∇Φ = 0. Throws before touching the
+// row when nothing is visible.
+template <class Kernel, class Method, class Visible>
+void compute_row(ShapeFunctions& sf, std::size_t row, const std::vector<Vector3>& particles,
+                 const std::vector<double>& volumes, const Vector3& x, const TangentFrame& frame,
+                 double h, Visible& visible, RowWorkspace& ws) {
+  const std::size_t begin = sf.row_begin[row];
+  const std::size_t capacity = sf.row_begin[row + 1] - begin;
+  ws.reserve(capacity);
+
+  // Visible candidates fill ws.ordered from the front, hidden ones from the
+  // back; reversing the back part restores index order for both.
+  std::size_t visible_count = 0;
+  std::size_t hidden_count = 0;
+  for (std::size_t s = 0; s < capacity; ++s) {
+    const int j = sf.neighbour[begin + s];
+    if (visible(row, static_cast<std::size_t>(j)))
+      ws.ordered[visible_count++] = j;
+    else
+      ws.ordered[capacity - 1 - hidden_count++] = j;
+  }
+  if (visible_count == 0) throw_no_visible_neighbour(row);
+  const auto ordered_begin = ws.ordered.begin();
+  std::reverse(ordered_begin + static_cast<std::ptrdiff_t>(visible_count),
+               ordered_begin + static_cast<std::ptrdiff_t>(capacity));
+  std::copy(ordered_begin, ordered_begin + static_cast<std::ptrdiff_t>(capacity),
+            sf.neighbour.begin() + static_cast<std::ptrdiff_t>(begin));
+
+  const Vector3 e1 = frame.e1.normalized();
+  const Vector3 e2 = frame.e2.normalized();
+  double weight_sum = 0.0;
+  for (std::size_t k = 0; k < visible_count; ++k) {
+    const auto j = static_cast<std::size_t>(ws.ordered[k]);
+    const Vector3 d = particles[j] - x;
+    const double r = d.norm();
+    const double xi1 = d.dot(e1);
+    const double xi2 = d.dot(e2);
+    const double volume = volumes[j];
+    ws.xi1[k] = xi1;
+    ws.xi2[k] = xi2;
+    ws.weight[k] = volume * Kernel::value(r, h);
+    // d|x_j − x|/dx·e_α = −ξ_α / r; every kernel has dW/dr = 0 at r = 0.
+    const double radial = r > 0.0 ? -volume * Kernel::derivative(r, h) / r : 0.0;
+    ws.dweight_d1[k] = radial * xi1;
+    ws.dweight_d2[k] = radial * xi2;
+    weight_sum += ws.weight[k];
+  }
+  ws.count = visible_count;
+
+  double* phi = sf.phi.data() + begin;
+  double* d1 = sf.dphi_d1.data() + begin;
+  double* d2 = sf.dphi_d2.data() + begin;
+  // A first-order fit needs three neighbours not on one line; Method reports
+  // a (nearly) singular system by returning false.
+  const bool linear = visible_count >= 3 && weight_sum > 0.0 && Method::solve(ws, h, phi, d1, d2);
+  if (!linear) {
+    if (!(weight_sum > 0.0)) throw_no_visible_neighbour(row);
+    for (std::size_t k = 0; k < visible_count; ++k) {
+      phi[k] = ws.weight[k] / weight_sum;
+      d1[k] = 0.0;
+      d2[k] = 0.0;
+    }
+  }
+  for (std::size_t k = visible_count; k < capacity; ++k) phi[k] = d1[k] = d2[k] = 0.0;
+  sf.row_size[row] = static_cast<int>(visible_count);
+  sf.shepard[row] = linear ? 0 : 1;
+}
+
+template <class Kernel, class Method, class Visible>
+ShapeFunctions build_all(const std::vector<Vector3>& particles,
+                         const std::vector<double>& volumes,
+                         const std::vector<Vector3>& eval_positions,
+                         const std::vector<TangentFrame>& eval_frames, double h, Visible& visible) {
+  static_assert(kernel::check_kernel<Kernel>());
+  require_positive("h", h);
+  check_sizes(particles.size(), volumes.size(), eval_positions.size(), eval_frames.size());
+  check_volumes(volumes);
+  for (std::size_t i = 0; i < eval_positions.size(); ++i) {
+    if (!eval_positions[i].allFinite()) {
+      std::ostringstream name;
+      name << "coordinates of evaluation point " << i;
+      invalid_parameter(name.str(), eval_positions[i].transpose(), "must be finite");
+    }
+    check_frame(eval_frames[i], i);
+  }
+
+  const double support = Kernel::support_radius_factor * h;
+  const double tolerance = coincidence_tolerance_factor * h;
+  const CellList particle_cells(particles, support);
+  particle_cells.require_no_coincident_points(tolerance, "particles");
+  CellList(eval_positions, support).require_no_coincident_points(tolerance, "evaluation points");
+
+  const std::size_t rows = eval_positions.size();
+  ShapeFunctions sf;
+  sf.row_begin.assign(rows + 1, 0);
+  sf.row_size.assign(rows, 0);
+  sf.shepard.assign(rows, 0);
+  const auto row_count = static_cast<std::ptrdiff_t>(rows);
+
+  // One search per row: each block of rows gathers its (sorted) neighbour
+  // lists in its own buffer, and the buffers are then copied into place.
+  std::ptrdiff_t block_count = 1;
+#ifdef _OPENMP
+  block_count = std::max(1, omp_get_max_threads());
+#endif
+  const auto block_first_row = [&](std::ptrdiff_t block) {
+    return static_cast<std::size_t>(block) * rows / static_cast<std::size_t>(block_count);
+  };
+  std::vector<std::vector<int>> gathered(static_cast<std::size_t>(block_count));
+  SPHSHELL_APPROX_OMP("omp parallel for schedule(static, 1)")
+  for (std::ptrdiff_t block = 0; block < block_count; ++block) {
+    std::vector<int>& list = gathered[static_cast<std::size_t>(block)];
+    const std::size_t last = block_first_row(block + 1);
+    list.reserve((last - block_first_row(block)) * 16);
+    for (std::size_t row = block_first_row(block); row < last; ++row) {
+      const std::size_t first = list.size();
+      particle_cells.for_each_within(eval_positions[row], support,
+                                     [&list](int j, double) { list.push_back(j); });
+      std::sort(list.begin() + static_cast<std::ptrdiff_t>(first), list.end());
+      sf.row_begin[row + 1] = list.size() - first;
+    }
+  }
+  for (std::size_t r = 0; r < rows; ++r) sf.row_begin[r + 1] += sf.row_begin[r];
+  const std::size_t slots = sf.row_begin[rows];
+  sf.neighbour.resize(slots);
+  sf.phi.resize(slots);
+  sf.dphi_d1.resize(slots);
+  sf.dphi_d2.resize(slots);
+  SPHSHELL_APPROX_OMP("omp parallel for schedule(static, 1)")
+  for (std::ptrdiff_t block = 0; block < block_count; ++block) {
+    std::vector<int>& list = gathered[static_cast<std::size_t>(block)];
+    std::copy(list.begin(), list.end(),
+              sf.neighbour.begin() + static_cast<std::ptrdiff_t>(sf.row_begin[block_first_row(block)]));
+    std::vector<int>().swap(list);
+  }
+
+  // Exceptions may not leave an OpenMP region; the one of the lowest row is
+  // kept so the message does not depend on the thread count.
+  std::exception_ptr error;
+  std::ptrdiff_t error_row = row_count;
+  SPHSHELL_APPROX_OMP("omp parallel")
+  {
+    RowWorkspace ws;
+    SPHSHELL_APPROX_OMP("omp for schedule(static)")
+    for (std::ptrdiff_t i = 0; i < row_count; ++i) {
+      const auto row = static_cast<std::size_t>(i);
+      try {
+        compute_row<Kernel, Method>(sf, row, particles, volumes, eval_positions[row],
+                                    eval_frames[row], h, visible, ws);
+      } catch (...) {
+        SPHSHELL_APPROX_OMP("omp critical(sphshell_approx_error)")
+        if (i < error_row) {
+          error_row = i;
+          error = std::current_exception();
+        }
+      }
+    }
+  }
+  if (error) std::rethrow_exception(error);
+  return sf;
+}
+
+template <class Kernel, class Method, class Visible>
+void rebuild_one_row(ShapeFunctions& sf, std::size_t row, const std::vector<Vector3>& particles,
+                     const std::vector<double>& volumes, const Vector3& eval_position,
+                     const TangentFrame& eval_frame, double h, Visible& visible) {
+  static_assert(kernel::check_kernel<Kernel>());
+  require_positive("h", h);
+  if (row >= sf.rows()) invalid_parameter("row", row, "must be < rows()");
+  if (particles.size() != volumes.size()) check_sizes(particles.size(), volumes.size(), 0, 0);
+  if (!eval_position.allFinite())
+    invalid_parameter("coordinates of the rebuilt evaluation point", eval_position.transpose(),
+                      "must be finite");
+  check_frame(eval_frame, row);
+  const std::size_t begin = sf.row_begin[row];
+  const std::size_t end = sf.row_begin[row + 1];
+  for (std::size_t s = begin; s < end; ++s) {
+    const auto j = static_cast<std::size_t>(sf.neighbour[s]);
+    if (j >= particles.size()) invalid_parameter("neighbour index", j, "must be < particles.size()");
+    if (!(volumes[j] > 0.0) || !std::isfinite(volumes[j])) check_volumes(volumes);
+  }
+  // Slots hold the row's whole geometric neighbour set; restoring index order
+  // makes the result identical to a full build with the same predicate.
+  std::sort(sf.neighbour.begin() + static_cast<std::ptrdiff_t>(begin),
+            sf.neighbour.begin() + static_cast<std::ptrdiff_t>(end));
+  RowWorkspace ws;
+  compute_row<Kernel, Method>(sf, row, particles, volumes, eval_position, eval_frame, h, visible,
+                              ws);
+}
+
+}  // namespace sphshell::approx::detail
+
+#undef SPHSHELL_APPROX_OMP
