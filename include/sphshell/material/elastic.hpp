@@ -20,9 +20,16 @@ enum class InitialGuess {
   radial_return  // (σ̄* − σs,n)/(3G + Ep), exact for a purely deviatoric trial stress
 };
 
+// The function whose root Newton seeks (return_map.hpp explains the choice).
+enum class NewtonFunction {
+  normalized,  // φ = 1 − σs/σ̄, the unsquared yield function (2.19) over σ̄
+  squared      // g = σᵀΞσ − σs², eq. (2.36), with Appendix A's derivative
+};
+
 struct ReturnMapOptions {
   ReturnMapForm form = ReturnMapForm::closed_form;
   InitialGuess initial_guess = InitialGuess::appendix_b;
+  NewtonFunction newton_function = NewtonFunction::normalized;
   // 0: iterate to convergence (safeguarded). > 0: exactly that many plain
   // Newton steps, no convergence test and no safeguard — the baseline of codes
   // that run a fixed number of iterations.

@@ -20,6 +20,15 @@
 //   value times σs/uᵢ. g and its derivative are then a handful of flops.
 // - generic: the literal 3×3 L, its inverse and the matrix products, as in the
 //   paper; kept as the reference and the benchmark baseline.
+//
+// The function Newton iterates on (NewtonFunction): by default the unsquared
+// yield function (2.19) normalized by σ̄, φ = 1 − σs/σ̄(Δε̄p), which has the
+// same root and sign as g. Appendix B's initial value is exactly the first
+// Newton step of φ from Δε̄p = 0, and φ is nearly linear in Δε̄p (exactly linear
+// for a purely deviatoric trial stress), so one correction usually meets the
+// tolerance; the squared g of eq. (2.36) curves more and typically needs one
+// more correction for the same 1e-12 (see bench_return_map). Either way the
+// stopping test is on g: |g| ≤ 1e-12 σs².
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/types.hpp>
@@ -47,9 +56,10 @@ struct Solution {
 };
 
 struct Evaluation {
-  double residual;    // g(Δε̄p)
-  double derivative;  // dg/dΔε̄p
-  double scale;       // σs(Δε̄p)², the tolerance's reference
+  double residual;        // the Newton function (φ or g) at Δε̄p
+  double derivative;      // its derivative
+  double yield_residual;  // g(Δε̄p) = σᵀΞσ − σs², tested for convergence
+  double scale;           // σs(Δε̄p)², the tolerance's reference
 };
 
 namespace detail {
@@ -76,7 +86,7 @@ inline int solve_safeguarded(const Residual& residual, double& increment, double
   Evaluation value = residual(increment);
   bool distrust_newton = false;
   int iterations = 0;
-  while (!(std::abs(value.residual) <= relative_tolerance * value.scale)) {
+  while (!(std::abs(value.yield_residual) <= relative_tolerance * value.scale)) {
     if (value.residual > 0.0)
       lower = increment;
     else
@@ -86,7 +96,7 @@ inline int solve_safeguarded(const Residual& residual, double& increment, double
         upper - lower <= 4.0 * std::numeric_limits<double>::epsilon() * upper)
       break;
     if (iterations == max_iterations)
-      throw_not_converged(increment, value.residual, value.scale);
+      throw_not_converged(increment, value.yield_residual, value.scale);
     const double newton = increment - value.residual / value.derivative;
     if (!distrust_newton && newton > lower && newton < upper) {
       increment = newton;
@@ -117,8 +127,7 @@ inline void solve_fixed(const Residual& residual, double& increment, int steps) 
 // Closed form in the shared eigenbasis of Γ and Ξ.
 inline Solution closed_form(const PlaneStressElasticity& elasticity, const StressVoigt& trial,
                             double yield_stress, double plastic_modulus,
-                            InitialGuess initial_guess = InitialGuess::appendix_b,
-                            int fixed_iterations = 0) {
+                            const ReturnMapOptions& options = {}) {
   const double sum = trial.x() + trial.y();   // P*
   const double diff = trial.x() - trial.y();  // Q*
   const double shear = trial.z();             // s*
@@ -136,21 +145,29 @@ inline Solution closed_form(const PlaneStressElasticity& elasticity, const Stres
     const double inverse_u2 = 1.0 / (yield_stress + slope_2 * increment);
     const double term_1 = equibiaxial_part * inverse_u1 * inverse_u1;
     const double term_2 = deviatoric_part * inverse_u2 * inverse_u2;
-    // σᵀΞσ = σs²·S², S² = A/u₁² + B/u₂².
-    const double ratio_squared_minus_one = (term_1 + term_2) - 1.0;
+    // σᵀΞσ = σs²·S², S = σ̄/σs, S² = A/u₁² + B/u₂².
+    const double ratio_squared = term_1 + term_2;
     const double d_ratio_squared =
         -2.0 * (term_1 * slope_1 * inverse_u1 + term_2 * slope_2 * inverse_u2);
     const double scale = sigma_s * sigma_s;
-    return Evaluation{scale * ratio_squared_minus_one,
-                      2.0 * sigma_s * plastic_modulus * ratio_squared_minus_one +
-                          scale * d_ratio_squared,
-                      scale};
+    const double yield_residual = scale * (ratio_squared - 1.0);
+    if (options.newton_function == NewtonFunction::squared) {
+      // Appendix A in this basis: dg/dΔε̄p = 2σsEp(S² − 1) + σs² dS²/dΔε̄p.
+      return Evaluation{yield_residual,
+                        2.0 * sigma_s * plastic_modulus * (ratio_squared - 1.0) +
+                            scale * d_ratio_squared,
+                        yield_residual, scale};
+    }
+    // φ = 1 − 1/S, dφ/dΔε̄p = ½ S⁻³ dS²/dΔε̄p.
+    const double inverse_ratio = 1.0 / std::sqrt(ratio_squared);
+    return Evaluation{1.0 - inverse_ratio, 0.5 * inverse_ratio / ratio_squared * d_ratio_squared,
+                      yield_residual, scale};
   };
 
   const double trial_equivalent = std::sqrt(equibiaxial_part + deviatoric_part);
   const double excess = trial_equivalent - yield_stress;
   double increment = 0.0;
-  switch (initial_guess) {
+  switch (options.initial_guess) {
     case InitialGuess::appendix_b: {
       // σ̂ = σ*ᵀKᵀΞσ*/σ̄* with K = ΓΞ/σ̄* is the stiffness-weighted mean of κ₁, κ₂ (eq. B.5).
       const double sigma_hat = (kappa_1 * equibiaxial_part + kappa_2 * deviatoric_part) /
@@ -166,9 +183,9 @@ inline Solution closed_form(const PlaneStressElasticity& elasticity, const Stres
       break;
   }
 
-  int iterations = fixed_iterations;
-  if (fixed_iterations > 0) {
-    detail::solve_fixed(residual, increment, fixed_iterations);
+  int iterations = options.fixed_iterations;
+  if (options.fixed_iterations > 0) {
+    detail::solve_fixed(residual, increment, options.fixed_iterations);
   } else {
     // Since min uᵢ ≤ σs·σ̄*/σ̄ ≤ max uᵢ, the root lies in
     // [excess/max slope, excess/min slope]; widened to contain the start.
@@ -190,8 +207,7 @@ inline Solution closed_form(const PlaneStressElasticity& elasticity, const Stres
 // dσ/dΔε̄p = −L⁻¹ΓΞσ · dc/dΔε̄p with dc/dΔε̄p = σs,n/σs².
 inline Solution generic(const PlaneStressElasticity& elasticity, const StressVoigt& trial,
                         double yield_stress, double plastic_modulus,
-                        InitialGuess initial_guess = InitialGuess::appendix_b,
-                        int fixed_iterations = 0) {
+                        const ReturnMapOptions& options = {}) {
   const Matrix3 xi = von_mises_matrix();
   const Matrix3 gamma_xi = elasticity.matrix() * xi;
 
@@ -208,15 +224,25 @@ inline Solution generic(const PlaneStressElasticity& elasticity, const StressVoi
     const double dc = yield_stress / (sigma_s * sigma_s);
     const StressVoigt d_stress = -dc * (inverse_l * (gamma_xi * stress));
     const StressVoigt xi_stress = xi * stress;
-    return Evaluation{stress.dot(xi_stress) - sigma_s * sigma_s,
-                      2.0 * xi_stress.dot(d_stress) - 2.0 * sigma_s * plastic_modulus,
-                      sigma_s * sigma_s};
+    const double equivalent_squared = stress.dot(xi_stress);
+    const double yield_residual = equivalent_squared - sigma_s * sigma_s;
+    const double d_equivalent_squared = 2.0 * xi_stress.dot(d_stress);
+    if (options.newton_function == NewtonFunction::squared) {
+      return Evaluation{yield_residual, d_equivalent_squared - 2.0 * sigma_s * plastic_modulus,
+                        yield_residual, sigma_s * sigma_s};
+    }
+    // φ = 1 − σs/σ̄: dφ = −Ep/σ̄ + σs dσ̄/σ̄², dσ̄ = d(σ̄²)/(2σ̄).
+    const double equivalent = std::sqrt(equivalent_squared);
+    return Evaluation{1.0 - sigma_s / equivalent,
+                      -plastic_modulus / equivalent +
+                          sigma_s * d_equivalent_squared / (2.0 * equivalent_squared * equivalent),
+                      yield_residual, sigma_s * sigma_s};
   };
 
   const double trial_equivalent = std::sqrt(trial.dot(xi * trial));
   const double excess = trial_equivalent - yield_stress;
   double increment = 0.0;
-  switch (initial_guess) {
+  switch (options.initial_guess) {
     case InitialGuess::appendix_b: {
       const Matrix3 k = gamma_xi / trial_equivalent;                               // eq. (B.3)
       const double sigma_hat = trial.dot(k.transpose() * (xi * trial)) / trial_equivalent;  // (B.5)
@@ -231,9 +257,9 @@ inline Solution generic(const PlaneStressElasticity& elasticity, const StressVoi
       break;
   }
 
-  int iterations = fixed_iterations;
-  if (fixed_iterations > 0) {
-    detail::solve_fixed(residual, increment, fixed_iterations);
+  int iterations = options.fixed_iterations;
+  if (options.fixed_iterations > 0) {
+    detail::solve_fixed(residual, increment, options.fixed_iterations);
   } else {
     // No eigen-structure used here: g(0) > 0 is known, the upper end is found by expansion.
     iterations = detail::solve_safeguarded(residual, increment, 0.0,
@@ -248,10 +274,8 @@ inline Solution solve(const PlaneStressElasticity& elasticity, const StressVoigt
                       double yield_stress, double plastic_modulus,
                       const ReturnMapOptions& options) {
   if (options.form == ReturnMapForm::generic)
-    return generic(elasticity, trial, yield_stress, plastic_modulus, options.initial_guess,
-                   options.fixed_iterations);
-  return closed_form(elasticity, trial, yield_stress, plastic_modulus, options.initial_guess,
-                     options.fixed_iterations);
+    return generic(elasticity, trial, yield_stress, plastic_modulus, options);
+  return closed_form(elasticity, trial, yield_stress, plastic_modulus, options);
 }
 
 }  // namespace sphshell::material::return_map
