@@ -50,16 +50,9 @@ inline constexpr double relative_tolerance = 1e-12;
 inline constexpr int max_iterations = 100;
 
 struct Solution {
-  StressVoigt stress;  // returned stress, on the yield surface
+  StressVoigt stress;               // returned stress, on the yield surface
   double plastic_strain_increment;  // Δε̄p
   int iterations;  // Newton (or safeguard) corrections applied after the initial value
-};
-
-struct Evaluation {
-  double residual;        // the Newton function (φ or g) at Δε̄p
-  double derivative;      // its derivative
-  double yield_residual;  // g(Δε̄p) = σᵀΞσ − σs², tested for convergence
-  double scale;           // σs(Δε̄p)², the tolerance's reference
 };
 
 namespace detail {
@@ -75,19 +68,26 @@ namespace detail {
   throw Error(message.str());
 }
 
-// Safeguarded Newton–Raphson on a decreasing g with g(lower) > 0 > g(upper)
-// (upper may be +inf: then the bracket is expanded by doubling). A Newton step
-// that leaves the bracket, or a step after one that failed to halve |g|, is
-// replaced by bisection (or doubling), so convergence never depends on the
-// quality of the initial value. Returns the number of corrections applied.
-template <class Residual>
-inline int solve_safeguarded(const Residual& residual, double& increment, double lower,
-                             double upper) {
-  Evaluation value = residual(increment);
+// A kernel evaluates the return at a trial Δε̄p and caches what the next calls need:
+//   void evaluate(double increment);
+//   double yield_residual() const;    g = σᵀΞσ − σs² at the last evaluation
+//   double scale() const;             σs² there
+//   double newton_correction() const; −f/f' for the selected Newton function f
+//   StressVoigt stress() const;       the returned stress there
+
+// Safeguarded Newton–Raphson on the decreasing g, with g(lower) > 0 > g(upper)
+// (upper may be +inf: then the bracket grows by doubling). A Newton step that
+// leaves the bracket, or any step after one that failed to halve |g|, is
+// replaced by bisection (or doubling), so convergence never hinges on the
+// initial value. Returns the number of corrections applied; the kernel is left
+// evaluated at the returned Δε̄p.
+template <class Kernel>
+inline int solve_safeguarded(Kernel& kernel, double& increment, double lower, double upper) {
+  kernel.evaluate(increment);
   bool distrust_newton = false;
   int iterations = 0;
-  while (!(std::abs(value.yield_residual) <= relative_tolerance * value.scale)) {
-    if (value.residual > 0.0)
+  while (!(std::abs(kernel.yield_residual()) <= relative_tolerance * kernel.scale())) {
+    if (kernel.yield_residual() > 0.0)
       lower = increment;
     else
       upper = increment;
@@ -96,8 +96,8 @@ inline int solve_safeguarded(const Residual& residual, double& increment, double
         upper - lower <= 4.0 * std::numeric_limits<double>::epsilon() * upper)
       break;
     if (iterations == max_iterations)
-      throw_not_converged(increment, value.yield_residual, value.scale);
-    const double newton = increment - value.residual / value.derivative;
+      throw_not_converged(increment, kernel.yield_residual(), kernel.scale());
+    const double newton = increment + kernel.newton_correction();
     if (!distrust_newton && newton > lower && newton < upper) {
       increment = newton;
     } else if (upper < std::numeric_limits<double>::infinity()) {
@@ -105,150 +105,205 @@ inline int solve_safeguarded(const Residual& residual, double& increment, double
     } else {
       increment = lower > 0.0 ? 2.0 * lower : 2.0 * increment + 1e-12;
     }
-    const double previous = std::abs(value.residual);
-    value = residual(increment);
-    distrust_newton = std::abs(value.residual) > 0.5 * previous;
+    const double previous = std::abs(kernel.yield_residual());
+    kernel.evaluate(increment);
+    distrust_newton = std::abs(kernel.yield_residual()) > 0.5 * previous;
     ++iterations;
   }
   return iterations;
 }
 
 // Plain Newton, a fixed number of steps, no test: the "fixed iterations" baseline.
-template <class Residual>
-inline void solve_fixed(const Residual& residual, double& increment, int steps) {
+template <class Kernel>
+inline void solve_fixed(Kernel& kernel, double& increment, int steps) {
   for (int step = 0; step < steps; ++step) {
-    const Evaluation value = residual(increment);
-    increment -= value.residual / value.derivative;
+    kernel.evaluate(increment);
+    increment += kernel.newton_correction();
   }
+  kernel.evaluate(increment);
 }
+
+// The closed form in the shared eigenbasis of Γ and Ξ (see the top of the file).
+class ClosedFormKernel {
+ public:
+  ClosedFormKernel(const PlaneStressElasticity& elasticity, const StressVoigt& trial,
+                   double yield_stress, double plastic_modulus, NewtonFunction function)
+      : sum_(trial.x() + trial.y()),
+        diff_(trial.x() - trial.y()),
+        shear_(trial.z()),
+        equibiaxial_part_(0.25 * sum_ * sum_),
+        deviatoric_part_(0.75 * diff_ * diff_ + 3.0 * shear_ * shear_),
+        kappa_1_(elasticity.equibiaxial_stiffness()),
+        kappa_2_(elasticity.deviatoric_stiffness()),
+        slope_1_(kappa_1_ + plastic_modulus),
+        slope_2_(kappa_2_ + plastic_modulus),
+        yield_stress_(yield_stress),
+        plastic_modulus_(plastic_modulus),
+        function_(function) {}
+
+  double trial_equivalent() const { return std::sqrt(equibiaxial_part_ + deviatoric_part_); }
+  // σ̂ = σ*ᵀKᵀΞσ*/σ̄* with K = ΓΞ/σ̄* (eq. B.3, B.5) is the stiffness-weighted mean of κ₁, κ₂.
+  double sigma_hat() const {
+    return (kappa_1_ * equibiaxial_part_ + kappa_2_ * deviatoric_part_) /
+           (equibiaxial_part_ + deviatoric_part_);
+  }
+  double deviatoric_slope() const { return slope_2_; }
+  // Since min uᵢ ≤ σs σ̄*/σ̄ ≤ max uᵢ, the root lies in [excess/max slope, excess/min slope].
+  double lower_bound(double excess) const { return excess / std::max(slope_1_, slope_2_); }
+  double upper_bound(double excess) const { return excess / std::min(slope_1_, slope_2_); }
+
+  void evaluate(double increment) {
+    sigma_s_ = yield_stress_ + plastic_modulus_ * increment;
+    const double u1 = yield_stress_ + slope_1_ * increment;
+    const double u2 = yield_stress_ + slope_2_ * increment;
+    const double inverse_product = 1.0 / (u1 * u2);  // one division for both 1/uᵢ
+    inverse_u1_ = u2 * inverse_product;
+    inverse_u2_ = u1 * inverse_product;
+    term_1_ = equibiaxial_part_ * inverse_u1_ * inverse_u1_;
+    term_2_ = deviatoric_part_ * inverse_u2_ * inverse_u2_;
+    ratio_squared_ = term_1_ + term_2_;  // S² = (σ̄/σs)² = A/u₁² + B/u₂²
+  }
+
+  double scale() const { return sigma_s_ * sigma_s_; }
+  double yield_residual() const { return scale() * (ratio_squared_ - 1.0); }
+
+  double newton_correction() const {
+    const double d_ratio_squared =
+        -2.0 * (term_1_ * slope_1_ * inverse_u1_ + term_2_ * slope_2_ * inverse_u2_);
+    if (function_ == NewtonFunction::squared) {
+      // Appendix A in this basis: g = σs²(S² − 1), g' = 2σsEp(S² − 1) + σs² dS².
+      const double g = ratio_squared_ - 1.0;
+      return -sigma_s_ * g / (2.0 * plastic_modulus_ * g + sigma_s_ * d_ratio_squared);
+    }
+    // φ = 1 − 1/S, φ' = ½S⁻³ dS², so −φ/φ' = −2S²(S − 1)/dS².
+    const double ratio = std::sqrt(ratio_squared_);
+    return -2.0 * ratio_squared_ * (ratio - 1.0) / d_ratio_squared;
+  }
+
+  // σ = L⁻¹σ*: each eigen-component scaled by 1/(1 + cκᵢ) = σs/uᵢ.
+  StressVoigt stress() const {
+    const double returned_sum = sum_ * sigma_s_ * inverse_u1_;
+    const double deviatoric_factor = sigma_s_ * inverse_u2_;
+    const double returned_diff = diff_ * deviatoric_factor;
+    return StressVoigt(0.5 * (returned_sum + returned_diff), 0.5 * (returned_sum - returned_diff),
+                       shear_ * deviatoric_factor);
+  }
+
+ private:
+  double sum_, diff_, shear_;  // P*, Q*, s*
+  double equibiaxial_part_;    // A: σ̄*² along (1,1,0)
+  double deviatoric_part_;     // B: σ̄*² along (1,−1,0) and (0,0,1)
+  double kappa_1_, kappa_2_;   // eigenvalues of ΓΞ
+  double slope_1_, slope_2_;   // duᵢ/dΔε̄p = κᵢ + Ep
+  double yield_stress_, plastic_modulus_;
+  NewtonFunction function_;
+  double sigma_s_ = 0.0, inverse_u1_ = 0.0, inverse_u2_ = 0.0;
+  double term_1_ = 0.0, term_2_ = 0.0, ratio_squared_ = 0.0;
+};
+
+// The literal matrix form: L = I + cΓΞ, σ = L⁻¹σ*, and Appendix A's derivative
+// dσ/dΔε̄p = −L⁻¹ΓΞσ · dc/dΔε̄p with dc/dΔε̄p = σs,n/σs².
+class GenericKernel {
+ public:
+  GenericKernel(const PlaneStressElasticity& elasticity, const StressVoigt& trial,
+                double yield_stress, double plastic_modulus, NewtonFunction function)
+      : xi_(von_mises_matrix()),
+        gamma_xi_(elasticity.matrix() * xi_),
+        trial_(trial),
+        yield_stress_(yield_stress),
+        plastic_modulus_(plastic_modulus),
+        function_(function) {}
+
+  double trial_equivalent() const { return std::sqrt(trial_.dot(xi_ * trial_)); }
+  double sigma_hat() const {
+    const double equivalent = trial_equivalent();
+    const Matrix3 k = gamma_xi_ / equivalent;                          // eq. (B.3)
+    return trial_.dot(k.transpose() * (xi_ * trial_)) / equivalent;  // eq. (B.5)
+  }
+
+  void evaluate(double increment) {
+    sigma_s_ = yield_stress_ + plastic_modulus_ * increment;
+    const Matrix3 l = Matrix3::Identity() + (increment / sigma_s_) * gamma_xi_;
+    inverse_l_ = l.inverse();
+    stress_ = inverse_l_ * trial_;
+  }
+
+  double scale() const { return sigma_s_ * sigma_s_; }
+  double yield_residual() const { return stress_.dot(xi_ * stress_) - scale(); }
+
+  double newton_correction() const {
+    const double dc = yield_stress_ / scale();
+    const StressVoigt d_stress = -dc * (inverse_l_ * (gamma_xi_ * stress_));
+    const StressVoigt xi_stress = xi_ * stress_;
+    const double equivalent_squared = stress_.dot(xi_stress);
+    const double d_equivalent_squared = 2.0 * xi_stress.dot(d_stress);
+    if (function_ == NewtonFunction::squared) {
+      const double g = equivalent_squared - scale();
+      return -g / (d_equivalent_squared - 2.0 * sigma_s_ * plastic_modulus_);
+    }
+    // φ = 1 − σs/σ̄: φ' = −Ep/σ̄ + σs σ̄'/σ̄², σ̄' = (σ̄²)'/(2σ̄).
+    const double equivalent = std::sqrt(equivalent_squared);
+    const double phi = 1.0 - sigma_s_ / equivalent;
+    const double d_phi = -plastic_modulus_ / equivalent +
+                         sigma_s_ * d_equivalent_squared / (2.0 * equivalent_squared * equivalent);
+    return -phi / d_phi;
+  }
+
+  StressVoigt stress() const { return stress_; }
+
+ private:
+  Matrix3 xi_, gamma_xi_;
+  StressVoigt trial_;
+  double yield_stress_, plastic_modulus_;
+  NewtonFunction function_;
+  double sigma_s_ = 0.0;
+  Matrix3 inverse_l_ = Matrix3::Identity();
+  StressVoigt stress_ = StressVoigt::Zero();
+};
 
 }  // namespace detail
 
-// Closed form in the shared eigenbasis of Γ and Ξ.
 inline Solution closed_form(const PlaneStressElasticity& elasticity, const StressVoigt& trial,
                             double yield_stress, double plastic_modulus,
                             const ReturnMapOptions& options = {}) {
-  const double sum = trial.x() + trial.y();   // P*
-  const double diff = trial.x() - trial.y();  // Q*
-  const double shear = trial.z();             // s*
-  // σ̄*² = A + B, A along (1,1,0), B along (1,−1,0) and (0,0,1).
-  const double equibiaxial_part = 0.25 * sum * sum;
-  const double deviatoric_part = 0.75 * diff * diff + 3.0 * shear * shear;
-  const double kappa_1 = elasticity.equibiaxial_stiffness();
-  const double kappa_2 = elasticity.deviatoric_stiffness();
-  const double slope_1 = kappa_1 + plastic_modulus;  // duᵢ/dΔε̄p
-  const double slope_2 = kappa_2 + plastic_modulus;
-
-  const auto residual = [&](double increment) {
-    const double sigma_s = yield_stress + plastic_modulus * increment;
-    const double inverse_u1 = 1.0 / (yield_stress + slope_1 * increment);
-    const double inverse_u2 = 1.0 / (yield_stress + slope_2 * increment);
-    const double term_1 = equibiaxial_part * inverse_u1 * inverse_u1;
-    const double term_2 = deviatoric_part * inverse_u2 * inverse_u2;
-    // σᵀΞσ = σs²·S², S = σ̄/σs, S² = A/u₁² + B/u₂².
-    const double ratio_squared = term_1 + term_2;
-    const double d_ratio_squared =
-        -2.0 * (term_1 * slope_1 * inverse_u1 + term_2 * slope_2 * inverse_u2);
-    const double scale = sigma_s * sigma_s;
-    const double yield_residual = scale * (ratio_squared - 1.0);
-    if (options.newton_function == NewtonFunction::squared) {
-      // Appendix A in this basis: dg/dΔε̄p = 2σsEp(S² − 1) + σs² dS²/dΔε̄p.
-      return Evaluation{yield_residual,
-                        2.0 * sigma_s * plastic_modulus * (ratio_squared - 1.0) +
-                            scale * d_ratio_squared,
-                        yield_residual, scale};
-    }
-    // φ = 1 − 1/S, dφ/dΔε̄p = ½ S⁻³ dS²/dΔε̄p.
-    const double inverse_ratio = 1.0 / std::sqrt(ratio_squared);
-    return Evaluation{1.0 - inverse_ratio, 0.5 * inverse_ratio / ratio_squared * d_ratio_squared,
-                      yield_residual, scale};
-  };
-
-  const double trial_equivalent = std::sqrt(equibiaxial_part + deviatoric_part);
-  const double excess = trial_equivalent - yield_stress;
+  detail::ClosedFormKernel kernel(elasticity, trial, yield_stress, plastic_modulus,
+                                  options.newton_function);
+  const double excess = kernel.trial_equivalent() - yield_stress;
   double increment = 0.0;
   switch (options.initial_guess) {
-    case InitialGuess::appendix_b: {
-      // σ̂ = σ*ᵀKᵀΞσ*/σ̄* with K = ΓΞ/σ̄* is the stiffness-weighted mean of κ₁, κ₂ (eq. B.5).
-      const double sigma_hat = (kappa_1 * equibiaxial_part + kappa_2 * deviatoric_part) /
-                               (equibiaxial_part + deviatoric_part);
-      increment = excess / (sigma_hat + plastic_modulus);  // eq. (B.8)
+    case InitialGuess::appendix_b:
+      increment = excess / (kernel.sigma_hat() + plastic_modulus);  // eq. (B.8)
       break;
-    }
     case InitialGuess::zero:
       increment = 0.0;
       break;
     case InitialGuess::radial_return:
-      increment = excess / slope_2;
+      increment = excess / kernel.deviatoric_slope();
       break;
   }
-
   int iterations = options.fixed_iterations;
   if (options.fixed_iterations > 0) {
-    detail::solve_fixed(residual, increment, options.fixed_iterations);
+    detail::solve_fixed(kernel, increment, options.fixed_iterations);
   } else {
-    // Since min uᵢ ≤ σs·σ̄*/σ̄ ≤ max uᵢ, the root lies in
-    // [excess/max slope, excess/min slope]; widened to contain the start.
-    const double lower = std::min(excess / std::max(slope_1, slope_2), increment);
-    const double upper = std::max(excess / std::min(slope_1, slope_2), increment);
-    iterations = detail::solve_safeguarded(residual, increment, lower, upper);
+    // The analytic bracket, widened to contain the start.
+    iterations = detail::solve_safeguarded(kernel, increment,
+                                           std::min(kernel.lower_bound(excess), increment),
+                                           std::max(kernel.upper_bound(excess), increment));
   }
-
-  const double sigma_s = yield_stress + plastic_modulus * increment;
-  const double returned_sum = sum * sigma_s / (yield_stress + slope_1 * increment);
-  const double deviatoric_factor = sigma_s / (yield_stress + slope_2 * increment);
-  const double returned_diff = diff * deviatoric_factor;
-  return Solution{StressVoigt(0.5 * (returned_sum + returned_diff),
-                              0.5 * (returned_sum - returned_diff), shear * deviatoric_factor),
-                  increment, iterations};
+  return Solution{kernel.stress(), increment, iterations};
 }
 
-// The literal matrix form: L = I + cΓΞ, σ = L⁻¹σ*, and Appendix A's derivative
-// dσ/dΔε̄p = −L⁻¹ΓΞσ · dc/dΔε̄p with dc/dΔε̄p = σs,n/σs².
 inline Solution generic(const PlaneStressElasticity& elasticity, const StressVoigt& trial,
                         double yield_stress, double plastic_modulus,
                         const ReturnMapOptions& options = {}) {
-  const Matrix3 xi = von_mises_matrix();
-  const Matrix3 gamma_xi = elasticity.matrix() * xi;
-
-  const auto returned_stress = [&](double increment, Matrix3& inverse_l) {
-    const double sigma_s = yield_stress + plastic_modulus * increment;
-    const Matrix3 l = Matrix3::Identity() + (increment / sigma_s) * gamma_xi;
-    inverse_l = l.inverse();
-    return StressVoigt(inverse_l * trial);
-  };
-  const auto residual = [&](double increment) {
-    Matrix3 inverse_l;
-    const StressVoigt stress = returned_stress(increment, inverse_l);
-    const double sigma_s = yield_stress + plastic_modulus * increment;
-    const double dc = yield_stress / (sigma_s * sigma_s);
-    const StressVoigt d_stress = -dc * (inverse_l * (gamma_xi * stress));
-    const StressVoigt xi_stress = xi * stress;
-    const double equivalent_squared = stress.dot(xi_stress);
-    const double yield_residual = equivalent_squared - sigma_s * sigma_s;
-    const double d_equivalent_squared = 2.0 * xi_stress.dot(d_stress);
-    if (options.newton_function == NewtonFunction::squared) {
-      return Evaluation{yield_residual, d_equivalent_squared - 2.0 * sigma_s * plastic_modulus,
-                        yield_residual, sigma_s * sigma_s};
-    }
-    // φ = 1 − σs/σ̄: dφ = −Ep/σ̄ + σs dσ̄/σ̄², dσ̄ = d(σ̄²)/(2σ̄).
-    const double equivalent = std::sqrt(equivalent_squared);
-    return Evaluation{1.0 - sigma_s / equivalent,
-                      -plastic_modulus / equivalent +
-                          sigma_s * d_equivalent_squared / (2.0 * equivalent_squared * equivalent),
-                      yield_residual, sigma_s * sigma_s};
-  };
-
-  const double trial_equivalent = std::sqrt(trial.dot(xi * trial));
-  const double excess = trial_equivalent - yield_stress;
+  detail::GenericKernel kernel(elasticity, trial, yield_stress, plastic_modulus,
+                               options.newton_function);
+  const double excess = kernel.trial_equivalent() - yield_stress;
   double increment = 0.0;
   switch (options.initial_guess) {
-    case InitialGuess::appendix_b: {
-      const Matrix3 k = gamma_xi / trial_equivalent;                               // eq. (B.3)
-      const double sigma_hat = trial.dot(k.transpose() * (xi * trial)) / trial_equivalent;  // (B.5)
-      increment = excess / (sigma_hat + plastic_modulus);                         // (B.8)
+    case InitialGuess::appendix_b:
+      increment = excess / (kernel.sigma_hat() + plastic_modulus);  // eq. (B.8)
       break;
-    }
     case InitialGuess::zero:
       increment = 0.0;
       break;
@@ -256,18 +311,15 @@ inline Solution generic(const PlaneStressElasticity& elasticity, const StressVoi
       increment = excess / (3.0 * elasticity.shear_modulus() + plastic_modulus);
       break;
   }
-
   int iterations = options.fixed_iterations;
   if (options.fixed_iterations > 0) {
-    detail::solve_fixed(residual, increment, options.fixed_iterations);
+    detail::solve_fixed(kernel, increment, options.fixed_iterations);
   } else {
     // No eigen-structure used here: g(0) > 0 is known, the upper end is found by expansion.
-    iterations = detail::solve_safeguarded(residual, increment, 0.0,
+    iterations = detail::solve_safeguarded(kernel, increment, 0.0,
                                            std::numeric_limits<double>::infinity());
   }
-  Matrix3 inverse_l;
-  const StressVoigt stress = returned_stress(increment, inverse_l);
-  return Solution{stress, increment, iterations};
+  return Solution{kernel.stress(), increment, iterations};
 }
 
 inline Solution solve(const PlaneStressElasticity& elasticity, const StressVoigt& trial,
