@@ -180,28 +180,30 @@ void print_histogram(const char* label, const std::vector<StrainVoigt>& incremen
               100.0 * (counts[0] + counts[1]) / std::max(plastic, 1));
 }
 
-// Error of a fixed number of Newton steps against the converged return, each
-// step started from the same (converged) state.
-void print_fixed_iteration_error(int steps, InitialGuess guess, const char* label) {
+// Error of a return against a round-off reference (12 plain Newton steps),
+// every step started from the same state on the converged path.
+void print_return_error(const char* label, const std::vector<StrainVoigt>& increments,
+                        const ReturnMapOptions& options) {
+  const ReturnMapOptions reference_options =
+      options_with(ReturnMapForm::closed_form, InitialGuess::appendix_b, NewtonFunction::normalized, 12);
   J2Plasticity::State state = preloaded(j2_law, preload_strain);
   double worst_strain = 0.0, worst_stress = 0.0, sum_strain = 0.0;
   int plastic = 0;
-  for (const StrainVoigt& d_eps : stream) {
-    J2Plasticity::State fixed = state;
+  for (const StrainVoigt& d_eps : increments) {
+    J2Plasticity::State candidate = state;
     const J2Plasticity::State before = state;
-    const auto result = j2_law.update(state, d_eps);
-    j2_law.update(fixed, d_eps,
-                  options_with(ReturnMapForm::closed_form, guess, NewtonFunction::normalized, steps));
+    const auto result = j2_law.update(state, d_eps, reference_options);
+    j2_law.update(candidate, d_eps, options);
     if (!result.plastic) continue;
     ++plastic;
     const double increment = state.eps_p - before.eps_p;
-    const double strain_error = std::abs(fixed.eps_p - state.eps_p) / increment;
+    const double strain_error = std::abs(candidate.eps_p - state.eps_p) / increment;
     worst_strain = std::max(worst_strain, strain_error);
     sum_strain += strain_error;
-    worst_stress = std::max(worst_stress, (fixed.stress - state.stress).norm() / state.sigma_y);
+    worst_stress = std::max(worst_stress, (candidate.stress - state.stress).norm() / state.sigma_y);
   }
-  std::printf("  %-40s max |d(eps_p)| rel %.2e, mean %.2e, max |d(sigma)|/sigma_s %.2e\n", label,
-              worst_strain, sum_strain / std::max(plastic, 1), worst_stress);
+  std::printf("  %-44s max %.2e  mean %.2e  max |d sigma|/sigma_s %.2e\n", label, worst_strain,
+              sum_strain / std::max(plastic, 1), worst_stress);
 }
 
 void print_stream_report() {
@@ -228,10 +230,20 @@ void print_stream_report() {
                   options_with(ReturnMapForm::closed_form, InitialGuess::radial_return));
   print_histogram("Appendix B start, squared g", coarse_stream,
                   options_with(ReturnMapForm::closed_form, InitialGuess::appendix_b, NewtonFunction::squared));
-  std::printf("Fixed Newton steps vs converged (stream):\n");
-  print_fixed_iteration_error(3, InitialGuess::appendix_b, "3 steps from Appendix B start");
-  print_fixed_iteration_error(3, InitialGuess::zero, "3 steps from zero start");
-  print_fixed_iteration_error(1, InitialGuess::appendix_b, "1 step from Appendix B start");
+  std::printf("Relative error of d(eps_p) against a round-off reference:\n");
+  for (const auto* increments : {&stream, &coarse_stream}) {
+    std::printf(" %s:\n", increments == &stream ? "stream" : "coarse stream");
+    print_return_error("converged (default: Appendix B, phi)", *increments, {});
+    print_return_error("fixed 3 steps, Appendix B start, phi", *increments,
+                       options_with(ReturnMapForm::closed_form, InitialGuess::appendix_b,
+                                    NewtonFunction::normalized, 3));
+    print_return_error("fixed 3 steps, zero start, squared g", *increments,
+                       options_with(ReturnMapForm::closed_form, InitialGuess::zero,
+                                    NewtonFunction::squared, 3));
+    print_return_error("fixed 1 step, Appendix B start, phi", *increments,
+                       options_with(ReturnMapForm::closed_form, InitialGuess::appendix_b,
+                                    NewtonFunction::normalized, 1));
+  }
   std::fflush(stdout);
 }
 

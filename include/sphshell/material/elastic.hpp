@@ -75,7 +75,8 @@ class PlaneStressElasticity {
       : E_(youngs_modulus),
         nu_(poisson_ratio),
         shear_modulus_(youngs_modulus / (2.0 * (1.0 + poisson_ratio))),
-        biaxial_modulus_(youngs_modulus / (1.0 - poisson_ratio * poisson_ratio)) {}
+        biaxial_modulus_(youngs_modulus / (1.0 - poisson_ratio * poisson_ratio)),
+        equibiaxial_stiffness_(0.5 * youngs_modulus / (1.0 - poisson_ratio)) {}
 
   double youngs_modulus() const { return E_; }
   double poisson_ratio() const { return nu_; }
@@ -84,7 +85,7 @@ class PlaneStressElasticity {
   // Eigenvalues of ΓΞ along (1,1,0)/√2 and along (1,−1,0)/√2, (0,0,1): the
   // stiffness the return map sees against the volumetric-like and deviatoric
   // parts of a plane stress.
-  double equibiaxial_stiffness() const { return 0.5 * E_ / (1.0 - nu_); }
+  double equibiaxial_stiffness() const { return equibiaxial_stiffness_; }
   double deviatoric_stiffness() const { return 3.0 * shear_modulus_; }
 
   // Γ Δε, Δε with engineering shear (eq. 2.23).
@@ -113,6 +114,7 @@ class PlaneStressElasticity {
   double nu_;
   double shear_modulus_;
   double biaxial_modulus_;
+  double equibiaxial_stiffness_;
 };
 
 namespace detail {

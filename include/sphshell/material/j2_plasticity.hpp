@@ -44,7 +44,8 @@ struct J2Plasticity {
       : parameters_((detail::validate_plastic_constants(parameters.E, parameters.nu,
                                                         parameters.sigma_y0, parameters.Ep),
                      parameters)),
-        elasticity_(parameters.E, parameters.nu) {}
+        elasticity_(parameters.E, parameters.nu),
+        return_map_constants_(elasticity_, parameters.Ep) {}
 
   State initial_state() const { return State{StressVoigt::Zero(), 0.0, parameters_.sigma_y0}; }
 
@@ -62,7 +63,7 @@ struct J2Plasticity {
       return {false, 0};
     }
     const return_map::Solution solution =
-        return_map::solve(elasticity_, trial, state.sigma_y, parameters_.Ep, options);
+        return_map::solve(elasticity_, return_map_constants_, trial, state.sigma_y, options);
     state.stress = solution.stress;
     state.eps_p += solution.plastic_strain_increment;
     state.sigma_y += parameters_.Ep * solution.plastic_strain_increment;  // eq. (2.34)
@@ -88,6 +89,7 @@ struct J2Plasticity {
  private:
   Parameters parameters_;
   PlaneStressElasticity elasticity_;
+  return_map::ClosedFormConstants return_map_constants_;
 };
 
 }  // namespace sphshell::material

@@ -68,6 +68,7 @@ struct LemaitreDamage {
   explicit LemaitreDamage(const Parameters& parameters)
       : parameters_((validate(parameters), parameters)),
         elasticity_(parameters.E, parameters.nu),
+        return_map_constants_(elasticity_, parameters.Ep),
         damage_rate_(parameters.Dc / (parameters.eps_c - parameters.eps_s)) {}
 
   State initial_state() const {
@@ -98,7 +99,8 @@ struct LemaitreDamage {
       return {false, 0};
     }
     const return_map::Solution solution =
-        return_map::solve(elasticity_, effective_trial, state.sigma_y, parameters_.Ep, options);
+        return_map::solve(elasticity_, return_map_constants_, effective_trial, state.sigma_y,
+                          options);
     const double increment = solution.plastic_strain_increment;
     const double eps_p_new = state.eps_p + increment;
 
@@ -160,6 +162,7 @@ struct LemaitreDamage {
 
   Parameters parameters_;
   PlaneStressElasticity elasticity_;
+  return_map::ClosedFormConstants return_map_constants_;
   double damage_rate_;  // Dc/(ε̄cp − ε̄sp)
 };
 

@@ -55,39 +55,55 @@ struct Solution {
   int iterations;  // Newton (or safeguard) corrections applied after the initial value
 };
 
+// What the closed form needs from E, ν and Ep, computed once per law so the
+// hot path has no divisions for it.
+struct ClosedFormConstants {
+  ClosedFormConstants(const PlaneStressElasticity& elasticity, double plastic_modulus)
+      : kappa_1(elasticity.equibiaxial_stiffness()),
+        kappa_2(elasticity.deviatoric_stiffness()),
+        slope_1(kappa_1 + plastic_modulus),
+        slope_2(kappa_2 + plastic_modulus),
+        plastic_modulus(plastic_modulus),
+        inverse_max_slope(1.0 / std::max(slope_1, slope_2)),
+        inverse_min_slope(1.0 / std::min(slope_1, slope_2)),
+        inverse_slope_2(1.0 / slope_2) {}
+  double kappa_1, kappa_2;  // eigenvalues of ΓΞ: E/(2(1−ν)) and 3G
+  double slope_1, slope_2;  // κᵢ + Ep
+  double plastic_modulus;
+  double inverse_max_slope, inverse_min_slope, inverse_slope_2;
+};
+
 namespace detail {
 
-[[noreturn]] [[gnu::noinline, gnu::cold]] inline void throw_not_converged(double increment,
-                                                                          double residual,
-                                                                          double scale) {
+[[noreturn]] [[gnu::noinline, gnu::cold]] inline void throw_not_converged(
+    double increment, double relative_residual) {
   std::ostringstream message;
   message.precision(17);
   message << "sphshell: plane-stress return map did not converge in " << max_iterations
           << " iterations (delta eps_p = " << increment << ", |g|/sigma_s^2 = "
-          << std::abs(residual) / scale << ")";
+          << std::abs(relative_residual) << ")";
   throw Error(message.str());
 }
 
 // A kernel evaluates the return at a trial Δε̄p and caches what the next calls need:
 //   void evaluate(double increment);
-//   double yield_residual() const;    g = σᵀΞσ − σs² at the last evaluation
-//   double scale() const;             σs² there
-//   double newton_correction() const; −f/f' for the selected Newton function f
-//   StressVoigt stress() const;       the returned stress there
+//   double relative_yield_residual() const;  g/σs² = (σ̄/σs)² − 1 at the last evaluation
+//   double newton_correction() const;        −f/f' for the selected Newton function f
+//   StressVoigt stress() const;              the returned stress there
+// The test |g| ≤ tol·σs² is applied as |g/σs²| ≤ tol.
 
 // Safeguarded Newton–Raphson on the decreasing g, with g(lower) > 0 > g(upper)
 // (upper may be +inf: then the bracket grows by doubling). A Newton step that
 // leaves the bracket, or any step after one that failed to halve |g|, is
 // replaced by bisection (or doubling), so convergence never hinges on the
-// initial value. Returns the number of corrections applied; the kernel is left
-// evaluated at the returned Δε̄p.
+// initial value. The kernel arrives evaluated at `increment` and is left
+// evaluated at the returned Δε̄p. Returns the number of corrections applied.
 template <class Kernel>
 inline int solve_safeguarded(Kernel& kernel, double& increment, double lower, double upper) {
-  kernel.evaluate(increment);
   bool distrust_newton = false;
   int iterations = 0;
-  while (!(std::abs(kernel.yield_residual()) <= relative_tolerance * kernel.scale())) {
-    if (kernel.yield_residual() > 0.0)
+  while (!(std::abs(kernel.relative_yield_residual()) <= relative_tolerance)) {
+    if (kernel.relative_yield_residual() > 0.0)
       lower = increment;
     else
       upper = increment;
@@ -96,7 +112,7 @@ inline int solve_safeguarded(Kernel& kernel, double& increment, double lower, do
         upper - lower <= 4.0 * std::numeric_limits<double>::epsilon() * upper)
       break;
     if (iterations == max_iterations)
-      throw_not_converged(increment, kernel.yield_residual(), kernel.scale());
+      throw_not_converged(increment, kernel.relative_yield_residual());
     const double newton = increment + kernel.newton_correction();
     if (!distrust_newton && newton > lower && newton < upper) {
       increment = newton;
@@ -105,52 +121,57 @@ inline int solve_safeguarded(Kernel& kernel, double& increment, double lower, do
     } else {
       increment = lower > 0.0 ? 2.0 * lower : 2.0 * increment + 1e-12;
     }
-    const double previous = std::abs(kernel.yield_residual());
+    const double previous = std::abs(kernel.relative_yield_residual());
     kernel.evaluate(increment);
-    distrust_newton = std::abs(kernel.yield_residual()) > 0.5 * previous;
+    distrust_newton = std::abs(kernel.relative_yield_residual()) > 0.5 * previous;
     ++iterations;
   }
   return iterations;
 }
 
 // Plain Newton, a fixed number of steps, no test: the "fixed iterations" baseline.
+// The kernel arrives evaluated at `increment`.
 template <class Kernel>
 inline void solve_fixed(Kernel& kernel, double& increment, int steps) {
   for (int step = 0; step < steps; ++step) {
-    kernel.evaluate(increment);
     increment += kernel.newton_correction();
+    kernel.evaluate(increment);
   }
-  kernel.evaluate(increment);
 }
 
 // The closed form in the shared eigenbasis of Γ and Ξ (see the top of the file).
 class ClosedFormKernel {
  public:
-  ClosedFormKernel(const PlaneStressElasticity& elasticity, const StressVoigt& trial,
-                   double yield_stress, double plastic_modulus, NewtonFunction function)
+  ClosedFormKernel(const ClosedFormConstants& constants, const StressVoigt& trial,
+                   double yield_stress, NewtonFunction function)
       : sum_(trial.x() + trial.y()),
         diff_(trial.x() - trial.y()),
         shear_(trial.z()),
         equibiaxial_part_(0.25 * sum_ * sum_),
         deviatoric_part_(0.75 * diff_ * diff_ + 3.0 * shear_ * shear_),
-        kappa_1_(elasticity.equibiaxial_stiffness()),
-        kappa_2_(elasticity.deviatoric_stiffness()),
-        slope_1_(kappa_1_ + plastic_modulus),
-        slope_2_(kappa_2_ + plastic_modulus),
+        constants_(constants),
+        slope_1_(constants.slope_1),
+        slope_2_(constants.slope_2),
         yield_stress_(yield_stress),
-        plastic_modulus_(plastic_modulus),
+        plastic_modulus_(constants.plastic_modulus),
         function_(function) {}
 
   double trial_equivalent() const { return std::sqrt(equibiaxial_part_ + deviatoric_part_); }
-  // σ̂ = σ*ᵀKᵀΞσ*/σ̄* with K = ΓΞ/σ̄* (eq. B.3, B.5) is the stiffness-weighted mean of κ₁, κ₂.
-  double sigma_hat() const {
-    return (kappa_1_ * equibiaxial_part_ + kappa_2_ * deviatoric_part_) /
-           (equibiaxial_part_ + deviatoric_part_);
+
+  // eq. (B.8), Δε̄p⁰ = (σ̄* − σs,n)/(σ̂ + Ep), with σ̂ = σ*ᵀKᵀΞσ*/σ̄* and
+  // K = ΓΞ/σ̄* (B.3, B.5): σ̂ is the stiffness-weighted mean (κ₁A + κ₂B)/(A + B),
+  // so Δε̄p⁰ = excess·(A + B)/(κ₁A + κ₂B + Ep(A + B)) = numerator/denominator.
+  double appendix_b_numerator(double excess) const {
+    return excess * (equibiaxial_part_ + deviatoric_part_);
   }
-  double deviatoric_slope() const { return slope_2_; }
+  double appendix_b_denominator() const {
+    return constants_.kappa_1 * equibiaxial_part_ + constants_.kappa_2 * deviatoric_part_ +
+           plastic_modulus_ * (equibiaxial_part_ + deviatoric_part_);
+  }
+  double radial_return_start(double excess) const { return excess * constants_.inverse_slope_2; }
   // Since min uᵢ ≤ σs σ̄*/σ̄ ≤ max uᵢ, the root lies in [excess/max slope, excess/min slope].
-  double lower_bound(double excess) const { return excess / std::max(slope_1_, slope_2_); }
-  double upper_bound(double excess) const { return excess / std::min(slope_1_, slope_2_); }
+  double lower_bound(double excess) const { return excess * constants_.inverse_max_slope; }
+  double upper_bound(double excess) const { return excess * constants_.inverse_min_slope; }
 
   void evaluate(double increment) {
     sigma_s_ = yield_stress_ + plastic_modulus_ * increment;
@@ -164,8 +185,23 @@ class ClosedFormKernel {
     ratio_squared_ = term_1_ + term_2_;  // S² = (σ̄/σs)² = A/u₁² + B/u₂²
   }
 
-  double scale() const { return sigma_s_ * sigma_s_; }
-  double yield_residual() const { return scale() * (ratio_squared_ - 1.0); }
+  // evaluate(numerator/denominator) without waiting for that division: with
+  // nᵢ = σs,n·denominator + slopeᵢ·numerator, 1/uᵢ = denominator/nᵢ, and one
+  // division 1/(n₁n₂) serves both. Used for the Appendix-B start, whose
+  // fraction form is known.
+  void evaluate_fraction(double numerator, double denominator, double increment) {
+    sigma_s_ = yield_stress_ + plastic_modulus_ * increment;
+    const double n1 = yield_stress_ * denominator + slope_1_ * numerator;
+    const double n2 = yield_stress_ * denominator + slope_2_ * numerator;
+    const double inverse_product = denominator / (n1 * n2);
+    inverse_u1_ = n2 * inverse_product;
+    inverse_u2_ = n1 * inverse_product;
+    term_1_ = equibiaxial_part_ * inverse_u1_ * inverse_u1_;
+    term_2_ = deviatoric_part_ * inverse_u2_ * inverse_u2_;
+    ratio_squared_ = term_1_ + term_2_;
+  }
+
+  double relative_yield_residual() const { return ratio_squared_ - 1.0; }
 
   double newton_correction() const {
     const double d_ratio_squared =
@@ -175,9 +211,11 @@ class ClosedFormKernel {
       const double g = ratio_squared_ - 1.0;
       return -sigma_s_ * g / (2.0 * plastic_modulus_ * g + sigma_s_ * d_ratio_squared);
     }
-    // φ = 1 − 1/S, φ' = ½S⁻³ dS², so −φ/φ' = −2S²(S − 1)/dS².
+    // φ = 1 − 1/S, φ' = ½S⁻³ dS², so −φ/φ' = −2S²(S − 1)/dS²; the reciprocal
+    // does not wait for the square root.
+    const double inverse_slope = -2.0 / d_ratio_squared;
     const double ratio = std::sqrt(ratio_squared_);
-    return -2.0 * ratio_squared_ * (ratio - 1.0) / d_ratio_squared;
+    return inverse_slope * ratio_squared_ * (ratio - 1.0);
   }
 
   // σ = L⁻¹σ*: each eigen-component scaled by 1/(1 + cκᵢ) = σs/uᵢ.
@@ -193,8 +231,8 @@ class ClosedFormKernel {
   double sum_, diff_, shear_;  // P*, Q*, s*
   double equibiaxial_part_;    // A: σ̄*² along (1,1,0)
   double deviatoric_part_;     // B: σ̄*² along (1,−1,0) and (0,0,1)
-  double kappa_1_, kappa_2_;   // eigenvalues of ΓΞ
-  double slope_1_, slope_2_;   // duᵢ/dΔε̄p = κᵢ + Ep
+  const ClosedFormConstants& constants_;
+  double slope_1_, slope_2_;  // duᵢ/dΔε̄p = κᵢ + Ep
   double yield_stress_, plastic_modulus_;
   NewtonFunction function_;
   double sigma_s_ = 0.0, inverse_u1_ = 0.0, inverse_u2_ = 0.0;
@@ -229,7 +267,7 @@ class GenericKernel {
   }
 
   double scale() const { return sigma_s_ * sigma_s_; }
-  double yield_residual() const { return stress_.dot(xi_ * stress_) - scale(); }
+  double relative_yield_residual() const { return (stress_.dot(xi_ * stress_) - scale()) / scale(); }
 
   double newton_correction() const {
     const double dc = yield_stress_ / scale();
@@ -263,22 +301,26 @@ class GenericKernel {
 
 }  // namespace detail
 
-inline Solution closed_form(const PlaneStressElasticity& elasticity, const StressVoigt& trial,
-                            double yield_stress, double plastic_modulus,
-                            const ReturnMapOptions& options = {}) {
-  detail::ClosedFormKernel kernel(elasticity, trial, yield_stress, plastic_modulus,
-                                  options.newton_function);
+inline Solution closed_form(const ClosedFormConstants& constants, const StressVoigt& trial,
+                            double yield_stress, const ReturnMapOptions& options = {}) {
+  detail::ClosedFormKernel kernel(constants, trial, yield_stress, options.newton_function);
   const double excess = kernel.trial_equivalent() - yield_stress;
   double increment = 0.0;
   switch (options.initial_guess) {
-    case InitialGuess::appendix_b:
-      increment = excess / (kernel.sigma_hat() + plastic_modulus);  // eq. (B.8)
+    case InitialGuess::appendix_b: {
+      const double numerator = kernel.appendix_b_numerator(excess);
+      const double denominator = kernel.appendix_b_denominator();
+      increment = numerator / denominator;
+      kernel.evaluate_fraction(numerator, denominator, increment);
       break;
+    }
     case InitialGuess::zero:
       increment = 0.0;
+      kernel.evaluate(increment);
       break;
     case InitialGuess::radial_return:
-      increment = excess / kernel.deviatoric_slope();
+      increment = kernel.radial_return_start(excess);
+      kernel.evaluate(increment);
       break;
   }
   int iterations = options.fixed_iterations;
@@ -291,6 +333,13 @@ inline Solution closed_form(const PlaneStressElasticity& elasticity, const Stres
                                            std::max(kernel.upper_bound(excess), increment));
   }
   return Solution{kernel.stress(), increment, iterations};
+}
+
+inline Solution closed_form(const PlaneStressElasticity& elasticity, const StressVoigt& trial,
+                            double yield_stress, double plastic_modulus,
+                            const ReturnMapOptions& options = {}) {
+  return closed_form(ClosedFormConstants(elasticity, plastic_modulus), trial, yield_stress,
+                     options);
 }
 
 inline Solution generic(const PlaneStressElasticity& elasticity, const StressVoigt& trial,
@@ -311,6 +360,7 @@ inline Solution generic(const PlaneStressElasticity& elasticity, const StressVoi
       increment = excess / (3.0 * elasticity.shear_modulus() + plastic_modulus);
       break;
   }
+  kernel.evaluate(increment);
   int iterations = options.fixed_iterations;
   if (options.fixed_iterations > 0) {
     detail::solve_fixed(kernel, increment, options.fixed_iterations);
@@ -322,12 +372,20 @@ inline Solution generic(const PlaneStressElasticity& elasticity, const StressVoi
   return Solution{kernel.stress(), increment, iterations};
 }
 
+// Dispatch on options.form; the laws pass their precomputed constants.
+inline Solution solve(const PlaneStressElasticity& elasticity, const ClosedFormConstants& constants,
+                      const StressVoigt& trial, double yield_stress,
+                      const ReturnMapOptions& options) {
+  if (options.form == ReturnMapForm::generic)
+    return generic(elasticity, trial, yield_stress, constants.plastic_modulus, options);
+  return closed_form(constants, trial, yield_stress, options);
+}
+
 inline Solution solve(const PlaneStressElasticity& elasticity, const StressVoigt& trial,
                       double yield_stress, double plastic_modulus,
                       const ReturnMapOptions& options) {
-  if (options.form == ReturnMapForm::generic)
-    return generic(elasticity, trial, yield_stress, plastic_modulus, options);
-  return closed_form(elasticity, trial, yield_stress, plastic_modulus, options);
+  return solve(elasticity, ClosedFormConstants(elasticity, plastic_modulus), trial, yield_stress,
+               options);
 }
 
 }  // namespace sphshell::material::return_map
