@@ -8,14 +8,13 @@
 // variant (6× larger increments) is reported too. Each benchmark cycles
 // through the stream and resets the state at every pass.
 
-#include <sphshell/material/all.hpp>
-
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <sphshell/material/all.hpp>
 #include <vector>
 
 using namespace sphshell;
@@ -55,14 +54,14 @@ typename Law::State preloaded(const Law& law, const StrainVoigt& total_strain) {
   return state;
 }
 
-const StrainVoigt preload_strain = 1.2 * yield_stress / youngs_modulus * StrainVoigt(1.0, -0.5, 0.0);
+const StrainVoigt preload_strain =
+    1.2 * yield_stress / youngs_modulus * StrainVoigt(1.0, -0.5, 0.0);
 const std::vector<StrainVoigt> stream = tension_shear_stream(5e-6);
 const std::vector<StrainVoigt> coarse_stream = tension_shear_stream(3e-5);
 
 template <class Law>
-void run_stream(benchmark::State& benchmark_state, const Law& law,
-                const typename Law::State& start, const std::vector<StrainVoigt>& increments,
-                const ReturnMapOptions& options) {
+void run_stream(benchmark::State& benchmark_state, const Law& law, const typename Law::State& start,
+                const std::vector<StrainVoigt>& increments, const ReturnMapOptions& options) {
   typename Law::State state = start;
   std::size_t index = 0;
   for (auto _ : benchmark_state) {
@@ -103,9 +102,9 @@ void BM_j2_closed_radial_start(benchmark::State& state) {
              options_with(ReturnMapForm::closed_form, InitialGuess::radial_return));
 }
 void BM_j2_closed_squared_g(benchmark::State& state) {
-  run_stream(state, j2_law, preloaded(j2_law, preload_strain), stream,
-             options_with(ReturnMapForm::closed_form, InitialGuess::appendix_b,
-                          NewtonFunction::squared));
+  run_stream(
+      state, j2_law, preloaded(j2_law, preload_strain), stream,
+      options_with(ReturnMapForm::closed_form, InitialGuess::appendix_b, NewtonFunction::squared));
 }
 void BM_j2_closed_fixed_3(benchmark::State& state) {
   run_stream(state, j2_law, preloaded(j2_law, preload_strain), stream,
@@ -184,8 +183,8 @@ void print_histogram(const char* label, const std::vector<StrainVoigt>& incremen
 // every step started from the same state on the converged path.
 void print_return_error(const char* label, const std::vector<StrainVoigt>& increments,
                         const ReturnMapOptions& options) {
-  const ReturnMapOptions reference_options =
-      options_with(ReturnMapForm::closed_form, InitialGuess::appendix_b, NewtonFunction::normalized, 12);
+  const ReturnMapOptions reference_options = options_with(
+      ReturnMapForm::closed_form, InitialGuess::appendix_b, NewtonFunction::normalized, 12);
   J2Plasticity::State state = preloaded(j2_law, preload_strain);
   double worst_strain = 0.0, worst_stress = 0.0, sum_strain = 0.0;
   int plastic = 0;
@@ -207,19 +206,24 @@ void print_return_error(const char* label, const std::vector<StrainVoigt>& incre
 }
 
 void print_stream_report() {
-  std::printf("Newton corrections per plastic step (columns: 0 1 2 3 >3), tolerance |g| <= 1e-12 sigma_s^2\n");
+  std::printf(
+      "Newton corrections per plastic step (columns: 0 1 2 3 >3), tolerance |g| <= 1e-12 "
+      "sigma_s^2\n");
   std::printf(" stream (increments 2.5-7.5e-6):\n");
   print_histogram("Appendix B start, phi = 1 - sigma_s/sigma", stream, {});
   print_histogram("zero start, phi", stream,
                   options_with(ReturnMapForm::closed_form, InitialGuess::zero));
   print_histogram("radial-return start, phi", stream,
                   options_with(ReturnMapForm::closed_form, InitialGuess::radial_return));
-  print_histogram("Appendix B start, squared g (eq. 2.36)", stream,
-                  options_with(ReturnMapForm::closed_form, InitialGuess::appendix_b, NewtonFunction::squared));
-  print_histogram("zero start, squared g", stream,
-                  options_with(ReturnMapForm::closed_form, InitialGuess::zero, NewtonFunction::squared));
+  print_histogram(
+      "Appendix B start, squared g (eq. 2.36)", stream,
+      options_with(ReturnMapForm::closed_form, InitialGuess::appendix_b, NewtonFunction::squared));
+  print_histogram(
+      "zero start, squared g", stream,
+      options_with(ReturnMapForm::closed_form, InitialGuess::zero, NewtonFunction::squared));
   print_histogram("radial-return start, squared g", stream,
-                  options_with(ReturnMapForm::closed_form, InitialGuess::radial_return, NewtonFunction::squared));
+                  options_with(ReturnMapForm::closed_form, InitialGuess::radial_return,
+                               NewtonFunction::squared));
   print_histogram("generic 3x3, Appendix B start, phi", stream,
                   options_with(ReturnMapForm::generic, InitialGuess::appendix_b));
   std::printf(" coarse stream (increments 1.5-4.5e-5):\n");
@@ -228,8 +232,9 @@ void print_stream_report() {
                   options_with(ReturnMapForm::closed_form, InitialGuess::zero));
   print_histogram("radial-return start, phi", coarse_stream,
                   options_with(ReturnMapForm::closed_form, InitialGuess::radial_return));
-  print_histogram("Appendix B start, squared g", coarse_stream,
-                  options_with(ReturnMapForm::closed_form, InitialGuess::appendix_b, NewtonFunction::squared));
+  print_histogram(
+      "Appendix B start, squared g", coarse_stream,
+      options_with(ReturnMapForm::closed_form, InitialGuess::appendix_b, NewtonFunction::squared));
   std::printf("Relative error of d(eps_p) against a round-off reference:\n");
   for (const auto* increments : {&stream, &coarse_stream}) {
     std::printf(" %s:\n", increments == &stream ? "stream" : "coarse stream");
@@ -237,9 +242,9 @@ void print_stream_report() {
     print_return_error("fixed 3 steps, Appendix B start, phi", *increments,
                        options_with(ReturnMapForm::closed_form, InitialGuess::appendix_b,
                                     NewtonFunction::normalized, 3));
-    print_return_error("fixed 3 steps, zero start, squared g", *increments,
-                       options_with(ReturnMapForm::closed_form, InitialGuess::zero,
-                                    NewtonFunction::squared, 3));
+    print_return_error(
+        "fixed 3 steps, zero start, squared g", *increments,
+        options_with(ReturnMapForm::closed_form, InitialGuess::zero, NewtonFunction::squared, 3));
     print_return_error("fixed 1 step, Appendix B start, phi", *increments,
                        options_with(ReturnMapForm::closed_form, InitialGuess::appendix_b,
                                     NewtonFunction::normalized, 1));

@@ -3,10 +3,9 @@
 // solving for the lateral strain each step, so the table is a uniaxial test of
 // the plane-stress return map.
 
-#include <sphshell/material/all.hpp>
-
 #include <cmath>
 #include <cstdio>
+#include <sphshell/material/all.hpp>
 #include <vector>
 
 using namespace sphshell;
@@ -53,8 +52,9 @@ int main() {
   const std::vector<double> targets = {0.01, 0.0, -0.01, 0.005};
   const double step = 2.5e-4;
 
-  std::printf("step,eps_x[-],eps_y[-],sigma_x[MPa],sigma_y[MPa],eq_stress[MPa],eps_p[-],"
-              "yield_stress[MPa],plastic,newton_iterations\n");
+  std::printf(
+      "step,eps_x[-],eps_y[-],sigma_x[MPa],sigma_y[MPa],eq_stress[MPa],eps_p[-],"
+      "yield_stress[MPa],plastic,newton_iterations\n");
   double eps_x = 0.0, eps_y = 0.0;
   int index = 0;
   std::printf("%d,%.6e,%.6e,%.3f,%.3e,%.3f,%.6e,%.3f,%d,%d\n", index, eps_x, eps_y, 0.0, 0.0, 0.0,

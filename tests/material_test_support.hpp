@@ -2,9 +2,8 @@
 // Load paths shared by the material tests. They drive a law only through its
 // public update(); the expected values are computed independently in the tests.
 
-#include <sphshell/core/types.hpp>
-
 #include <cmath>
+#include <sphshell/core/types.hpp>
 #include <stdexcept>
 
 namespace material_test {

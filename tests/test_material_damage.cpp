@@ -1,12 +1,9 @@
-#include <sphshell/material/all.hpp>
-
-#include <catch2/catch.hpp>
-
 #include <Eigen/LU>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <random>
+#include <sphshell/material/all.hpp>
 
 #include "material_test_support.hpp"
 
@@ -34,7 +31,8 @@ TEST_CASE("Damage along a uniaxial stress path (T = 1/3) follows the integrated 
   const double nu = GENERATE(0.3, 0.2);
   const double plastic_modulus = 1e9;
   const double eps_s = 0.02, eps_c = 0.37, critical = 0.24;
-  const LemaitreDamage law({youngs_modulus, nu, yield_stress, plastic_modulus, eps_s, eps_c, critical});
+  const LemaitreDamage law(
+      {youngs_modulus, nu, yield_stress, plastic_modulus, eps_s, eps_c, critical});
   LemaitreDamage::State state = law.initial_state();
   // Coarse steps: the damage threshold is crossed inside a step, which the law must split.
   const double d_eps = 7.3e-4;
@@ -60,7 +58,8 @@ TEST_CASE("Damage along a uniaxial stress path (T = 1/3) follows the integrated 
     if (state.D > 0.0) damaged_seen = true;
     if (!result.plastic) continue;
     // Strain equivalence: elastic strain σx/((1−D)E), the rest is plastic.
-    const double measured_plastic_strain = axial_strain - state.stress.x() / ((1.0 - state.D) * youngs_modulus);
+    const double measured_plastic_strain =
+        axial_strain - state.stress.x() / ((1.0 - state.D) * youngs_modulus);
     CHECK(state.eps_p == Approx(measured_plastic_strain).epsilon(1e-8));
     CHECK(state.stress.x() ==
           Approx((1.0 - state.D) * (yield_stress + plastic_modulus * state.eps_p)).epsilon(1e-10));
@@ -88,15 +87,16 @@ TEST_CASE("Damage along a uniaxial stress path (T = 1/3) follows the integrated 
 TEST_CASE("Damage under equibiaxial tension (T = 2/3) follows the integrated damage law",
           "[material][damage]") {
   const double nu = 0.3, eps_s = 0.01, eps_c = 0.2, critical = 0.5, plastic_modulus = 2e9;
-  const LemaitreDamage law({youngs_modulus, nu, yield_stress, plastic_modulus, eps_s, eps_c, critical});
+  const LemaitreDamage law(
+      {youngs_modulus, nu, yield_stress, plastic_modulus, eps_s, eps_c, critical});
   LemaitreDamage::State state = law.initial_state();
   for (int step = 0; step < 400 && !state.failed; ++step) {
     const auto result = law.update(state, StrainVoigt(4e-4, 4e-4, 0.0));
     if (state.failed) break;
     CHECK(state.stress.x() == Approx(state.stress.y()).epsilon(1e-13));
-    CHECK(state.D == Approx(damage_at_constant_triaxiality(2.0 / 3.0, nu, state.eps_p, eps_s,
-                                                            eps_c, critical))
-                         .margin(1e-12));
+    CHECK(state.D ==
+          Approx(damage_at_constant_triaxiality(2.0 / 3.0, nu, state.eps_p, eps_s, eps_c, critical))
+              .margin(1e-12));
     if (result.plastic)
       CHECK(state.stress.x() == Approx((1.0 - state.D) * state.sigma_y).epsilon(1e-10));
   }
@@ -143,4 +143,54 @@ TEST_CASE("Damaged elastic energy density is ½σᵀΓ⁻¹σ/(1−D) and unload
   CHECK_FALSE(result.plastic);
   CHECK(state.D == damage);
   CHECK(before - state.stress.x() == Approx((1.0 - damage) * youngs_modulus * 1e-4).epsilon(1e-8));
+}
+
+TEST_CASE("A damage step is the J2 return of the effective stress, with T at the returned stress",
+          "[material][damage]") {
+  const double nu = 0.3, eps_s = 0.05, eps_c = 0.4, critical = 0.6, plastic_modulus = 2e9;
+  const LemaitreDamage law(
+      {youngs_modulus, nu, yield_stress, plastic_modulus, eps_s, eps_c, critical});
+  const J2Plasticity j2({youngs_modulus, nu, yield_stress, plastic_modulus});
+  std::mt19937_64 engine(11);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  int damaging = 0, crossing = 0;
+  for (int trial = 0; trial < 500; ++trial) {
+    LemaitreDamage::State state;
+    state.eps_p = 0.1 * (1.0 + uniform(engine));  // 0 … 0.2: below and above the threshold
+    state.sigma_y = yield_stress + plastic_modulus * state.eps_p;
+    state.D = state.eps_p > eps_s ? 0.2 * (1.0 + uniform(engine)) : 0.0;
+    state.failed = false;
+    const StressVoigt direction(uniform(engine), uniform(engine), uniform(engine));
+    state.stress = (1.0 - state.D) * state.sigma_y * direction /
+                   std::sqrt(direction.x() * direction.x() - direction.x() * direction.y() +
+                             direction.y() * direction.y() + 3 * direction.z() * direction.z());
+    const StrainVoigt d_eps = 4e-3 * StrainVoigt(uniform(engine), uniform(engine), uniform(engine));
+
+    // Independent expectation: J2 on σ̃ = σ/(1−D), then eq. (2.40)–(2.41) with T of the result.
+    J2Plasticity::State effective{state.stress / (1.0 - state.D), state.eps_p, state.sigma_y};
+    const auto j2_result = j2.update(effective, d_eps);
+    const double hydrostatic = (effective.stress.x() + effective.stress.y()) / 3.0;
+    const double triaxiality = hydrostatic / j2.equivalent_stress(effective);
+    const double y = 2.0 / 3.0 * (1.0 + nu) + 3.0 * (1.0 - 2.0 * nu) * triaxiality * triaxiality;
+    const double threshold = eps_s / y;
+    const double active = std::max(0.0, effective.eps_p - std::max(state.eps_p, threshold));
+    const double expected_damage =
+        j2_result.plastic ? state.D + critical / (eps_c - eps_s) * y * active : state.D;
+    if (state.eps_p < threshold && effective.eps_p > threshold) ++crossing;
+
+    LemaitreDamage::State updated = state;
+    const auto result = law.update(updated, d_eps);
+    REQUIRE(result.plastic == j2_result.plastic);
+    if (expected_damage >= critical) {
+      CHECK(updated.failed);
+      continue;
+    }
+    if (updated.D > state.D) ++damaging;
+    CHECK(updated.D == Approx(expected_damage).epsilon(1e-12));
+    CHECK(updated.eps_p == Approx(effective.eps_p).epsilon(1e-12));
+    CHECK((updated.stress - (1.0 - expected_damage) * effective.stress).norm() <=
+          1e-9 * yield_stress);
+  }
+  CHECK(damaging > 100);
+  CHECK(crossing > 0);
 }

@@ -1,13 +1,11 @@
 // Random states and random strain increments: the invariants every return must
 // keep, and agreement of the closed-form and generic 3×3 return maps.
 
-#include <sphshell/material/all.hpp>
-
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <random>
+#include <sphshell/material/all.hpp>
 
 using namespace sphshell;
 using namespace sphshell::material;
@@ -31,7 +29,9 @@ struct Sampler {
     return v.normalized();
   }
   // Magnitude log-uniform in [1e-6, 1e-2].
-  StrainVoigt strain_increment() { return std::pow(10.0, -6.0 + 4.0 * uniform(engine)) * direction(); }
+  StrainVoigt strain_increment() {
+    return std::pow(10.0, -6.0 + 4.0 * uniform(engine)) * direction();
+  }
   // A stress with σ̄ = radius, radius on the surface in 30 % of the draws.
   StressVoigt stress_with_equivalent(double radius) {
     const double fraction = uniform(engine) < 0.3 ? 1.0 : uniform(engine);
@@ -60,7 +60,8 @@ TEST_CASE("Fuzz: J2 returns stay on the yield surface, eps_p never decreases, bo
   const ReturnMapOptions generic_options{ReturnMapForm::generic, InitialGuess::appendix_b,
                                          NewtonFunction::normalized, 0};
   Sampler sampler;
-  Worst outside, off_surface, form_mismatch_stress, form_mismatch_strain, hardening_drift, start_mismatch;
+  Worst outside, off_surface, form_mismatch_stress, form_mismatch_strain, hardening_drift,
+      start_mismatch;
   int non_finite = 0, decreasing = 0, plastic_count = 0;
   for (int draw = 0; draw < increments_per_law; ++draw) {
     J2Plasticity::State state;
@@ -77,7 +78,8 @@ TEST_CASE("Fuzz: J2 returns stay on the yield surface, eps_p never decreases, bo
       ++non_finite;
     if (closed.eps_p < state.eps_p) ++decreasing;
     outside.see(mises(closed.stress) / closed.sigma_y - 1.0, draw);
-    hardening_drift.see(std::abs(closed.sigma_y - (235e6 + 1.5e9 * closed.eps_p)) / closed.sigma_y, draw);
+    hardening_drift.see(std::abs(closed.sigma_y - (235e6 + 1.5e9 * closed.eps_p)) / closed.sigma_y,
+                        draw);
     if (result.plastic) {
       ++plastic_count;
       off_surface.see(std::abs(mises(closed.stress) / closed.sigma_y - 1.0), draw);
@@ -90,11 +92,14 @@ TEST_CASE("Fuzz: J2 returns stay on the yield surface, eps_p never decreases, bo
     // Every tenth draw also through the other starts and the squared Newton function.
     if (draw % 10 == 0 && result.plastic) {
       for (const InitialGuess guess : {InitialGuess::zero, InitialGuess::radial_return}) {
-        for (const NewtonFunction function : {NewtonFunction::normalized, NewtonFunction::squared}) {
+        for (const NewtonFunction function :
+             {NewtonFunction::normalized, NewtonFunction::squared}) {
           J2Plasticity::State other = state;
-          law.update(other, d_eps, ReturnMapOptions{ReturnMapForm::closed_form, guess, function, 0});
+          law.update(other, d_eps,
+                     ReturnMapOptions{ReturnMapForm::closed_form, guess, function, 0});
           // |g| ≤ 1e-12 σs² pins Δε̄p to ~1e-12 σs/E in absolute terms, hence the floor.
-          start_mismatch.see(std::abs(other.eps_p - closed.eps_p) / (increment + 235e6 / 210e9), draw);
+          start_mismatch.see(std::abs(other.eps_p - closed.eps_p) / (increment + 235e6 / 210e9),
+                             draw);
         }
       }
     }

@@ -1,11 +1,8 @@
+#include <Eigen/LU>
+#include <catch2/catch.hpp>
+#include <cmath>
 #include <sphshell/core/error.hpp>
 #include <sphshell/material/all.hpp>
-
-#include <catch2/catch.hpp>
-
-#include <Eigen/LU>
-
-#include <cmath>
 #include <string>
 
 #include "material_test_support.hpp"
@@ -76,7 +73,8 @@ TEST_CASE("Elastic law: Hooke's law in plane stress, energy ½σᵀΓ⁻¹σ", "
   const StressVoigt expected = gamma * (d1 + d2);
   CHECK((state.stress - expected).norm() <= 1e-9 * expected.norm());
   const StrainVoigt strain = d1 + d2;
-  CHECK(law.elastic_energy_density(state) == Approx(0.5 * strain.dot(gamma * strain)).epsilon(1e-12));
+  CHECK(law.elastic_energy_density(state) ==
+        Approx(0.5 * strain.dot(gamma * strain)).epsilon(1e-12));
   CHECK(law.equivalent_stress(state) == Approx(mises(state.stress)).epsilon(1e-14));
   CHECK(law.equivalent_plastic_strain(state) == 0.0);
   CHECK(law.damage(state) == 0.0);
@@ -184,7 +182,8 @@ TEST_CASE("Pure shear yields at sigma_y0/sqrt(3), equibiaxial tension at sigma_y
     J2Plasticity::State state = law.initial_state();
     const double biaxial_modulus = youngs_modulus / (1.0 - poisson_ratio);
     const double yield_strain = yield_stress / biaxial_modulus;
-    auto result = law.update(state, StrainVoigt(yield_strain * (1 - 1e-9), yield_strain * (1 - 1e-9), 0));
+    auto result =
+        law.update(state, StrainVoigt(yield_strain * (1 - 1e-9), yield_strain * (1 - 1e-9), 0));
     CHECK_FALSE(result.plastic);
     CHECK(state.stress.x() == Approx(yield_stress).epsilon(1e-8));
     result = law.update(state, StrainVoigt(0.3 * yield_strain, 0.3 * yield_strain, 0));
@@ -199,18 +198,20 @@ TEST_CASE("Closed-form and generic return maps agree; every start converges to t
           "[material]") {
   const PlaneStressElasticity elasticity(youngs_modulus, poisson_ratio);
   const double plastic_modulus = GENERATE(0.0, 1e9, 50e9);
-  const StressVoigt trial = GENERATE(StressVoigt(300e6, 20e6, 10e6), StressVoigt(-400e6, 250e6, 90e6),
-                                     StressVoigt(240e6, 240e6, 0.0), StressVoigt(0.0, 0.0, 2e9),
-                                     StressVoigt(3e9, -1e9, 5e8));
+  const StressVoigt trial = GENERATE(
+      StressVoigt(300e6, 20e6, 10e6), StressVoigt(-400e6, 250e6, 90e6),
+      StressVoigt(240e6, 240e6, 0.0), StressVoigt(0.0, 0.0, 2e9), StressVoigt(3e9, -1e9, 5e8));
   CAPTURE(plastic_modulus, trial.transpose());
-  const return_map::Solution reference = return_map::closed_form(elasticity, trial, yield_stress, plastic_modulus);
+  const return_map::Solution reference =
+      return_map::closed_form(elasticity, trial, yield_stress, plastic_modulus);
   const double sigma_s = yield_stress + plastic_modulus * reference.plastic_strain_increment;
   CHECK(mises(reference.stress) == Approx(sigma_s).epsilon(1e-12));
   // The returned stress satisfies σ = L⁻¹σ* with the literal L = I + cΓΞ (eq. 2.32).
   Matrix3 xi;
   xi << 1, -0.5, 0, -0.5, 1, 0, 0, 0, 3;
   const Matrix3 l = Matrix3::Identity() + reference.plastic_strain_increment / sigma_s *
-                                              reference_elasticity(youngs_modulus, poisson_ratio) * xi;
+                                              reference_elasticity(youngs_modulus, poisson_ratio) *
+                                              xi;
   CHECK((l * reference.stress - trial).norm() <= 1e-12 * trial.norm());
 
   for (const ReturnMapForm form : {ReturnMapForm::closed_form, ReturnMapForm::generic})
@@ -225,8 +226,9 @@ TEST_CASE("Closed-form and generic return maps agree; every start converges to t
             return_map::solve(elasticity, trial, yield_stress, plastic_modulus, options);
         CAPTURE(static_cast<int>(form), static_cast<int>(guess), static_cast<int>(function));
         // |g| ≤ 1e-12 σs² pins Δε̄p to ~1e-12 σs/E in absolute terms.
-        CHECK(other.plastic_strain_increment ==
-              Approx(reference.plastic_strain_increment).epsilon(1e-11).margin(1e-11 * yield_stress / youngs_modulus));
+        CHECK(other.plastic_strain_increment == Approx(reference.plastic_strain_increment)
+                                                    .epsilon(1e-11)
+                                                    .margin(1e-11 * yield_stress / youngs_modulus));
         CHECK((other.stress - reference.stress).norm() <= 1e-11 * sigma_s);
         CHECK(other.iterations <= 12);
       }
@@ -235,16 +237,19 @@ TEST_CASE("Closed-form and generic return maps agree; every start converges to t
 TEST_CASE("Fixed-iteration Newton runs exactly the requested steps without a test", "[material]") {
   const PlaneStressElasticity elasticity(youngs_modulus, poisson_ratio);
   const StressVoigt trial(330e6, -40e6, 30e6);
-  const return_map::Solution converged = return_map::closed_form(elasticity, trial, yield_stress, 1e9);
+  const return_map::Solution converged =
+      return_map::closed_form(elasticity, trial, yield_stress, 1e9);
   double previous_error = 1.0;
   for (int steps = 1; steps <= 3; ++steps) {
     ReturnMapOptions options;
     options.fixed_iterations = steps;
     options.initial_guess = InitialGuess::zero;
-    const return_map::Solution fixed = return_map::closed_form(elasticity, trial, yield_stress, 1e9, options);
+    const return_map::Solution fixed =
+        return_map::closed_form(elasticity, trial, yield_stress, 1e9, options);
     CHECK(fixed.iterations == steps);
-    const double error = std::abs(fixed.plastic_strain_increment - converged.plastic_strain_increment) /
-                         converged.plastic_strain_increment;
+    const double error =
+        std::abs(fixed.plastic_strain_increment - converged.plastic_strain_increment) /
+        converged.plastic_strain_increment;
     CHECK(error < previous_error);
     previous_error = error;
   }
@@ -259,8 +264,9 @@ TEST_CASE("Appendix-B start: one Newton correction for small increments", "[mate
   int single = 0, total = 0;
   for (int step = 0; step < 200; ++step) {
     const double angle = 0.5 * M_PI * step / 200.0;
-    const auto result = law.update(state, 3e-6 * StrainVoigt(std::cos(angle), -0.5 * std::cos(angle),
-                                                             std::sqrt(3.0) * std::sin(angle)));
+    const auto result =
+        law.update(state, 3e-6 * StrainVoigt(std::cos(angle), -0.5 * std::cos(angle),
+                                             std::sqrt(3.0) * std::sin(angle)));
     if (!result.plastic) continue;
     ++total;
     if (result.iterations <= 1) ++single;
@@ -277,4 +283,21 @@ TEST_CASE("A non-finite strain increment throws", "[material]") {
   const Elastic elastic({youngs_modulus, poisson_ratio});
   Elastic::State elastic_state = elastic.initial_state();
   CHECK_THROWS_AS(elastic.update(elastic_state, StrainVoigt(0, 0, -INFINITY)), Error);
+}
+
+namespace {
+// A kernel whose yield residual never changes sign: the bracket can only grow.
+struct NeverConverging {
+  void evaluate(double) {}
+  double relative_yield_residual() const { return 1.0; }
+  double newton_correction() const { return -1.0; }
+};
+}  // namespace
+
+TEST_CASE("The safeguarded Newton iteration throws when it exceeds its iteration cap",
+          "[material]") {
+  NeverConverging kernel;
+  double increment = 1e-3;
+  CHECK_THROWS_WITH(return_map::detail::solve_safeguarded(kernel, increment, 0.0, INFINITY),
+                    Catch::Contains("did not converge") && Catch::Contains("100 iterations"));
 }

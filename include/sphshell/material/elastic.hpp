@@ -3,10 +3,9 @@
 // PlaneStressElasticity helper every law shares (Γ of eq. 2.24, its inverse,
 // and the von Mises matrix Ξ of eq. 2.20).
 
+#include <cmath>
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/types.hpp>
-
-#include <cmath>
 #include <sstream>
 
 namespace sphshell::material {
@@ -15,8 +14,8 @@ enum class ReturnMapForm { closed_form, generic };
 
 // How the Newton–Raphson return map picks its first Δε̄p.
 enum class InitialGuess {
-  appendix_b,    // (σ̄* − σs,n)/(σ̂ + Ep), eq. (2.39)/(B.8) with the consistent K = ΓΞ/σ̄*
-  zero,          // Δε̄p⁰ = 0, the naive start
+  appendix_b,  // (σ̄* − σs,n)/(σ̂ + Ep), eq. (2.39)/(B.8) with the consistent K = ΓΞ/σ̄*
+  zero,        // Δε̄p⁰ = 0, the naive start
   radial_return  // (σ̄* − σs,n)/(3G + Ep), exact for a purely deviatoric trial stress
 };
 

@@ -27,14 +27,13 @@
 // - Failure: a point whose D reaches Dc is failed, keeps D = Dc and zero
 //   stress forever; update() of a failed state returns at once.
 
+#include <algorithm>
+#include <cmath>
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/material/elastic.hpp>
 #include <sphshell/material/j2_plasticity.hpp>
 #include <sphshell/material/return_map.hpp>
-
-#include <algorithm>
-#include <cmath>
 #include <sstream>
 
 namespace sphshell::material {
@@ -93,14 +92,14 @@ struct LemaitreDamage {
     }
     detail::require_finite_strain(d_eps);
     const double intact_n = 1.0 - state.D;
-    const StressVoigt effective_trial = state.stress / intact_n + elasticity_.stress_increment(d_eps);
+    const StressVoigt effective_trial =
+        state.stress / intact_n + elasticity_.stress_increment(d_eps);
     if (von_mises_squared(effective_trial) <= state.sigma_y * state.sigma_y) {
       state.stress = intact_n * effective_trial;  // elastic: D unchanged
       return {false, 0};
     }
-    const return_map::Solution solution =
-        return_map::solve(elasticity_, return_map_constants_, effective_trial, state.sigma_y,
-                          options);
+    const return_map::Solution solution = return_map::solve(
+        elasticity_, return_map_constants_, effective_trial, state.sigma_y, options);
     const double increment = solution.plastic_strain_increment;
     const double eps_p_new = state.eps_p + increment;
 
@@ -110,9 +109,9 @@ struct LemaitreDamage {
     const double weight = triaxiality_function(triaxiality);
     const double threshold = parameters_.eps_s / weight;  // eq. (2.40) at equality
     const double damaging_strain = eps_p_new - std::max(state.eps_p, threshold);
-    const double damage_new =
-        damaging_strain > 0.0 ? state.D + damage_rate_ * weight * damaging_strain  // eq. (2.41)
-                              : state.D;
+    const double damage_new = damaging_strain > 0.0
+                                  ? state.D + damage_rate_ * weight * damaging_strain  // eq. (2.41)
+                                  : state.D;
 
     state.eps_p = eps_p_new;
     state.sigma_y += parameters_.Ep * increment;

@@ -20,7 +20,6 @@
 // names the missing member.
 
 #include <sphshell/core/types.hpp>
-
 #include <type_traits>
 #include <utility>
 
@@ -46,17 +45,15 @@ using state_type_t = typename Law::State;
 template <class Law>
 using update_result_t = typename Law::UpdateResult;
 template <class Law>
-using update_result_fields_t = decltype(std::declval<typename Law::UpdateResult&>().plastic =
-                                            true,
-                                        std::declval<typename Law::UpdateResult&>().iterations =
-                                            1);
+using update_result_fields_t = decltype(std::declval<typename Law::UpdateResult&>().plastic = true,
+                                        std::declval<typename Law::UpdateResult&>().iterations = 1);
 template <class Law>
 using parameter_constructor_t = decltype(Law(std::declval<const typename Law::Parameters&>()));
 template <class Law>
 using initial_state_t = decltype(std::declval<const Law&>().initial_state());
 template <class Law>
-using update_t = decltype(std::declval<const Law&>().update(
-    std::declval<typename Law::State&>(), std::declval<const StrainVoigt&>()));
+using update_t = decltype(std::declval<const Law&>().update(std::declval<typename Law::State&>(),
+                                                            std::declval<const StrainVoigt&>()));
 template <class Law>
 using parameters_accessor_t = decltype(std::declval<const Law&>().parameters());
 template <class Law>
@@ -108,35 +105,54 @@ struct update_returns_result<Law, void_t<update_result_t<Law>, update_t<Law>>>
 
 }  // namespace detail
 
-template <class Law> struct has_parameters_type : detail::is_detected<detail::parameters_type_t, Law> {};
-template <class Law> struct has_state_type : detail::is_detected<detail::state_type_t, Law> {};
-template <class Law> struct has_update_result_type : detail::is_detected<detail::update_result_fields_t, Law> {};
-template <class Law> struct has_parameter_constructor : detail::is_detected<detail::parameter_constructor_t, Law> {};
-template <class Law> struct has_initial_state : detail::initial_state_returns_state<Law> {};
-template <class Law> struct has_update : detail::update_returns_result<Law> {};
-template <class Law> struct has_parameters_accessor : detail::is_detected<detail::parameters_accessor_t, Law> {};
-template <class Law> struct has_youngs_modulus : detail::yields<double, detail::youngs_modulus_t, Law> {};
-template <class Law> struct has_poisson_ratio : detail::yields<double, detail::poisson_ratio_t, Law> {};
-template <class Law> struct has_elasticity_matrix : detail::yields<Matrix3, detail::elasticity_matrix_t, Law> {};
-template <class Law> struct has_plasticity_flag : detail::is_detected<detail::has_plasticity_t, Law> {};
-template <class Law> struct has_damage_flag : detail::is_detected<detail::has_damage_t, Law> {};
-template <class Law> struct has_name : detail::is_detected<detail::name_t, Law> {};
-template <class Law> struct has_equivalent_stress : detail::yields<double, detail::equivalent_stress_t, Law> {};
-template <class Law> struct has_equivalent_plastic_strain : detail::yields<double, detail::equivalent_plastic_strain_t, Law> {};
-template <class Law> struct has_damage_accessor : detail::yields<double, detail::damage_t, Law> {};
-template <class Law> struct has_failed : detail::yields<bool, detail::failed_t, Law> {};
-template <class Law> struct has_elastic_energy_density : detail::yields<double, detail::elastic_energy_density_t, Law> {};
+template <class Law>
+struct has_parameters_type : detail::is_detected<detail::parameters_type_t, Law> {};
+template <class Law>
+struct has_state_type : detail::is_detected<detail::state_type_t, Law> {};
+template <class Law>
+struct has_update_result_type : detail::is_detected<detail::update_result_fields_t, Law> {};
+template <class Law>
+struct has_parameter_constructor : detail::is_detected<detail::parameter_constructor_t, Law> {};
+template <class Law>
+struct has_initial_state : detail::initial_state_returns_state<Law> {};
+template <class Law>
+struct has_update : detail::update_returns_result<Law> {};
+template <class Law>
+struct has_parameters_accessor : detail::is_detected<detail::parameters_accessor_t, Law> {};
+template <class Law>
+struct has_youngs_modulus : detail::yields<double, detail::youngs_modulus_t, Law> {};
+template <class Law>
+struct has_poisson_ratio : detail::yields<double, detail::poisson_ratio_t, Law> {};
+template <class Law>
+struct has_elasticity_matrix : detail::yields<Matrix3, detail::elasticity_matrix_t, Law> {};
+template <class Law>
+struct has_plasticity_flag : detail::is_detected<detail::has_plasticity_t, Law> {};
+template <class Law>
+struct has_damage_flag : detail::is_detected<detail::has_damage_t, Law> {};
+template <class Law>
+struct has_name : detail::is_detected<detail::name_t, Law> {};
+template <class Law>
+struct has_equivalent_stress : detail::yields<double, detail::equivalent_stress_t, Law> {};
+template <class Law>
+struct has_equivalent_plastic_strain
+    : detail::yields<double, detail::equivalent_plastic_strain_t, Law> {};
+template <class Law>
+struct has_damage_accessor : detail::yields<double, detail::damage_t, Law> {};
+template <class Law>
+struct has_failed : detail::yields<bool, detail::failed_t, Law> {};
+template <class Law>
+struct has_elastic_energy_density : detail::yields<double, detail::elastic_energy_density_t, Law> {
+};
 
 template <class Law>
 struct is_material_law
     : std::conjunction<has_parameters_type<Law>, has_state_type<Law>, has_update_result_type<Law>,
                        has_parameter_constructor<Law>, has_initial_state<Law>, has_update<Law>,
                        has_parameters_accessor<Law>, has_youngs_modulus<Law>,
-                       has_poisson_ratio<Law>, has_elasticity_matrix<Law>,
-                       has_plasticity_flag<Law>, has_damage_flag<Law>, has_name<Law>,
-                       has_equivalent_stress<Law>, has_equivalent_plastic_strain<Law>,
-                       has_damage_accessor<Law>, has_failed<Law>,
-                       has_elastic_energy_density<Law>> {};
+                       has_poisson_ratio<Law>, has_elasticity_matrix<Law>, has_plasticity_flag<Law>,
+                       has_damage_flag<Law>, has_name<Law>, has_equivalent_stress<Law>,
+                       has_equivalent_plastic_strain<Law>, has_damage_accessor<Law>,
+                       has_failed<Law>, has_elastic_energy_density<Law>> {};
 
 template <class Law>
 inline constexpr bool is_material_law_v = is_material_law<Law>::value;
@@ -150,19 +166,21 @@ constexpr bool check_material_law() {
                 "material law: missing UpdateResult { bool plastic; int iterations; }");
   static_assert(has_parameter_constructor<Law>::value,
                 "material law: missing constructor Law(const Parameters&)");
-  static_assert(has_initial_state<Law>::value,
-                "material law: missing State initial_state() const");
+  static_assert(has_initial_state<Law>::value, "material law: missing State initial_state() const");
   static_assert(has_update<Law>::value,
                 "material law: missing UpdateResult update(State&, const StrainVoigt&) const");
   static_assert(has_parameters_accessor<Law>::value,
                 "material law: missing const Parameters& parameters() const");
-  static_assert(has_youngs_modulus<Law>::value, "material law: missing double youngs_modulus() const");
-  static_assert(has_poisson_ratio<Law>::value, "material law: missing double poisson_ratio() const");
+  static_assert(has_youngs_modulus<Law>::value,
+                "material law: missing double youngs_modulus() const");
+  static_assert(has_poisson_ratio<Law>::value,
+                "material law: missing double poisson_ratio() const");
   static_assert(has_elasticity_matrix<Law>::value,
                 "material law: missing Matrix3 elasticity_matrix() const");
   static_assert(has_plasticity_flag<Law>::value,
                 "material law: missing static constexpr bool has_plasticity");
-  static_assert(has_damage_flag<Law>::value, "material law: missing static constexpr bool has_damage");
+  static_assert(has_damage_flag<Law>::value,
+                "material law: missing static constexpr bool has_damage");
   static_assert(has_name<Law>::value, "material law: missing static constexpr const char* name");
   static_assert(has_equivalent_stress<Law>::value,
                 "material law: missing double equivalent_stress(const State&) const");

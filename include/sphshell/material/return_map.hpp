@@ -30,15 +30,13 @@
 // more correction for the same 1e-12 (see bench_return_map). Either way the
 // stopping test is on g: |g| ≤ 1e-12 σs².
 
-#include <sphshell/core/error.hpp>
-#include <sphshell/core/types.hpp>
-#include <sphshell/material/elastic.hpp>
-
 #include <Eigen/LU>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sphshell/core/error.hpp>
+#include <sphshell/core/types.hpp>
+#include <sphshell/material/elastic.hpp>
 #include <sstream>
 
 namespace sphshell::material::return_map {
@@ -80,8 +78,8 @@ namespace detail {
   std::ostringstream message;
   message.precision(17);
   message << "sphshell: plane-stress return map did not converge in " << max_iterations
-          << " iterations (delta eps_p = " << increment << ", |g|/sigma_s^2 = "
-          << std::abs(relative_residual) << ")";
+          << " iterations (delta eps_p = " << increment
+          << ", |g|/sigma_s^2 = " << std::abs(relative_residual) << ")";
   throw Error(message.str());
 }
 
@@ -255,7 +253,7 @@ class GenericKernel {
   double trial_equivalent() const { return std::sqrt(trial_.dot(xi_ * trial_)); }
   double sigma_hat() const {
     const double equivalent = trial_equivalent();
-    const Matrix3 k = gamma_xi_ / equivalent;                          // eq. (B.3)
+    const Matrix3 k = gamma_xi_ / equivalent;                        // eq. (B.3)
     return trial_.dot(k.transpose() * (xi_ * trial_)) / equivalent;  // eq. (B.5)
   }
 
@@ -267,7 +265,9 @@ class GenericKernel {
   }
 
   double scale() const { return sigma_s_ * sigma_s_; }
-  double relative_yield_residual() const { return (stress_.dot(xi_ * stress_) - scale()) / scale(); }
+  double relative_yield_residual() const {
+    return (stress_.dot(xi_ * stress_) - scale()) / scale();
+  }
 
   double newton_correction() const {
     const double dc = yield_stress_ / scale();
@@ -366,8 +366,8 @@ inline Solution generic(const PlaneStressElasticity& elasticity, const StressVoi
     detail::solve_fixed(kernel, increment, options.fixed_iterations);
   } else {
     // No eigen-structure used here: g(0) > 0 is known, the upper end is found by expansion.
-    iterations = detail::solve_safeguarded(kernel, increment, 0.0,
-                                           std::numeric_limits<double>::infinity());
+    iterations =
+        detail::solve_safeguarded(kernel, increment, 0.0, std::numeric_limits<double>::infinity());
   }
   return Solution{kernel.stress(), increment, iterations};
 }
