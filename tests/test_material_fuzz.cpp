@@ -57,8 +57,8 @@ struct Worst {
 TEST_CASE("Fuzz: J2 returns stay on the yield surface, eps_p never decreases, both forms agree",
           "[material][fuzz]") {
   const J2Plasticity law({210e9, 0.3, 235e6, 1.5e9});
-  const ReturnMapOptions generic_options{ReturnMapForm::generic, InitialGuess::appendix_b,
-                                         NewtonFunction::normalized, 0};
+  const ReturnMapOptions generic_options{ReturnMapForm::generic, InitialGuess::appendix_b, 0,
+                                         NewtonFunction::normalized};
   Sampler sampler;
   Worst outside, off_surface, form_mismatch_stress, form_mismatch_strain, hardening_drift,
       start_mismatch;
@@ -96,7 +96,7 @@ TEST_CASE("Fuzz: J2 returns stay on the yield surface, eps_p never decreases, bo
              {NewtonFunction::normalized, NewtonFunction::squared}) {
           J2Plasticity::State other = state;
           law.update(other, d_eps,
-                     ReturnMapOptions{ReturnMapForm::closed_form, guess, function, 0});
+                     ReturnMapOptions{ReturnMapForm::closed_form, guess, 0, function});
           // |g| ≤ 1e-12 σs² pins Δε̄p to ~1e-12 σs/E in absolute terms, hence the floor.
           start_mismatch.see(std::abs(other.eps_p - closed.eps_p) / (increment + 235e6 / 210e9),
                              draw);
@@ -121,8 +121,8 @@ TEST_CASE("Fuzz: damage stays within (1-D) sigma_s, D and eps_p never decrease, 
           "[material][fuzz]") {
   const LemaitreDamage::Parameters parameters{210e9, 0.3, 235e6, 1.5e9, 0.02, 0.37, 0.24};
   const LemaitreDamage law(parameters);
-  const ReturnMapOptions generic_options{ReturnMapForm::generic, InitialGuess::appendix_b,
-                                         NewtonFunction::normalized, 0};
+  const ReturnMapOptions generic_options{ReturnMapForm::generic, InitialGuess::appendix_b, 0,
+                                         NewtonFunction::normalized};
   Sampler sampler;
   Worst outside, off_surface, form_mismatch_stress, form_mismatch_damage;
   int non_finite = 0, decreasing = 0, above_critical = 0, failed_with_stress = 0, failures = 0,

@@ -25,14 +25,15 @@ enum class NewtonFunction {
   squared      // g = σᵀΞσ − σs², eq. (2.36), with Appendix A's derivative
 };
 
+// Aggregate order: {form, initial_guess, fixed_iterations, newton_function}.
 struct ReturnMapOptions {
   ReturnMapForm form = ReturnMapForm::closed_form;
   InitialGuess initial_guess = InitialGuess::appendix_b;
-  NewtonFunction newton_function = NewtonFunction::normalized;
   // 0: iterate to convergence (safeguarded). > 0: exactly that many plain
   // Newton steps, no convergence test and no safeguard — the baseline of codes
   // that run a fixed number of iterations.
   int fixed_iterations = 0;
+  NewtonFunction newton_function = NewtonFunction::normalized;
 };
 
 namespace detail {
