@@ -301,3 +301,17 @@ TEST_CASE("The safeguarded Newton iteration throws when it exceeds its iteration
   CHECK_THROWS_WITH(return_map::detail::solve_safeguarded(kernel, increment, 0.0, INFINITY),
                     Catch::Contains("did not converge") && Catch::Contains("100 iterations"));
 }
+
+TEST_CASE("Return maps leave a trial stress inside the yield surface untouched", "[material]") {
+  const PlaneStressElasticity elasticity(youngs_modulus, poisson_ratio);
+  const StressVoigt inside(100e6, 50e6, 20e6);
+  for (const ReturnMapForm form : {ReturnMapForm::closed_form, ReturnMapForm::generic}) {
+    ReturnMapOptions options;
+    options.form = form;
+    const return_map::Solution solution =
+        return_map::solve(elasticity, inside, yield_stress, 1e9, options);
+    CHECK(solution.plastic_strain_increment == 0.0);
+    CHECK(solution.iterations == 0);
+    CHECK(solution.stress == inside);
+  }
+}

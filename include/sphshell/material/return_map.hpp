@@ -305,6 +305,9 @@ inline Solution closed_form(const ClosedFormConstants& constants, const StressVo
                             double yield_stress, const ReturnMapOptions& options = {}) {
   detail::ClosedFormKernel kernel(constants, trial, yield_stress, options.newton_function);
   const double excess = kernel.trial_equivalent() - yield_stress;
+  // A trial stress on or inside the surface (callers check first; this catches round-off) needs no
+  // return.
+  if (!(excess > 0.0)) return Solution{trial, 0.0, 0};
   double increment = 0.0;
   switch (options.initial_guess) {
     case InitialGuess::appendix_b: {
@@ -348,6 +351,7 @@ inline Solution generic(const PlaneStressElasticity& elasticity, const StressVoi
   detail::GenericKernel kernel(elasticity, trial, yield_stress, plastic_modulus,
                                options.newton_function);
   const double excess = kernel.trial_equivalent() - yield_stress;
+  if (!(excess > 0.0)) return Solution{trial, 0.0, 0};
   double increment = 0.0;
   switch (options.initial_guess) {
     case InitialGuess::appendix_b:
