@@ -8,13 +8,14 @@
 // variant (6× larger increments) is reported too. Each benchmark cycles
 // through the stream and resets the state at every pass.
 
+#include <sphshell/material/all.hpp>
+
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <sphshell/material/all.hpp>
 #include <vector>
 
 using namespace sphshell;

@@ -3,9 +3,10 @@
 // solving for the lateral strain each step, so the table is a uniaxial test of
 // the plane-stress return map.
 
+#include <sphshell/material/all.hpp>
+
 #include <cmath>
 #include <cstdio>
-#include <sphshell/material/all.hpp>
 #include <vector>
 
 using namespace sphshell;

@@ -2,8 +2,9 @@
 // Load paths shared by the material tests. They drive a law only through its
 // public update(); the expected values are computed independently in the tests.
 
-#include <cmath>
 #include <sphshell/core/types.hpp>
+
+#include <cmath>
 #include <stdexcept>
 
 namespace material_test {

@@ -1,9 +1,11 @@
+#include <sphshell/material/all.hpp>
+
 #include <Eigen/LU>
-#include <algorithm>
 #include <catch2/catch.hpp>
+
+#include <algorithm>
 #include <cmath>
 #include <random>
-#include <sphshell/material/all.hpp>
 
 #include "material_test_support.hpp"
 

@@ -1,11 +1,13 @@
 // Random states and random strain increments: the invariants every return must
 // keep, and agreement of the closed-form and generic 3×3 return maps.
 
-#include <algorithm>
+#include <sphshell/material/all.hpp>
+
 #include <catch2/catch.hpp>
+
+#include <algorithm>
 #include <cmath>
 #include <random>
-#include <sphshell/material/all.hpp>
 
 using namespace sphshell;
 using namespace sphshell::material;

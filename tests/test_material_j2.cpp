@@ -1,8 +1,10 @@
-#include <Eigen/LU>
-#include <catch2/catch.hpp>
-#include <cmath>
 #include <sphshell/core/error.hpp>
 #include <sphshell/material/all.hpp>
+
+#include <Eigen/LU>
+#include <catch2/catch.hpp>
+
+#include <cmath>
 #include <string>
 
 #include "material_test_support.hpp"

@@ -1,7 +1,9 @@
-#include <catch2/catch.hpp>
-#include <limits>
 #include <sphshell/core/error.hpp>
 #include <sphshell/material/all.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <limits>
 
 using namespace sphshell;
 using namespace sphshell::material;

@@ -3,9 +3,10 @@
 // PlaneStressElasticity helper every law shares (Γ of eq. 2.24, its inverse,
 // and the von Mises matrix Ξ of eq. 2.20).
 
-#include <cmath>
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/types.hpp>
+
+#include <cmath>
 #include <sstream>
 
 namespace sphshell::material {

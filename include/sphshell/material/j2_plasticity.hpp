@@ -2,11 +2,12 @@
 // Plane-stress von Mises plasticity with linear isotropic hardening (section 2.2
 // of the paper): elastic predictor, yield check, Newton–Raphson return map.
 
-#include <cmath>
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/material/elastic.hpp>
 #include <sphshell/material/return_map.hpp>
+
+#include <cmath>
 
 namespace sphshell::material {
 

@@ -27,13 +27,14 @@
 // - Failure: a point whose D reaches Dc is failed, keeps D = Dc and zero
 //   stress forever; update() of a failed state returns at once.
 
-#include <algorithm>
-#include <cmath>
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/material/elastic.hpp>
 #include <sphshell/material/j2_plasticity.hpp>
 #include <sphshell/material/return_map.hpp>
+
+#include <algorithm>
+#include <cmath>
 #include <sstream>
 
 namespace sphshell::material {

@@ -20,6 +20,7 @@
 // names the missing member.
 
 #include <sphshell/core/types.hpp>
+
 #include <type_traits>
 #include <utility>
 

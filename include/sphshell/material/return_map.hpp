@@ -30,13 +30,15 @@
 // more correction for the same 1e-12 (see bench_return_map). Either way the
 // stopping test is on g: |g| ≤ 1e-12 σs².
 
-#include <Eigen/LU>
-#include <algorithm>
-#include <cmath>
-#include <limits>
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/material/elastic.hpp>
+
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace sphshell::material::return_map {
