@@ -13,7 +13,8 @@
 //     σ_{n+1} = (1−D_{n+1}) [σ̃_n + ΓΔε − ΓΔεp],
 //   i.e. Lσ_{n+1} = σ* with σ* = σ_n + (1−D_n)ΓΔε and
 //     L = (1 + ΔD/(1−D_{n+1})) (I + cΓΞ),
-//   the form of eq. (2.46) with D_{n+1} and effective-stress flow. The yield
+//   the form of eq. (2.46) with D_{n+1} and effective-stress flow (the
+//   (1−D)cΓΞ term of the paper's L becomes (1−D_n)/(1−D_{n+1})·cΓΞ). The yield
 //   equation σᵀΞσ/(1−D_{n+1})² − σs² = 0 then equals σ̃ᵀΞσ̃ − σs² = 0 with
 //   (I + cΓΞ)σ̃ = σ̃* = σ̃_n + ΓΔε: ΔD cancels, so the scalar Newton for Δε̄p
 //   is exactly the J2 one (return_map.hpp) and D = 0 reduces to J2 exactly.
@@ -131,6 +132,7 @@ struct LemaitreDamage {
   double youngs_modulus() const { return parameters_.E; }
   double poisson_ratio() const { return parameters_.nu; }
   const PlaneStressElasticity& elasticity() const { return elasticity_; }
+  // The undamaged Γ; the current stiffness of a point is (1−D)Γ.
   Matrix3 elasticity_matrix() const { return elasticity_.matrix(); }
 
   // Nominal σ̄; after a plastic return it equals (1−D)σs.
