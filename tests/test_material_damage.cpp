@@ -128,8 +128,9 @@ TEST_CASE("Without damage growth the damage law reproduces J2 plasticity exactly
   CHECK(plastic > 100);
 }
 
-TEST_CASE("Damaged elastic energy density is ½σᵀΓ⁻¹σ/(1−D) and unloading has slope (1−D)E",
-          "[material][damage]") {
+TEST_CASE(
+    "Damaged elastic energy density is 1/2 sigma^T Gamma^-1 sigma/(1-D), unloading slope (1-D)E",
+    "[material][damage]") {
   const LemaitreDamage law({youngs_modulus, 0.3, yield_stress, 1e9, 0.0, 0.1, 0.9});
   LemaitreDamage::State state = law.initial_state();
   for (int step = 0; step < 60; ++step) uniaxial_step(law, state, 5e-4);

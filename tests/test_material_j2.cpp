@@ -62,7 +62,8 @@ TEST_CASE("Material laws expose the family flags and names", "[material]") {
   CHECK(LemaitreDamage::has_damage);
 }
 
-TEST_CASE("Elastic law: Hooke's law in plane stress, energy ½σᵀΓ⁻¹σ", "[material]") {
+TEST_CASE("Elastic law: plane-stress Hooke law, energy density 1/2 sigma^T Gamma^-1 sigma",
+          "[material]") {
   const Elastic law({youngs_modulus, poisson_ratio});
   const Matrix3 gamma = reference_elasticity(youngs_modulus, poisson_ratio);
   CHECK(law.elasticity_matrix().isApprox(gamma, 1e-15));
@@ -196,7 +197,7 @@ TEST_CASE("Pure shear yields at sigma_y0/sqrt(3), equibiaxial tension at sigma_y
   }
 }
 
-TEST_CASE("Closed-form and generic return maps agree; every start converges to the same root",
+TEST_CASE("Closed-form and generic return maps agree, every start converges to the same root",
           "[material]") {
   const PlaneStressElasticity elasticity(youngs_modulus, poisson_ratio);
   const double plastic_modulus = GENERATE(0.0, 1e9, 50e9);
