@@ -318,3 +318,17 @@ TEST_CASE("Return maps leave a trial stress inside the yield surface untouched",
     CHECK(solution.stress == inside);
   }
 }
+
+TEST_CASE("A non-finite material state throws instead of propagating NaN", "[material]") {
+  const J2Plasticity law({youngs_modulus, poisson_ratio, yield_stress, 1e9});
+  J2Plasticity::State state = law.initial_state();
+  state.stress.x() = std::nan("");
+  CHECK_THROWS_WITH(law.update(state, StrainVoigt(1e-5, 0, 0)), Catch::Contains("non-finite"));
+  state = law.initial_state();
+  state.sigma_y = std::nan("");
+  CHECK_THROWS_AS(law.update(state, StrainVoigt(1e-5, 0, 0)), Error);
+  const LemaitreDamage damage({youngs_modulus, poisson_ratio, yield_stress, 1e9, 0.0, 0.3, 0.5});
+  LemaitreDamage::State damaged = damage.initial_state();
+  damaged.D = std::nan("");
+  CHECK_THROWS_AS(damage.update(damaged, StrainVoigt(1e-5, 0, 0)), Error);
+}

@@ -85,6 +85,16 @@ namespace detail {
   throw Error(message.str());
 }
 
+// Reached only from the plastic branch: a NaN state fails the elastic test and lands here.
+[[noreturn]] [[gnu::noinline, gnu::cold]] inline void throw_non_finite_trial(
+    const StressVoigt& trial, double yield_stress) {
+  std::ostringstream message;
+  message.precision(17);
+  message << "sphshell: non-finite material state in the return map (trial stress = (" << trial.x()
+          << ", " << trial.y() << ", " << trial.z() << "), yield stress = " << yield_stress << ")";
+  throw Error(message.str());
+}
+
 // A kernel evaluates the return at a trial Δε̄p and caches what the next calls need:
 //   void evaluate(double increment);
 //   double relative_yield_residual() const;  g/σs² = (σ̄/σs)² − 1 at the last evaluation
@@ -309,7 +319,10 @@ inline Solution closed_form(const ClosedFormConstants& constants, const StressVo
   const double excess = kernel.trial_equivalent() - yield_stress;
   // A trial stress on or inside the surface (callers check first; this catches round-off) needs no
   // return.
-  if (!(excess > 0.0)) return Solution{trial, 0.0, 0};
+  if (!(excess > 0.0)) {
+    if (!std::isfinite(excess)) detail::throw_non_finite_trial(trial, yield_stress);
+    return Solution{trial, 0.0, 0};
+  }
   double increment = 0.0;
   switch (options.initial_guess) {
     case InitialGuess::appendix_b: {
@@ -353,7 +366,10 @@ inline Solution generic(const PlaneStressElasticity& elasticity, const StressVoi
   detail::GenericKernel kernel(elasticity, trial, yield_stress, plastic_modulus,
                                options.newton_function);
   const double excess = kernel.trial_equivalent() - yield_stress;
-  if (!(excess > 0.0)) return Solution{trial, 0.0, 0};
+  if (!(excess > 0.0)) {
+    if (!std::isfinite(excess)) detail::throw_non_finite_trial(trial, yield_stress);
+    return Solution{trial, 0.0, 0};
+  }
   double increment = 0.0;
   switch (options.initial_guess) {
     case InitialGuess::appendix_b:
