@@ -78,8 +78,11 @@ struct LemaitreDamage {
 
   // Y(T) = ⅔(1+ν) + 3(1−2ν)T², the triaxiality function of eq. (2.40)–(2.41).
   double triaxiality_function(double triaxiality) const {
+    return triaxiality_function_of_square(triaxiality * triaxiality);
+  }
+  double triaxiality_function_of_square(double triaxiality_squared) const {
     const double nu = parameters_.nu;
-    return 2.0 / 3.0 * (1.0 + nu) + 3.0 * (1.0 - 2.0 * nu) * triaxiality * triaxiality;
+    return 2.0 / 3.0 * (1.0 + nu) + 3.0 * (1.0 - 2.0 * nu) * triaxiality_squared;
   }
 
   UpdateResult update(State& state, const StrainVoigt& d_eps) const {
@@ -105,14 +108,16 @@ struct LemaitreDamage {
     const double increment = solution.plastic_strain_increment;
     const double eps_p_new = state.eps_p + increment;
 
-    // σ̄ of the returned effective stress is σs > 0, so T is well defined.
+    // σ̄ of the returned effective stress is σs > 0, so T is well defined; only T² enters.
     const double hydrostatic = (solution.stress.x() + solution.stress.y()) / 3.0;
-    const double triaxiality = hydrostatic / std::sqrt(von_mises_squared(solution.stress));
-    const double weight = triaxiality_function(triaxiality);
-    const double threshold = parameters_.eps_s / weight;  // eq. (2.40) at equality
-    const double damaging_strain = eps_p_new - std::max(state.eps_p, threshold);
-    const double damage_new = damaging_strain > 0.0
-                                  ? state.D + damage_rate_ * weight * damaging_strain  // eq. (2.41)
+    const double weight = triaxiality_function_of_square(hydrostatic * hydrostatic /
+                                                         von_mises_squared(solution.stress));
+    // Y·(ε̄p,n+1 − max(ε̄p,n, ε̄sp/Y)) without dividing by Y: the part of the step above the
+    // threshold Y ε̄p = ε̄sp of eq. (2.40), weighted as in eq. (2.41).
+    const double weighted_damaging_strain =
+        weight * eps_p_new - std::max(weight * state.eps_p, parameters_.eps_s);
+    const double damage_new = weighted_damaging_strain > 0.0
+                                  ? state.D + damage_rate_ * weighted_damaging_strain  // eq. (2.41)
                                   : state.D;
 
     state.eps_p = eps_p_new;
