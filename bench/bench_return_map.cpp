@@ -1,0 +1,265 @@
+// Cost of the integral-point stress update along a strain stream that keeps
+// yielding, like the 500 steps of the paper's Table 1.
+//
+// The stream: a state preloaded to 1.2× the uniaxial yield strain, then 500
+// increments whose direction swings between tension (1, −½, 0) and shear
+// (0, 0, √3) twice, with magnitudes 2.5–7.5e-6 — the size of one explicit time
+// step in the paper's plate problems (σ* exceeds σs by ~0.5 %). A coarse
+// variant (6× larger increments) is reported too. Each benchmark cycles
+// through the stream and resets the state at every pass.
+
+#include <sphshell/material/all.hpp>
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+using namespace sphshell;
+using namespace sphshell::material;
+
+namespace {
+
+constexpr double youngs_modulus = 210e9;
+constexpr double poisson_ratio = 0.3;
+constexpr double yield_stress = 235e6;
+constexpr double plastic_modulus = 1e9;
+constexpr int stream_length = 500;
+constexpr double pi = 3.14159265358979323846;
+
+const J2Plasticity j2_law({youngs_modulus, poisson_ratio, yield_stress, plastic_modulus});
+const Elastic elastic_law({youngs_modulus, poisson_ratio});
+// ε̄sp = 0: damage grows from the first plastic step; ε̄cp large so no point fails in the stream.
+const LemaitreDamage damage_law({youngs_modulus, poisson_ratio, yield_stress, plastic_modulus, 0.0,
+                                 0.5, 0.9});
+
+std::vector<StrainVoigt> tension_shear_stream(double magnitude) {
+  std::vector<StrainVoigt> stream;
+  stream.reserve(stream_length);
+  for (int k = 0; k < stream_length; ++k) {
+    const double angle = 0.25 * pi * (1.0 - std::cos(4.0 * pi * k / stream_length));
+    const double size = magnitude * (1.0 + 0.5 * std::sin(6.0 * pi * k / stream_length));
+    stream.emplace_back(size * std::cos(angle), -0.5 * size * std::cos(angle),
+                        std::sqrt(3.0) * size * std::sin(angle));
+  }
+  return stream;
+}
+
+template <class Law>
+typename Law::State preloaded(const Law& law, const StrainVoigt& total_strain) {
+  typename Law::State state = law.initial_state();
+  for (int step = 0; step < 100; ++step) law.update(state, total_strain / 100.0);
+  return state;
+}
+
+const StrainVoigt preload_strain =
+    1.2 * yield_stress / youngs_modulus * StrainVoigt(1.0, -0.5, 0.0);
+const std::vector<StrainVoigt> stream = tension_shear_stream(5e-6);
+const std::vector<StrainVoigt> coarse_stream = tension_shear_stream(3e-5);
+
+template <class Law>
+void run_stream(benchmark::State& benchmark_state, const Law& law, const typename Law::State& start,
+                const std::vector<StrainVoigt>& increments, const ReturnMapOptions& options) {
+  typename Law::State state = start;
+  std::size_t index = 0;
+  for (auto _ : benchmark_state) {
+    auto result = law.update(state, increments[index], options);
+    benchmark::DoNotOptimize(result);
+    benchmark::DoNotOptimize(state);
+    if (++index == increments.size()) {
+      index = 0;
+      state = start;
+    }
+  }
+  benchmark_state.SetItemsProcessed(benchmark_state.iterations());
+}
+
+ReturnMapOptions options_with(ReturnMapForm form, InitialGuess guess,
+                              NewtonFunction function = NewtonFunction::normalized,
+                              int fixed_iterations = 0) {
+  ReturnMapOptions options;
+  options.form = form;
+  options.initial_guess = guess;
+  options.newton_function = function;
+  options.fixed_iterations = fixed_iterations;
+  return options;
+}
+
+void BM_elastic_update(benchmark::State& state) {
+  run_stream(state, elastic_law, preloaded(elastic_law, preload_strain), stream, {});
+}
+void BM_j2_closed_appendix_b(benchmark::State& state) {
+  run_stream(state, j2_law, preloaded(j2_law, preload_strain), stream, {});
+}
+void BM_j2_closed_zero_start(benchmark::State& state) {
+  run_stream(state, j2_law, preloaded(j2_law, preload_strain), stream,
+             options_with(ReturnMapForm::closed_form, InitialGuess::zero));
+}
+void BM_j2_closed_radial_start(benchmark::State& state) {
+  run_stream(state, j2_law, preloaded(j2_law, preload_strain), stream,
+             options_with(ReturnMapForm::closed_form, InitialGuess::radial_return));
+}
+void BM_j2_closed_squared_g(benchmark::State& state) {
+  run_stream(
+      state, j2_law, preloaded(j2_law, preload_strain), stream,
+      options_with(ReturnMapForm::closed_form, InitialGuess::appendix_b, NewtonFunction::squared));
+}
+void BM_j2_closed_fixed_3(benchmark::State& state) {
+  run_stream(state, j2_law, preloaded(j2_law, preload_strain), stream,
+             options_with(ReturnMapForm::closed_form, InitialGuess::appendix_b,
+                          NewtonFunction::normalized, 3));
+}
+void BM_j2_generic_appendix_b(benchmark::State& state) {
+  run_stream(state, j2_law, preloaded(j2_law, preload_strain), stream,
+             options_with(ReturnMapForm::generic, InitialGuess::appendix_b));
+}
+void BM_j2_closed_coarse_stream(benchmark::State& state) {
+  run_stream(state, j2_law, preloaded(j2_law, preload_strain), coarse_stream, {});
+}
+void BM_damage_closed(benchmark::State& state) {
+  run_stream(state, damage_law, preloaded(damage_law, preload_strain), stream, {});
+}
+
+// One stress point: 5 integral points through the thickness (Gauss–Legendre
+// positions), strains ε + ζκ with a membrane stream and a bending stream.
+void BM_stress_point_5_integral_points(benchmark::State& benchmark_state) {
+  constexpr int points = 5;
+  constexpr double thickness = 0.01;
+  const std::array<double, points> zeta = {
+      -0.9061798459386640 * thickness / 2, -0.5384693101056831 * thickness / 2, 0.0,
+      0.5384693101056831 * thickness / 2, 0.9061798459386640 * thickness / 2};
+  std::vector<StrainVoigt> curvature_stream(stream.size());
+  for (std::size_t k = 0; k < stream.size(); ++k)
+    curvature_stream[k] = stream[(k + stream.size() / 2) % stream.size()] / (thickness / 2);
+  std::array<J2Plasticity::State, points> start;
+  for (int p = 0; p < points; ++p)
+    start[p] = preloaded(j2_law, preload_strain * (1.0 + 0.3 * zeta[p] / thickness));
+  std::array<J2Plasticity::State, points> states = start;
+  std::size_t index = 0;
+  for (auto _ : benchmark_state) {
+    for (int p = 0; p < points; ++p) {
+      auto result = j2_law.update(states[p], stream[index] + zeta[p] * curvature_stream[index]);
+      benchmark::DoNotOptimize(result);
+    }
+    benchmark::DoNotOptimize(states);
+    if (++index == stream.size()) {
+      index = 0;
+      states = start;
+    }
+  }
+  benchmark_state.SetItemsProcessed(benchmark_state.iterations() * points);
+}
+
+BENCHMARK(BM_elastic_update);
+BENCHMARK(BM_j2_closed_appendix_b);
+BENCHMARK(BM_j2_closed_zero_start);
+BENCHMARK(BM_j2_closed_radial_start);
+BENCHMARK(BM_j2_closed_squared_g);
+BENCHMARK(BM_j2_closed_fixed_3);
+BENCHMARK(BM_j2_generic_appendix_b);
+BENCHMARK(BM_j2_closed_coarse_stream);
+BENCHMARK(BM_damage_closed);
+BENCHMARK(BM_stress_point_5_integral_points);
+
+void print_histogram(const char* label, const std::vector<StrainVoigt>& increments,
+                     const ReturnMapOptions& options) {
+  std::array<int, 5> counts{};  // 0, 1, 2, 3, > 3 corrections
+  int plastic = 0;
+  J2Plasticity::State state = preloaded(j2_law, preload_strain);
+  for (const StrainVoigt& d_eps : increments) {
+    const auto result = j2_law.update(state, d_eps, options);
+    if (!result.plastic) continue;
+    ++plastic;
+    ++counts[static_cast<std::size_t>(std::min(result.iterations, 4))];
+  }
+  std::printf("  %-40s %5d %5d %5d %5d %5d   of %d plastic (%.1f %% in <= 1)\n", label, counts[0],
+              counts[1], counts[2], counts[3], counts[4], plastic,
+              100.0 * (counts[0] + counts[1]) / std::max(plastic, 1));
+}
+
+// Error of a return against a round-off reference (12 plain Newton steps),
+// every step started from the same state on the converged path.
+void print_return_error(const char* label, const std::vector<StrainVoigt>& increments,
+                        const ReturnMapOptions& options) {
+  const ReturnMapOptions reference_options = options_with(
+      ReturnMapForm::closed_form, InitialGuess::appendix_b, NewtonFunction::normalized, 12);
+  J2Plasticity::State state = preloaded(j2_law, preload_strain);
+  double worst_strain = 0.0, worst_stress = 0.0, sum_strain = 0.0;
+  int plastic = 0;
+  for (const StrainVoigt& d_eps : increments) {
+    J2Plasticity::State candidate = state;
+    const J2Plasticity::State before = state;
+    const auto result = j2_law.update(state, d_eps, reference_options);
+    j2_law.update(candidate, d_eps, options);
+    if (!result.plastic) continue;
+    ++plastic;
+    const double increment = state.eps_p - before.eps_p;
+    const double strain_error = std::abs(candidate.eps_p - state.eps_p) / increment;
+    worst_strain = std::max(worst_strain, strain_error);
+    sum_strain += strain_error;
+    worst_stress = std::max(worst_stress, (candidate.stress - state.stress).norm() / state.sigma_y);
+  }
+  std::printf("  %-44s max %.2e  mean %.2e  max |d sigma|/sigma_s %.2e\n", label, worst_strain,
+              sum_strain / std::max(plastic, 1), worst_stress);
+}
+
+void print_stream_report() {
+  std::printf(
+      "Newton corrections per plastic step (columns: 0 1 2 3 >3), tolerance |g| <= 1e-12 "
+      "sigma_s^2\n");
+  std::printf(" stream (increments 2.5-7.5e-6):\n");
+  print_histogram("Appendix B start, phi = 1 - sigma_s/sigma", stream, {});
+  print_histogram("zero start, phi", stream,
+                  options_with(ReturnMapForm::closed_form, InitialGuess::zero));
+  print_histogram("radial-return start, phi", stream,
+                  options_with(ReturnMapForm::closed_form, InitialGuess::radial_return));
+  print_histogram(
+      "Appendix B start, squared g (eq. 2.36)", stream,
+      options_with(ReturnMapForm::closed_form, InitialGuess::appendix_b, NewtonFunction::squared));
+  print_histogram(
+      "zero start, squared g", stream,
+      options_with(ReturnMapForm::closed_form, InitialGuess::zero, NewtonFunction::squared));
+  print_histogram("radial-return start, squared g", stream,
+                  options_with(ReturnMapForm::closed_form, InitialGuess::radial_return,
+                               NewtonFunction::squared));
+  print_histogram("generic 3x3, Appendix B start, phi", stream,
+                  options_with(ReturnMapForm::generic, InitialGuess::appendix_b));
+  std::printf(" coarse stream (increments 1.5-4.5e-5):\n");
+  print_histogram("Appendix B start, phi", coarse_stream, {});
+  print_histogram("zero start, phi", coarse_stream,
+                  options_with(ReturnMapForm::closed_form, InitialGuess::zero));
+  print_histogram("radial-return start, phi", coarse_stream,
+                  options_with(ReturnMapForm::closed_form, InitialGuess::radial_return));
+  print_histogram(
+      "Appendix B start, squared g", coarse_stream,
+      options_with(ReturnMapForm::closed_form, InitialGuess::appendix_b, NewtonFunction::squared));
+  std::printf("Relative error of d(eps_p) against a round-off reference:\n");
+  for (const auto* increments : {&stream, &coarse_stream}) {
+    std::printf(" %s:\n", increments == &stream ? "stream" : "coarse stream");
+    print_return_error("converged (default: Appendix B, phi)", *increments, {});
+    print_return_error("fixed 3 steps, Appendix B start, phi", *increments,
+                       options_with(ReturnMapForm::closed_form, InitialGuess::appendix_b,
+                                    NewtonFunction::normalized, 3));
+    print_return_error(
+        "fixed 3 steps, zero start, squared g", *increments,
+        options_with(ReturnMapForm::closed_form, InitialGuess::zero, NewtonFunction::squared, 3));
+    print_return_error("fixed 1 step, Appendix B start, phi", *increments,
+                       options_with(ReturnMapForm::closed_form, InitialGuess::appendix_b,
+                                    NewtonFunction::normalized, 1));
+  }
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  print_stream_report();
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,0 +1,8 @@
+#pragma once
+// Every material law and the family contract.
+
+#include <sphshell/material/elastic.hpp>
+#include <sphshell/material/j2_plasticity.hpp>
+#include <sphshell/material/lemaitre_damage.hpp>
+#include <sphshell/material/material.hpp>
+#include <sphshell/material/return_map.hpp>

@@ -1,0 +1,198 @@
+#pragma once
+// The material family contract. A material law `Law` provides:
+//   types      Law::Parameters, Law::State,
+//              Law::UpdateResult { bool plastic; int iterations; }
+//   construct  Law(const Law::Parameters&)   — validates, throws sphshell::Error
+//   flags      static constexpr bool has_plasticity, has_damage;
+//              static constexpr const char* name
+//   members    State initial_state() const;
+//              UpdateResult update(State&, const StrainVoigt& d_eps) const;
+//              const Parameters& parameters() const;
+//              double youngs_modulus() const; double poisson_ratio() const;
+//              Matrix3 elasticity_matrix() const;             (plane-stress Γ, eq. 2.24)
+//              double equivalent_stress(const State&) const;   (σ̄ = √(σᵀΞσ))
+//              double equivalent_plastic_strain(const State&) const;
+//              double damage(const State&) const;
+//              bool failed(const State&) const;
+//              double elastic_energy_density(const State&) const;
+// is_material_law<Law> checks all of it; each has_* trait checks one member, and
+// check_material_law<Law>() static_asserts them one by one so a compile error
+// names the missing member.
+
+#include <sphshell/core/types.hpp>
+
+#include <type_traits>
+#include <utility>
+
+namespace sphshell::material {
+
+namespace detail {
+
+template <class...>
+using void_t = void;
+
+template <class Default, class AlwaysVoid, template <class...> class Op, class... Args>
+struct detector : std::false_type {};
+template <template <class...> class Op, class... Args>
+struct detector<void, void_t<Op<Args...>>, Op, Args...> : std::true_type {};
+
+template <template <class...> class Op, class... Args>
+using is_detected = detector<void, void, Op, Args...>;
+
+template <class Law>
+using parameters_type_t = typename Law::Parameters;
+template <class Law>
+using state_type_t = typename Law::State;
+template <class Law>
+using update_result_t = typename Law::UpdateResult;
+template <class Law>
+using update_result_fields_t = decltype(std::declval<typename Law::UpdateResult&>().plastic = true,
+                                        std::declval<typename Law::UpdateResult&>().iterations = 1);
+template <class Law>
+using parameter_constructor_t = decltype(Law(std::declval<const typename Law::Parameters&>()));
+template <class Law>
+using initial_state_t = decltype(std::declval<const Law&>().initial_state());
+template <class Law>
+using update_t = decltype(std::declval<const Law&>().update(std::declval<typename Law::State&>(),
+                                                            std::declval<const StrainVoigt&>()));
+template <class Law>
+using parameters_accessor_t = decltype(std::declval<const Law&>().parameters());
+template <class Law>
+using youngs_modulus_t = decltype(std::declval<const Law&>().youngs_modulus());
+template <class Law>
+using poisson_ratio_t = decltype(std::declval<const Law&>().poisson_ratio());
+template <class Law>
+using elasticity_matrix_t = decltype(std::declval<const Law&>().elasticity_matrix());
+template <class Law>
+using has_plasticity_t = decltype(std::bool_constant<Law::has_plasticity>{});
+template <class Law>
+using has_damage_t = decltype(std::bool_constant<Law::has_damage>{});
+template <class Law>
+using name_t = decltype(static_cast<const char*>(Law::name));
+template <class Law>
+using equivalent_stress_t = decltype(std::declval<const Law&>().equivalent_stress(
+    std::declval<const typename Law::State&>()));
+template <class Law>
+using equivalent_plastic_strain_t = decltype(std::declval<const Law&>().equivalent_plastic_strain(
+    std::declval<const typename Law::State&>()));
+template <class Law>
+using damage_t =
+    decltype(std::declval<const Law&>().damage(std::declval<const typename Law::State&>()));
+template <class Law>
+using failed_t =
+    decltype(std::declval<const Law&>().failed(std::declval<const typename Law::State&>()));
+template <class Law>
+using elastic_energy_density_t = decltype(std::declval<const Law&>().elastic_energy_density(
+    std::declval<const typename Law::State&>()));
+
+// Detected and convertible to Expected.
+template <class Expected, template <class...> class Op, class Law, class = void>
+struct yields : std::false_type {};
+template <class Expected, template <class...> class Op, class Law>
+struct yields<Expected, Op, Law, std::enable_if_t<is_detected<Op, Law>::value>>
+    : std::is_convertible<Op<Law>, Expected> {};
+
+template <class Law, class = void>
+struct initial_state_returns_state : std::false_type {};
+template <class Law>
+struct initial_state_returns_state<Law, void_t<state_type_t<Law>, initial_state_t<Law>>>
+    : std::is_convertible<initial_state_t<Law>, typename Law::State> {};
+
+template <class Law, class = void>
+struct update_returns_result : std::false_type {};
+template <class Law>
+struct update_returns_result<Law, void_t<update_result_t<Law>, update_t<Law>>>
+    : std::is_convertible<update_t<Law>, typename Law::UpdateResult> {};
+
+}  // namespace detail
+
+template <class Law>
+struct has_parameters_type : detail::is_detected<detail::parameters_type_t, Law> {};
+template <class Law>
+struct has_state_type : detail::is_detected<detail::state_type_t, Law> {};
+template <class Law>
+struct has_update_result_type : detail::is_detected<detail::update_result_fields_t, Law> {};
+template <class Law>
+struct has_parameter_constructor : detail::is_detected<detail::parameter_constructor_t, Law> {};
+template <class Law>
+struct has_initial_state : detail::initial_state_returns_state<Law> {};
+template <class Law>
+struct has_update : detail::update_returns_result<Law> {};
+template <class Law>
+struct has_parameters_accessor : detail::is_detected<detail::parameters_accessor_t, Law> {};
+template <class Law>
+struct has_youngs_modulus : detail::yields<double, detail::youngs_modulus_t, Law> {};
+template <class Law>
+struct has_poisson_ratio : detail::yields<double, detail::poisson_ratio_t, Law> {};
+template <class Law>
+struct has_elasticity_matrix : detail::yields<Matrix3, detail::elasticity_matrix_t, Law> {};
+template <class Law>
+struct has_plasticity_flag : detail::is_detected<detail::has_plasticity_t, Law> {};
+template <class Law>
+struct has_damage_flag : detail::is_detected<detail::has_damage_t, Law> {};
+template <class Law>
+struct has_name : detail::is_detected<detail::name_t, Law> {};
+template <class Law>
+struct has_equivalent_stress : detail::yields<double, detail::equivalent_stress_t, Law> {};
+template <class Law>
+struct has_equivalent_plastic_strain
+    : detail::yields<double, detail::equivalent_plastic_strain_t, Law> {};
+template <class Law>
+struct has_damage_accessor : detail::yields<double, detail::damage_t, Law> {};
+template <class Law>
+struct has_failed : detail::yields<bool, detail::failed_t, Law> {};
+template <class Law>
+struct has_elastic_energy_density : detail::yields<double, detail::elastic_energy_density_t, Law> {
+};
+
+template <class Law>
+struct is_material_law
+    : std::conjunction<has_parameters_type<Law>, has_state_type<Law>, has_update_result_type<Law>,
+                       has_parameter_constructor<Law>, has_initial_state<Law>, has_update<Law>,
+                       has_parameters_accessor<Law>, has_youngs_modulus<Law>,
+                       has_poisson_ratio<Law>, has_elasticity_matrix<Law>, has_plasticity_flag<Law>,
+                       has_damage_flag<Law>, has_name<Law>, has_equivalent_stress<Law>,
+                       has_equivalent_plastic_strain<Law>, has_damage_accessor<Law>,
+                       has_failed<Law>, has_elastic_energy_density<Law>> {};
+
+template <class Law>
+inline constexpr bool is_material_law_v = is_material_law<Law>::value;
+
+// static_assert(check_material_law<Law>()) reports the first missing member by name.
+template <class Law>
+constexpr bool check_material_law() {
+  static_assert(has_parameters_type<Law>::value, "material law: missing nested type Parameters");
+  static_assert(has_state_type<Law>::value, "material law: missing nested type State");
+  static_assert(has_update_result_type<Law>::value,
+                "material law: missing UpdateResult { bool plastic; int iterations; }");
+  static_assert(has_parameter_constructor<Law>::value,
+                "material law: missing constructor Law(const Parameters&)");
+  static_assert(has_initial_state<Law>::value, "material law: missing State initial_state() const");
+  static_assert(has_update<Law>::value,
+                "material law: missing UpdateResult update(State&, const StrainVoigt&) const");
+  static_assert(has_parameters_accessor<Law>::value,
+                "material law: missing const Parameters& parameters() const");
+  static_assert(has_youngs_modulus<Law>::value,
+                "material law: missing double youngs_modulus() const");
+  static_assert(has_poisson_ratio<Law>::value,
+                "material law: missing double poisson_ratio() const");
+  static_assert(has_elasticity_matrix<Law>::value,
+                "material law: missing Matrix3 elasticity_matrix() const");
+  static_assert(has_plasticity_flag<Law>::value,
+                "material law: missing static constexpr bool has_plasticity");
+  static_assert(has_damage_flag<Law>::value,
+                "material law: missing static constexpr bool has_damage");
+  static_assert(has_name<Law>::value, "material law: missing static constexpr const char* name");
+  static_assert(has_equivalent_stress<Law>::value,
+                "material law: missing double equivalent_stress(const State&) const");
+  static_assert(has_equivalent_plastic_strain<Law>::value,
+                "material law: missing double equivalent_plastic_strain(const State&) const");
+  static_assert(has_damage_accessor<Law>::value,
+                "material law: missing double damage(const State&) const");
+  static_assert(has_failed<Law>::value, "material law: missing bool failed(const State&) const");
+  static_assert(has_elastic_energy_density<Law>::value,
+                "material law: missing double elastic_energy_density(const State&) const");
+  return is_material_law<Law>::value;
+}
+
+}  // namespace sphshell::material
