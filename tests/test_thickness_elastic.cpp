@@ -3,7 +3,7 @@
 
 #include <sphshell/thickness/all.hpp>
 
-#include "support/stand_in_materials.hpp"
+#include <sphshell/material/all.hpp>
 
 #include <catch2/catch.hpp>
 
@@ -12,7 +12,7 @@
 #include <string>
 
 // After the merge: namespace law = sphshell::material;
-namespace law = sphshell::test_support;
+namespace law = sphshell::material;
 
 using namespace sphshell::thickness;
 using sphshell::StrainVoigt;

@@ -19,6 +19,9 @@
 #include <sphshell/core/types.hpp>
 #include <sphshell/crack/crack.hpp>
 #include <sphshell/crack/none.hpp>
+#include <sphshell/io/csv_probe.hpp>
+#include <sphshell/io/pvd_collection.hpp>
+#include <sphshell/io/vtu_writer.hpp>
 #include <sphshell/material/material.hpp>
 #include <sphshell/shell/constraints.hpp>
 #include <sphshell/shell/kinematics.hpp>
@@ -29,6 +32,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -68,6 +72,15 @@ struct SolverOptions {
   // A run stops with an error when |energy balance| exceeds this fraction of
   // the largest energy in play (after the first steps).
   double energy_tolerance = 0.5;
+  // ParaView output: every output_interval seconds of simulated time, one .vtu
+  // of the particles and one of the stress points, gathered in particles.pvd and
+  // stress_points.pvd inside output_directory (created if missing). An empty
+  // directory writes nothing.
+  std::string output_directory;
+  double output_interval = 0.0;
+  // Probes (add_particle_probe, add_stress_point_probe) write a CSV row every
+  // probe_interval seconds (0: every step).
+  double probe_interval = 0.0;
 };
 
 struct EnergyReport {
@@ -184,6 +197,61 @@ class Solver {
                                                                               std::move(time)));
   }
 
+  // CSV time history of one particle: t, displacement, velocity, rotation.
+  void add_particle_probe(const std::string& csv_path, int particle) {
+    checked({particle});
+    probes_.push_back({io::CsvProbe(csv_path, {"t [s]", "ux [m]", "uy [m]", "uz [m]", "vx [m/s]",
+                                               "vy [m/s]", "vz [m/s]", "rx [rad]", "ry [rad]", "rz [rad]"}),
+                       particle, false});
+    write_probe(probes_.back());
+  }
+  // CSV time history of one stress point: t, then the equivalent stress,
+  // equivalent plastic strain and damage at each thickness output point
+  // (integral points in the rule's order, ζ ascending).
+  void add_stress_point_probe(const std::string& csv_path, int stress_point) {
+    if (stress_point < 0 || static_cast<std::size_t>(stress_point) >= model_.stress_point_count())
+      detail::invalid_parameter("stress point index", stress_point, "out of range");
+    std::vector<std::string> columns{"t [s]"};
+    for (int k = 1; k <= output_points; ++k) columns.push_back("equivalent_stress_" + std::to_string(k) + " [Pa]");
+    for (int k = 1; k <= output_points; ++k) columns.push_back("equivalent_plastic_strain_" + std::to_string(k));
+    for (int k = 1; k <= output_points; ++k) columns.push_back("damage_" + std::to_string(k));
+    probes_.push_back({io::CsvProbe(csv_path, std::move(columns)), stress_point, true});
+    write_probe(probes_.back());
+  }
+
+  // Writes one ParaView frame now (particles and stress points), whatever the
+  // output interval; requires output_directory.
+  void write_frame() {
+    if (options_.output_directory.empty())
+      detail::invalid_parameter("output_directory", "(empty)", "set it to write ParaView frames");
+    if (!particle_collection_) {
+      std::filesystem::create_directories(options_.output_directory);
+      particle_collection_ = std::make_unique<io::PvdCollection>(options_.output_directory + "/particles.pvd");
+      stress_point_collection_ =
+          std::make_unique<io::PvdCollection>(options_.output_directory + "/stress_points.pvd");
+    }
+    std::ostringstream suffix;
+    suffix.width(6);
+    suffix.fill('0');
+    suffix << frames_written_++;
+    const std::string particle_file = options_.output_directory + "/particles_" + suffix.str() + ".vtu";
+    const std::string stress_file = options_.output_directory + "/stress_points_" + suffix.str() + ".vtu";
+    io::write_vtu_points(particle_file, position_, particle_fields());
+    particle_collection_->add(time_, particle_file);
+    io::write_vtu_points(stress_file, stress_point_positions(), stress_point_fields());
+    stress_point_collection_->add(time_, stress_file);
+  }
+
+  // Current stress point positions, interpolated from the particles.
+  std::vector<Vector3> stress_point_positions() const {
+    std::vector<Vector3> positions(model_.stress_point_count(), Vector3::Zero());
+    const approx::ShapeFunctions& shape = shape_[0];
+    for (std::size_t row = 0; row < positions.size(); ++row)
+      for (std::size_t s = shape.row_begin[row]; s < shape.row_begin[row] + shape.row_size[row]; ++s)
+        positions[row] += shape.phi[s] * position_[shape.neighbour[s]];
+    return positions;
+  }
+
   // One explicit step of size time_step().
   void step() {
     if (!forces_current_) compute_internal_forces();
@@ -197,6 +265,7 @@ class Solver {
     compute_internal_forces();
     check_stability();
     if (options_.progress_interval > 0 && steps_ % options_.progress_interval == 0) print_progress();
+    write_scheduled_output();
   }
 
   // Steps until time t_end, calling observer(*this) after every step.
@@ -600,11 +669,106 @@ class Solver {
     return 2.0 / std::sqrt(std::max(membrane, rotation));
   }
 
+  void write_scheduled_output() {
+    const double tolerance = 1e-9 * time_step_;
+    if (!options_.output_directory.empty() && options_.output_interval > 0.0) {
+      if (frames_written_ == 0) write_frame_at_start();
+      if (time_ >= next_frame_time_ - tolerance) {
+        write_frame();
+        next_frame_time_ += options_.output_interval * std::max(1.0, std::floor((time_ - next_frame_time_) / options_.output_interval + 1.0));
+      }
+    }
+    if (!probes_.empty() && time_ >= next_probe_time_ - tolerance) {
+      for (Probe& probe : probes_) write_probe(probe);
+      next_probe_time_ = time_ + options_.probe_interval;
+    }
+  }
+
+  // The first frame shows the reference configuration at t = 0.
+  void write_frame_at_start() {
+    const std::vector<Vector3> current = position_;
+    const double t = time_;
+    time_ = 0.0;
+    position_ = model_.particle_position;
+    write_frame();
+    position_ = current;
+    time_ = t;
+    next_frame_time_ = options_.output_interval;
+  }
+
+  struct Probe {
+    io::CsvProbe file;
+    int index;
+    bool stress_point;
+  };
+
+  void write_probe(Probe& probe) {
+    std::vector<double> row{time_};
+    if (!probe.stress_point) {
+      const Vector3 u = displacement(probe.index), v = velocity_[probe.index], r = rotation(probe.index);
+      row.insert(row.end(), {u.x(), u.y(), u.z(), v.x(), v.y(), v.z(), r.x(), r.y(), r.z()});
+    } else {
+      for (int k = 0; k < output_points; ++k) row.push_back(equivalent_stress(probe.index, k));
+      for (int k = 0; k < output_points; ++k) row.push_back(equivalent_plastic_strain(probe.index, k));
+      for (int k = 0; k < output_points; ++k) row.push_back(damage(probe.index, k));
+    }
+    probe.file.write_row(row);
+  }
+
+  static io::PointField vector_field(const std::string& name, const std::vector<Vector3>& values) {
+    io::PointField field{name, 3, {}};
+    field.values.reserve(3 * values.size());
+    for (const Vector3& v : values) field.values.insert(field.values.end(), {v.x(), v.y(), v.z()});
+    return field;
+  }
+
+  std::vector<io::PointField> particle_fields() const {
+    const std::size_t n = position_.size();
+    std::vector<Vector3> displacement_values(n), rotation_values(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      displacement_values[i] = displacement(static_cast<int>(i));
+      rotation_values[i] = rotation(static_cast<int>(i));
+    }
+    return {vector_field("displacement", displacement_values), vector_field("velocity", velocity_),
+            vector_field("rotation", rotation_values), vector_field("director", director_)};
+  }
+
+  // Per stress point: one array per quantity with a component per thickness
+  // output point (named ip1, ip2, … in ζ order).
+  std::vector<io::PointField> stress_point_fields() const {
+    const std::size_t m = model_.stress_point_count();
+    std::vector<std::string> names;
+    for (int k = 1; k <= output_points; ++k) names.push_back("ip" + std::to_string(k));
+    io::PointField stress{"equivalent_stress", output_points, {}, names};
+    io::PointField plastic{"equivalent_plastic_strain", output_points, {}, names};
+    io::PointField damage_field{"damage", output_points, {}, names};
+    io::PointField membrane{"membrane_force", 3, {}, {"Nxx", "Nyy", "Nxy"}};
+    io::PointField moment{"bending_moment", 3, {}, {"Mxx", "Myy", "Mxy"}};
+    for (std::size_t s = 0; s < m; ++s) {
+      const int sp = static_cast<int>(s);
+      for (int k = 0; k < output_points; ++k) {
+        stress.values.push_back(equivalent_stress(sp, k));
+        plastic.values.push_back(equivalent_plastic_strain(sp, k));
+        damage_field.values.push_back(damage(sp, k));
+      }
+      for (int c = 0; c < 3; ++c) {
+        membrane.values.push_back(membrane_[s][c]);
+        moment.values.push_back(moment_[s][c]);
+      }
+    }
+    std::vector<io::PointField> fields{stress, plastic};
+    if constexpr (Material::has_damage) fields.push_back(damage_field);
+    fields.push_back(membrane);
+    fields.push_back(moment);
+    return fields;
+  }
+
   void check_stability() {
     const std::size_t n = position_.size();
     for (std::size_t i = 0; i < n; ++i)
       if (!position_[i].allFinite() || !director_[i].allFinite() || !internal_force_[i].allFinite())
         fail_unstable("non-finite state at particle " + std::to_string(i));
+    if (steps_ % 16 != 0) return;  // the energy sums cost a pass over all states
     const EnergyReport e = energy();
     const double scale = std::max({std::abs(e.external_work), e.kinetic, std::abs(e.internal)});
     if (steps_ > 20 && scale > 0.0 && std::abs(e.balance()) > options_.energy_tolerance * scale) {
@@ -662,6 +826,12 @@ class Solver {
   std::vector<double> work_increment_;
   std::vector<Vector3> slot_force_, slot_director_force_;
   std::vector<std::size_t> particle_slot_begin_, particle_slots_;
+
+  std::vector<Probe> probes_;
+  std::unique_ptr<io::PvdCollection> particle_collection_, stress_point_collection_;
+  long frames_written_ = 0;
+  double next_frame_time_ = 0.0;
+  double next_probe_time_ = 0.0;
 
   detail::Constraints constraints_;
   std::vector<std::unique_ptr<detail::Load>> loads_;

@@ -1,6 +1,20 @@
 #pragma once
-// Umbrella header: everything a user needs to compose a Solver.
+// Umbrella header: every policy of every family, the shell model and the solver.
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
+
+#include <sphshell/approx/all.hpp>
+#include <sphshell/crack/crack.hpp>
+#include <sphshell/crack/none.hpp>
+#include <sphshell/kernel/all.hpp>
+#include <sphshell/material/all.hpp>
+#include <sphshell/thickness/all.hpp>
+
+#include <sphshell/io/csv_probe.hpp>
+#include <sphshell/io/pvd_collection.hpp>
+#include <sphshell/io/vtu_writer.hpp>
+
+#include <sphshell/shell/model.hpp>
+#include <sphshell/solver.hpp>

@@ -1,7 +1,7 @@
 // Must not compile: the rule has no reference_weights.
 #include <sphshell/thickness/section.hpp>
 
-#include "../support/stand_in_materials.hpp"
+#include <sphshell/material/elastic.hpp>
 
 #include <array>
 
@@ -12,8 +12,8 @@ struct RuleWithoutWeights {
 };
 
 int main() {
-  const sphshell::test_support::Elastic law({210e9, 0.3});
-  const sphshell::thickness::Section<RuleWithoutWeights, sphshell::test_support::Elastic> section(
+  const sphshell::material::Elastic law({210e9, 0.3});
+  const sphshell::thickness::Section<RuleWithoutWeights, sphshell::material::Elastic> section(
       law, 0.01);
   return section.output_points;
 }
