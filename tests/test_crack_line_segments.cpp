@@ -118,6 +118,13 @@ TEST_CASE("diagonal neighbours link, points two spacings apart do not", "[crack]
   CHECK(crack.segments().size() == 2);
   CHECK(crack.crack_count() == 1);
   CHECK(crack.total_length() == Approx(2.0 * std::sqrt(2.0) * spacing));
+  // Through the crack point shared by both segments: one of them cuts the pair
+  // whichever way the rounded coordinates put that point.
+  CHECK_FALSE(visible_on_plate(crack, node(3, 4), node(4, 3)));
+  // A diagonal segment runs through the grid node between its stress points;
+  // a particle on a crack's line is never cut off by it (design.md §2.6).
+  CHECK(visible_on_plate(crack, node(3, 3), node(4, 2)));
+  CHECK(visible_on_plate(crack, node(3, 3), node(2, 4)));
 
   LineSegments gapped = plate.crack();
   damage_one_by_one(gapped, {plate.stress_point(2, 2), plate.stress_point(4, 2)});
@@ -232,6 +239,10 @@ TEST_CASE("a straight crack cuts the pairs across it and nothing else", "[crack]
     CHECK(visible_on_plate(crack, node(2, 5), node(2, 6)));
     CHECK(visible_on_plate(crack, node(1, 5), node(2, 6)));
   }
+  SECTION("pairs longer than the support radius are judged too") {
+    CHECK_FALSE(visible_on_plate(crack, node(5, 2), node(5, 9)));
+    CHECK(visible_on_plate(crack, node(5, 0), node(5, 5)));
+  }
   SECTION("a pair through the tip point is cut (the crack end touches it)") {
     CHECK_FALSE(visible_on_plate(crack, node(8.5, 5), node(8.5, 6)));
   }
@@ -283,6 +294,12 @@ TEST_CASE("a pre-crack polyline cuts like a damage crack", "[crack][line_segment
   CHECK(created[0].start_point == 2);
   CHECK(crack.crack_count() == 1);
   CHECK(created[0].crack_id == crack.segments()[0].crack_id);
+
+  // Segments of mixed lengths: the index still finds every one in reach.
+  for (const Vector3& a : plate.particles)
+    for (const Vector3& b : plate.particles)
+      if ((a - b).norm() < support_radius)
+        CHECK(crack.visible(a, b, plate_frame) == visible_brute_force(crack, a, b, plate_frame));
 }
 
 TEST_CASE("affected points are exactly those within the support radius of the new segments", "[crack][line_segments]") {
