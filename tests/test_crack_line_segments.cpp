@@ -11,6 +11,8 @@ using namespace sphshell;
 using sphshell::crack::LineSegments;
 using sphshell::crack::Segment;
 
+static_assert(crack::is_crack_policy<LineSegments>::value && LineSegments::enabled);
+
 namespace {
 
 constexpr double spacing = 0.01;
@@ -62,7 +64,8 @@ bool visible_brute_force(const LineSegments& crack, const Vector3& a, const Vect
 }
 
 // Visibility of every particle pair closer than the support radius.
-std::vector<bool> visibility_table(const LineSegments& crack, const std::vector<Vector3>& particles) {
+std::vector<bool> visibility_table(const LineSegments& crack,
+                                   const std::vector<Vector3>& particles) {
   std::vector<bool> table;
   for (const Vector3& a : particles)
     for (const Vector3& b : particles)
@@ -76,7 +79,8 @@ void damage_one_by_one(LineSegments& crack, const std::vector<int>& stress_point
 
 }  // namespace
 
-TEST_CASE("a row of stress points damaged one by one forms one straight crack", "[crack][line_segments]") {
+TEST_CASE("a row of stress points damaged one by one forms one straight crack",
+          "[crack][line_segments]") {
   const Plate plate(12, 12);
   LineSegments crack = plate.crack();
   CHECK(crack.empty());
@@ -93,8 +97,10 @@ TEST_CASE("a row of stress points damaged one by one forms one straight crack", 
   for (int i = 3; i < 2 + n; ++i) {
     const auto created = crack.add_damaged_stress_points({plate.stress_point(i, 5)});
     REQUIRE(created.size() == 1);
-    CHECK(crack.points()[created[0].start_point].isApprox(plate.stress_points[plate.stress_point(i - 1, 5)]));
-    CHECK(crack.points()[created[0].end_point].isApprox(plate.stress_points[plate.stress_point(i, 5)]));
+    CHECK(crack.points()[created[0].start_point].isApprox(
+        plate.stress_points[plate.stress_point(i - 1, 5)]));
+    CHECK(crack.points()[created[0].end_point].isApprox(
+        plate.stress_points[plate.stress_point(i, 5)]));
   }
   CHECK(crack.segments().size() == std::size_t(n - 1));
   CHECK(crack.crack_count() == 1);
@@ -114,7 +120,8 @@ TEST_CASE("diagonal neighbours link, points two spacings apart do not", "[crack]
   LineSegments crack = plate.crack();
   CHECK(crack.linking_distance() > std::sqrt(2.0) * spacing);
   CHECK(crack.linking_distance() < 2.0 * spacing);
-  damage_one_by_one(crack, {plate.stress_point(2, 2), plate.stress_point(3, 3), plate.stress_point(4, 4)});
+  damage_one_by_one(crack,
+                    {plate.stress_point(2, 2), plate.stress_point(3, 3), plate.stress_point(4, 4)});
   CHECK(crack.segments().size() == 2);
   CHECK(crack.crack_count() == 1);
   CHECK(crack.total_length() == Approx(2.0 * std::sqrt(2.0) * spacing));
@@ -137,7 +144,8 @@ TEST_CASE("diagonal neighbours link, points two spacings apart do not", "[crack]
   CHECK(gapped.total_length() == Approx(2.0 * spacing));
 }
 
-TEST_CASE("far-apart damage forms two cracks, counted once each has a segment", "[crack][line_segments]") {
+TEST_CASE("far-apart damage forms two cracks, counted once each has a segment",
+          "[crack][line_segments]") {
   const Plate plate(16, 16);
   LineSegments crack = plate.crack();
   crack.add_damaged_stress_points({plate.stress_point(2, 2)});
@@ -160,8 +168,8 @@ TEST_CASE("far-apart damage forms two cracks, counted once each has a segment", 
 TEST_CASE("a stress point bridging two cracks merges them", "[crack][line_segments]") {
   const Plate plate(12, 12);
   LineSegments crack = plate.crack();
-  damage_one_by_one(crack, {plate.stress_point(2, 5), plate.stress_point(3, 5), plate.stress_point(5, 5),
-                            plate.stress_point(6, 5)});
+  damage_one_by_one(crack, {plate.stress_point(2, 5), plate.stress_point(3, 5),
+                            plate.stress_point(5, 5), plate.stress_point(6, 5)});
   CHECK(crack.crack_count() == 2);
   const auto created = crack.add_damaged_stress_points({plate.stress_point(4, 5)});
   // One segment to the nearest point of each crack.
@@ -215,7 +223,8 @@ TEST_CASE("a batch is processed in ascending index order", "[crack][line_segment
   CHECK(batch.damaged_count() == row.size());
 }
 
-TEST_CASE("a straight crack cuts the pairs across it and nothing else", "[crack][line_segments][visibility]") {
+TEST_CASE("a straight crack cuts the pairs across it and nothing else",
+          "[crack][line_segments][visibility]") {
   const Plate plate(12, 12);
   LineSegments crack = plate.crack();
   // Stress points (2..8, 5): the crack runs along y = 5.5 Δ from x = 2.5 Δ to 8.5 Δ.
@@ -259,7 +268,8 @@ TEST_CASE("a straight crack cuts the pairs across it and nothing else", "[crack]
   }
 }
 
-TEST_CASE("visibility does not depend on the order of damage insertion", "[crack][line_segments][visibility]") {
+TEST_CASE("visibility does not depend on the order of damage insertion",
+          "[crack][line_segments][visibility]") {
   const Plate plate(12, 12);
   std::vector<int> band;
   for (int i = 2; i <= 8; ++i) band.push_back(plate.stress_point(i, 5 + (i > 5)));
@@ -302,15 +312,18 @@ TEST_CASE("a pre-crack polyline cuts like a damage crack", "[crack][line_segment
         CHECK(crack.visible(a, b, plate_frame) == visible_brute_force(crack, a, b, plate_frame));
 }
 
-TEST_CASE("affected points are exactly those within the support radius of the new segments", "[crack][line_segments]") {
+TEST_CASE("affected points are exactly those within the support radius of the new segments",
+          "[crack][line_segments]") {
   const Plate plate(16, 16);
   LineSegments crack = plate.crack();
   for (int i = 2; i <= 5; ++i) crack.add_damaged_stress_points({plate.stress_point(i, 7)});
-  const auto created = crack.add_damaged_stress_points({plate.stress_point(6, 8), plate.stress_point(7, 8)});
+  const auto created =
+      crack.add_damaged_stress_points({plate.stress_point(6, 8), plate.stress_point(7, 8)});
   REQUIRE(created.size() == 2);
 
   std::vector<Vector3> eval_positions = plate.particles;
-  eval_positions.insert(eval_positions.end(), plate.stress_points.begin(), plate.stress_points.end());
+  eval_positions.insert(eval_positions.end(), plate.stress_points.begin(),
+                        plate.stress_points.end());
   const auto affected = crack.affected_points(eval_positions, created);
 
   std::vector<std::size_t> expected;
@@ -332,12 +345,14 @@ TEST_CASE("affected points are exactly those within the support radius of the ne
   for (std::size_t i = 0; i < eval_positions.size(); ++i)
     for (const Vector3& b : plate.particles) {
       if ((eval_positions[i] - b).norm() >= support_radius) continue;
-      if (crack.visible(eval_positions[i], b, plate_frame) != before.visible(eval_positions[i], b, plate_frame))
+      if (crack.visible(eval_positions[i], b, plate_frame) !=
+          before.visible(eval_positions[i], b, plate_frame))
         CHECK(std::binary_search(affected.begin(), affected.end(), i));
     }
 }
 
-TEST_CASE("an axial crack on a cylinder cuts circumferential pairs", "[crack][line_segments][visibility]") {
+TEST_CASE("an axial crack on a cylinder cuts circumferential pairs",
+          "[crack][line_segments][visibility]") {
   const double radius = 0.1;
   const int around = 126;
   const double angle_step = 2.0 * pi / around;
@@ -368,31 +383,36 @@ TEST_CASE("an axial crack on a cylinder cuts circumferential pairs", "[crack][li
   CHECK(crack.total_length() == Approx(9.0 * arc_spacing));
 
   auto visible = [&](double angle_a, double axial_a, double angle_b, double axial_b) {
-    return crack.visible(on_cylinder(angle_a, axial_a), on_cylinder(angle_b, axial_b), frame_at(angle_a));
+    return crack.visible(on_cylinder(angle_a, axial_a), on_cylinder(angle_b, axial_b),
+                         frame_at(angle_a));
   };
   CHECK_FALSE(visible(-0.5, 9.5, 0.5, 9.5));
   CHECK_FALSE(visible(0.5, 9.5, -0.5, 9.5));
   CHECK_FALSE(visible(-0.5, 6.5, 0.5, 7.5));
-  CHECK(visible(0.5, 9.5, 1.5, 9.5));      // one side
-  CHECK(visible(0.5, 8.5, 0.5, 9.5));      // axial pair beside the crack
-  CHECK(visible(-0.5, 16.5, 0.5, 16.5));   // beyond the tip
+  CHECK(visible(0.5, 9.5, 1.5, 9.5));     // one side
+  CHECK(visible(0.5, 8.5, 0.5, 9.5));     // axial pair beside the crack
+  CHECK(visible(-0.5, 16.5, 0.5, 16.5));  // beyond the tip
   // On the far side of the cylinder the crack projects straight onto the pair
   // in the tangent plane there, yet is out of reach.
   const double opposite = around / 2.0;
   CHECK(visible(opposite - 0.5, 9.5, opposite - 1.5, 9.5));
-  CHECK_FALSE(visible_brute_force(crack, on_cylinder(opposite - 0.5, 9.5), on_cylinder(opposite - 1.5, 9.5),
-                                  frame_at(opposite - 0.5)));
+  CHECK_FALSE(visible_brute_force(crack, on_cylinder(opposite - 0.5, 9.5),
+                                  on_cylinder(opposite - 1.5, 9.5), frame_at(opposite - 0.5)));
 }
 
-TEST_CASE("invalid crack input is rejected with a clear message", "[crack][line_segments][errors]") {
+TEST_CASE("invalid crack input is rejected with a clear message",
+          "[crack][line_segments][errors]") {
   const Plate plate(8, 8);
 
   SECTION("use before initialize") {
     LineSegments crack;
     CHECK_THROWS_WITH(crack.add_damaged_stress_points({0}), Catch::Contains("before initialize"));
-    CHECK_THROWS_WITH(crack.add_precrack({node(1, 1), node(2, 1)}), Catch::Contains("before initialize"));
-    CHECK_THROWS_WITH(crack.visible(node(1, 1), node(2, 1), plate_frame), Catch::Contains("before initialize"));
-    CHECK_THROWS_WITH(crack.affected_points(plate.particles, {}), Catch::Contains("before initialize"));
+    CHECK_THROWS_WITH(crack.add_precrack({node(1, 1), node(2, 1)}),
+                      Catch::Contains("before initialize"));
+    CHECK_THROWS_WITH(crack.visible(node(1, 1), node(2, 1), plate_frame),
+                      Catch::Contains("before initialize"));
+    CHECK_THROWS_WITH(crack.affected_points(plate.particles, {}),
+                      Catch::Contains("before initialize"));
     CHECK_THROWS_AS(crack.is_damaged(0), Error);
   }
   SECTION("bad reference geometry") {
@@ -406,15 +426,19 @@ TEST_CASE("invalid crack input is rejected with a clear message", "[crack][line_
   }
   LineSegments crack = plate.crack();
   SECTION("stress point index out of range") {
-    CHECK_THROWS_WITH(crack.add_damaged_stress_points({3, 64}), Catch::Contains("stress point index = 64"));
-    CHECK_THROWS_WITH(crack.add_damaged_stress_points({-1}), Catch::Contains("stress point index = -1"));
+    CHECK_THROWS_WITH(crack.add_damaged_stress_points({3, 64}),
+                      Catch::Contains("stress point index = 64"));
+    CHECK_THROWS_WITH(crack.add_damaged_stress_points({-1}),
+                      Catch::Contains("stress point index = -1"));
     CHECK(crack.damaged_count() == 0);  // nothing of a rejected batch is applied
     CHECK_THROWS_AS(crack.is_damaged(64), Error);
   }
   SECTION("pre-crack point off the shell") {
-    CHECK_THROWS_WITH(crack.add_precrack({node(1, 1), node(2, 1), node(2, 1) + Vector3(0, 0, 0.02)}),
-                      Catch::Contains("pre-crack point 2"));
-    CHECK_THROWS_WITH(crack.add_precrack({node(1, 1), node(20, 1)}), Catch::Contains("pre-crack point 1"));
+    CHECK_THROWS_WITH(
+        crack.add_precrack({node(1, 1), node(2, 1), node(2, 1) + Vector3(0, 0, 0.02)}),
+        Catch::Contains("pre-crack point 2"));
+    CHECK_THROWS_WITH(crack.add_precrack({node(1, 1), node(20, 1)}),
+                      Catch::Contains("pre-crack point 1"));
     CHECK(crack.points().empty());
   }
   SECTION("zero-length pre-crack piece") {
@@ -424,7 +448,8 @@ TEST_CASE("invalid crack input is rejected with a clear message", "[crack][line_
   }
   SECTION("segment of another crack object") {
     const Segment foreign{0, 1, 0};
-    CHECK_THROWS_WITH(crack.affected_points(plate.particles, {foreign}), Catch::Contains("crack segment point index"));
+    CHECK_THROWS_WITH(crack.affected_points(plate.particles, {foreign}),
+                      Catch::Contains("crack segment point index"));
   }
 }
 

@@ -78,14 +78,15 @@ class LineSegments {
     sphshell::detail::require_positive("crack spacing", spacing);
     sphshell::detail::require_positive("crack support_radius", support_radius);
     if (stress_point_normals.size() != stress_point_positions.size())
-      sphshell::detail::invalid_parameter("crack stress_point_normals.size()", stress_point_normals.size(),
-                                "must equal the number of stress point positions (" +
-                                    std::to_string(stress_point_positions.size()) + ")");
+      sphshell::detail::invalid_parameter("crack stress_point_normals.size()",
+                                          stress_point_normals.size(),
+                                          "must equal the number of stress point positions (" +
+                                              std::to_string(stress_point_positions.size()) + ")");
     for (std::size_t i = 0; i < stress_point_normals.size(); ++i) {
       const double length = stress_point_normals[i].norm();
       if (!(length > 0.0) || !std::isfinite(length))
-        sphshell::detail::invalid_parameter("length of stress point normal " + std::to_string(i), length,
-                                  "must be finite and > 0");
+        sphshell::detail::invalid_parameter("length of stress point normal " + std::to_string(i),
+                                            length, "must be finite and > 0");
     }
     // The cell list checks that every position is finite.
     stress_point_index_.emplace(stress_point_positions, spacing);
@@ -109,7 +110,7 @@ class LineSegments {
     require_initialized("add_precrack");
     if (polyline.size() < 2)
       sphshell::detail::invalid_parameter("pre-crack polyline size", polyline.size(),
-                                "needs at least 2 points");
+                                          "needs at least 2 points");
     for (std::size_t k = 0; k < polyline.size(); ++k) {
       const Vector3& point = polyline[k];
       if (!point.allFinite()) {
@@ -118,19 +119,20 @@ class LineSegments {
         sphshell::detail::invalid_parameter(name.str(), point.transpose(), "must be finite");
       }
       bool near_shell = false;
-      stress_point_index_->for_each_within(point, spacing_, [&](int, double) { near_shell = true; });
+      stress_point_index_->for_each_within(point, spacing_,
+                                           [&](int, double) { near_shell = true; });
       if (!near_shell) {
         std::ostringstream name;
         name << "pre-crack point " << k;
         sphshell::detail::invalid_parameter(name.str(), point.transpose(),
-                                  "must lie on the shell: within one spacing (" +
-                                      to_string(spacing_) + " m) of a stress point");
+                                            "must lie on the shell: within one spacing (" +
+                                                to_string(spacing_) + " m) of a stress point");
       }
       if (k > 0 && (point - polyline[k - 1]).norm() <= zero_length_in_spacings * spacing_) {
         std::ostringstream name;
         name << "length of pre-crack piece " << k - 1 << "-" << k;
         sphshell::detail::invalid_parameter(name.str(), (point - polyline[k - 1]).norm(),
-                                  "a pre-crack piece must not have zero length");
+                                            "a pre-crack piece must not have zero length");
       }
     }
     const int crack_id = crack_id_count_++;
@@ -167,7 +169,8 @@ class LineSegments {
         crack_of_point_.push_back(crack_id_count_++);
       } else {
         std::vector<int> joined_cracks;
-        for (int target : targets) joined_cracks.push_back(crack_of_point_[static_cast<std::size_t>(target)]);
+        for (int target : targets)
+          joined_cracks.push_back(crack_of_point_[static_cast<std::size_t>(target)]);
         const int merged_id = *std::min_element(joined_cracks.begin(), joined_cracks.end());
         crack_of_point_.push_back(merged_id);
         relabel(joined_cracks, merged_id);
@@ -235,7 +238,8 @@ class LineSegments {
       const Vector3 midpoint = 0.5 * (start + end);
       eval_index.for_each_within(midpoint, eval_index.radius(), [&](int i, double) {
         const auto slot = static_cast<std::size_t>(i);
-        if (!is_affected[slot] && distance_to_segment(eval_positions[slot], start, end) < support_radius_)
+        if (!is_affected[slot] &&
+            distance_to_segment(eval_positions[slot], start, end) < support_radius_)
           is_affected[slot] = 1;
       });
     }
@@ -269,7 +273,8 @@ class LineSegments {
   // "compacted id order" of crack_lengths().
   std::vector<int> crack_ids() const {
     std::vector<char> has_segment(static_cast<std::size_t>(crack_id_count_), 0);
-    for (const Segment& segment : segments_) has_segment[static_cast<std::size_t>(segment.crack_id)] = 1;
+    for (const Segment& segment : segments_)
+      has_segment[static_cast<std::size_t>(segment.crack_id)] = 1;
     std::vector<int> ids;
     for (int id = 0; id < crack_id_count_; ++id)
       if (has_segment[static_cast<std::size_t>(id)]) ids.push_back(id);
@@ -312,18 +317,21 @@ class LineSegments {
       std::vector<Candidate> candidates;
       auto consider = [&](int point, double distance_squared) {
         if (distance_squared <= reach_squared)
-          candidates.push_back({owner_.crack_of_point_[static_cast<std::size_t>(point)],
-                                distance_squared, point});
+          candidates.push_back(
+              {owner_.crack_of_point_[static_cast<std::size_t>(point)], distance_squared, point});
       };
       if (indexed_points_)
-        indexed_points_->for_each_within(position, indexed_points_->radius(), [&](int point, double) {
-          consider(point, (owner_.points_[static_cast<std::size_t>(point)] - position).squaredNorm());
-        });
+        indexed_points_->for_each_within(
+            position, indexed_points_->radius(), [&](int point, double) {
+              consider(point,
+                       (owner_.points_[static_cast<std::size_t>(point)] - position).squaredNorm());
+            });
       for (int point : unindexed_points_)
         consider(point, (owner_.points_[static_cast<std::size_t>(point)] - position).squaredNorm());
       std::sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) {
         if (x.crack_id != y.crack_id) return x.crack_id < y.crack_id;
-        if (x.distance_squared != y.distance_squared) return x.distance_squared < y.distance_squared;
+        if (x.distance_squared != y.distance_squared)
+          return x.distance_squared < y.distance_squared;
         return x.point < y.point;
       });
       std::vector<int> nearest;
@@ -364,16 +372,16 @@ class LineSegments {
   }
   void require_stress_point_index(int index) const {
     if (index < 0 || static_cast<std::size_t>(index) >= crack_point_of_stress_point_.size())
-      sphshell::detail::invalid_parameter("stress point index", index,
-                                "must lie in [0, " +
-                                    std::to_string(crack_point_of_stress_point_.size()) + ")");
+      sphshell::detail::invalid_parameter(
+          "stress point index", index,
+          "must lie in [0, " + std::to_string(crack_point_of_stress_point_.size()) + ")");
   }
   void require_segment(const Segment& segment) const {
     const auto point_count = static_cast<int>(points_.size());
     for (int point : {segment.start_point, segment.end_point})
       if (point < 0 || point >= point_count)
         sphshell::detail::invalid_parameter("crack segment point index", point,
-                                  "must lie in [0, " + std::to_string(point_count) + ")");
+                                            "must lie in [0, " + std::to_string(point_count) + ")");
   }
   static std::string to_string(double value) {
     std::ostringstream text;
@@ -388,14 +396,17 @@ class LineSegments {
   }
 
   void append_segment(int start_point, int end_point) {
-    segments_.push_back({start_point, end_point, crack_of_point_[static_cast<std::size_t>(end_point)]});
+    segments_.push_back(
+        {start_point, end_point, crack_of_point_[static_cast<std::size_t>(end_point)]});
     max_segment_length_ = std::max(max_segment_length_, segment_length(segments_.back()));
   }
 
   // Merges are rare (two crack tips meeting), so a full relabelling pass is
   // cheaper overall than keeping a union-find structure consistent.
   void relabel(const std::vector<int>& old_ids, int new_id) {
-    auto merged = [&](int id) { return std::find(old_ids.begin(), old_ids.end(), id) != old_ids.end(); };
+    auto merged = [&](int id) {
+      return std::find(old_ids.begin(), old_ids.end(), id) != old_ids.end();
+    };
     if (std::all_of(old_ids.begin(), old_ids.end(), [&](int id) { return id == new_id; })) return;
     for (int& id : crack_of_point_)
       if (merged(id)) id = new_id;
