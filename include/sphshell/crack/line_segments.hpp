@@ -152,12 +152,19 @@ class LineSegments {
     std::vector<int> ordered = stress_points;
     std::sort(ordered.begin(), ordered.end());
     ordered.erase(std::unique(ordered.begin(), ordered.end()), ordered.end());
+    // Called every step, mostly with nothing new: skip building the point index then.
+    ordered.erase(std::remove_if(ordered.begin(), ordered.end(),
+                                 [&](int stress_point) {
+                                   return crack_point_of_stress_point_[static_cast<std::size_t>(
+                                              stress_point)] >= 0;
+                                 }),
+                  ordered.end());
+    if (ordered.empty()) return {};
 
     std::vector<Segment> created;
     NearestPointSearch search(*this);
     for (int stress_point : ordered) {
       const auto slot = static_cast<std::size_t>(stress_point);
-      if (crack_point_of_stress_point_[slot] >= 0) continue;
       const Vector3& position = stress_point_positions_[slot];
       const std::vector<int> targets = search.nearest_point_of_each_crack(position);
 
