@@ -237,7 +237,8 @@ class LineSegments {
     }
     std::vector<std::size_t> affected;
     if (new_segments.empty() || eval_positions.empty()) return affected;
-    const approx::CellList eval_index(eval_positions, support_radius_ + max_half_length);
+    // Slightly wider than needed: the exact distance test below decides.
+    const approx::CellList eval_index(eval_positions, 1.01 * (support_radius_ + max_half_length));
     std::vector<char> is_affected(eval_positions.size(), 0);
     for (const Segment& segment : new_segments) {
       const Vector3& start = points_[static_cast<std::size_t>(segment.start_point)];
