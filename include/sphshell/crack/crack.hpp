@@ -2,7 +2,11 @@
 // The crack family. A crack policy states at compile time whether it is
 // enabled (`static constexpr bool enabled`) and gives a `name`; an enabled
 // policy also decides which particle pairs stay visible to each other and which
-// stress points are removed (design.md §2.6).
+// stress points are removed (design.md §2.6). An enabled policy
+// (crack::LineSegments) provides initialize, add_precrack,
+// add_damaged_stress_points, visible, affected_points and the introspection
+// members points, segments, is_damaged, damaged_count, crack_count,
+// total_length, crack_lengths and empty; crack::None has none of them.
 
 #include <type_traits>
 
