@@ -90,8 +90,12 @@ struct EnergyReport {
   double plastic_dissipation = 0.0;  // internal − elastic
   double external_work = 0.0;        // loads and prescribed motions
   double damping_work = 0.0;         // removed by mass-proportional damping
-  // Zero up to time-discretization error: kinetic + internal + damping − external.
-  double balance() const { return kinetic + internal + damping_work - external_work; }
+  // kinetic + internal + damping − external, zero up to the time-discretization
+  // error. The leapfrog velocities live at half steps, so the internal energy
+  // enters at the half step too (the mean of its two neighbouring values).
+  double balance() const { return balance_; }
+
+  double balance_ = 0.0;
 };
 
 template <class Approx, class Rule, class Material, class Crack = crack::None>
@@ -200,6 +204,7 @@ class Solver {
   // CSV time history of one particle: t, displacement, velocity, rotation.
   void add_particle_probe(const std::string& csv_path, int particle) {
     checked({particle});
+    create_parent_directory(csv_path);
     probes_.push_back({io::CsvProbe(csv_path, {"t [s]", "ux [m]", "uy [m]", "uz [m]", "vx [m/s]",
                                                "vy [m/s]", "vz [m/s]", "rx [rad]", "ry [rad]", "rz [rad]"}),
                        particle, false});
@@ -215,6 +220,7 @@ class Solver {
     for (int k = 1; k <= output_points; ++k) columns.push_back("equivalent_stress_" + std::to_string(k) + " [Pa]");
     for (int k = 1; k <= output_points; ++k) columns.push_back("equivalent_plastic_strain_" + std::to_string(k));
     for (int k = 1; k <= output_points; ++k) columns.push_back("damage_" + std::to_string(k));
+    create_parent_directory(csv_path);
     probes_.push_back({io::CsvProbe(csv_path, std::move(columns)), stress_point, true});
     write_probe(probes_.back());
   }
@@ -262,8 +268,9 @@ class Solver {
     time_ += time_step_;
     ++steps_;
     forces_current_ = false;
+    check_configuration();
     compute_internal_forces();
-    check_stability();
+    check_energy_balance();
     if (options_.progress_interval > 0 && steps_ % options_.progress_interval == 0) print_progress();
     write_scheduled_output();
   }
@@ -348,6 +355,8 @@ class Solver {
     report.plastic_dissipation = internal_energy_ - elastic;
     report.external_work = external_work_;
     report.damping_work = damping_work_;
+    report.balance_ = kinetic_energy_ + 0.5 * (previous_internal_energy_ + internal_energy_) +
+                      damping_work_ - external_work_;
     return report;
   }
 
@@ -384,6 +393,11 @@ class Solver {
       constraints_.fix_all_translations(i);
       constraints_.add_motion(i, owned);
     }
+  }
+
+  static void create_parent_directory(const std::string& path) {
+    const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+    if (!parent.empty()) std::filesystem::create_directories(parent);
   }
 
   static std::string to_string(double value) {
@@ -553,8 +567,25 @@ class Solver {
   void compute_internal_forces() {
     for (int group = 0; group < 2; ++group) {
       const long rows = static_cast<long>(point_count(group));
+      // An exception must not escape an OpenMP region: keep the one of the
+      // lowest point (deterministic) and rethrow it after the loop.
+      long failed_row = rows;
+      std::string failure;
 #pragma omp parallel for schedule(static)
-      for (long row = 0; row < rows; ++row) integrate_point(group, static_cast<std::size_t>(row));
+      for (long row = 0; row < rows; ++row) {
+        try {
+          integrate_point(group, static_cast<std::size_t>(row));
+        } catch (const std::exception& error) {
+#pragma omp critical(sphshell_failure)
+          if (row < failed_row) {
+            failed_row = row;
+            failure = error.what();
+          }
+        }
+      }
+      if (failed_row < rows)
+        fail_unstable(std::string(group == 0 ? "stress point " : "particle ") + std::to_string(failed_row) +
+                      ": " + failure);
     }
     const long particles = static_cast<long>(model_.particle_count());
 #pragma omp parallel for schedule(static)
@@ -567,6 +598,7 @@ class Solver {
       internal_force_[i] = force;
       internal_director_force_[i] = director_force;
     }
+    previous_internal_energy_ = internal_energy_;
     for (double work : work_increment_) internal_energy_ += work;
     std::fill(work_increment_.begin(), work_increment_.end(), 0.0);
     forces_current_ = true;
@@ -763,11 +795,16 @@ class Solver {
     return fields;
   }
 
-  void check_stability() {
+  void check_configuration() const {
     const std::size_t n = position_.size();
     for (std::size_t i = 0; i < n; ++i)
-      if (!position_[i].allFinite() || !director_[i].allFinite() || !internal_force_[i].allFinite())
-        fail_unstable("non-finite state at particle " + std::to_string(i));
+      if (!position_[i].allFinite() || !director_[i].allFinite() || !velocity_[i].allFinite())
+        fail_unstable("non-finite state at particle " + std::to_string(i) + " (external force " +
+                      to_string(external_force_[i].norm()) + " N, internal force " +
+                      to_string(internal_force_[i].norm()) + " N)");
+  }
+
+  void check_energy_balance() const {
     if (steps_ % 16 != 0) return;  // the energy sums cost a pass over all states
     const EnergyReport e = energy();
     const double scale = std::max({std::abs(e.external_work), e.kinetic, std::abs(e.internal)});
@@ -835,7 +872,7 @@ class Solver {
 
   detail::Constraints constraints_;
   std::vector<std::unique_ptr<detail::Load>> loads_;
-  double internal_energy_ = 0.0, external_work_ = 0.0, damping_work_ = 0.0, kinetic_energy_ = 0.0;
+  double previous_internal_energy_ = 0.0, internal_energy_ = 0.0, external_work_ = 0.0, damping_work_ = 0.0, kinetic_energy_ = 0.0;
 };
 
 }  // namespace sphshell
