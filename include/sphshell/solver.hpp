@@ -90,6 +90,7 @@ struct EnergyReport {
   double plastic_dissipation = 0.0;  // internal − elastic
   double external_work = 0.0;        // loads and prescribed motions
   double damping_work = 0.0;         // removed by mass-proportional damping
+  double released_by_fracture = 0.0; // elastic energy held by integration points when they were removed (part of plastic_dissipation)
   // kinetic + internal + damping − external, zero up to the time-discretization
   // error. The leapfrog velocities live at half steps, so the internal energy
   // enters at the half step too (the mean of its two neighbouring values).
@@ -258,6 +259,24 @@ class Solver {
     return positions;
   }
 
+  // A pre-crack: a polyline on the shell (reference coordinates). Pairs across
+  // it stop interacting at once.
+  void add_precrack(const std::vector<Vector3>& polyline) {
+    static_assert(Crack::enabled,
+                  "add_precrack needs a crack policy such as crack::LineSegments; a Solver with "
+                  "crack::None has no cracks");
+    crack_.add_precrack(polyline);
+    rebuild_near_segments(crack_.segments());
+  }
+  // The crack topology (reference configuration); crack::None has none.
+  const Crack& crack() const { return crack_; }
+  // Stress points removed from the force integration (all integral points failed).
+  std::size_t damaged_stress_point_count() const { return damaged_stress_points_; }
+  bool is_fragment(int particle) const { return fragment_[particle] != 0; }
+  std::size_t fragment_count() const {
+    return static_cast<std::size_t>(std::count(fragment_.begin(), fragment_.end(), 1));
+  }
+
   // One explicit step of size time_step().
   void step() {
     if (!forces_current_) compute_internal_forces();
@@ -270,6 +289,7 @@ class Solver {
     forces_current_ = false;
     check_configuration();
     compute_internal_forces();
+    if constexpr (Crack::enabled) update_cracks();
     check_energy_balance();
     if (options_.progress_interval > 0 && steps_ % options_.progress_interval == 0) print_progress();
     write_scheduled_output();
@@ -349,12 +369,14 @@ class Solver {
     report.internal = internal_energy_;
     double elastic = 0.0;
     for (std::size_t p = 0; p < state_.size(); ++p)
-      elastic += membrane_bending_weight_[p] * section_.elastic_energy(state_[p]) +
+      if (active_[p])
+        elastic += membrane_bending_weight_[p] * section_.elastic_energy(state_[p]) +
                  0.5 * shear_weight_[p] * shear_[p].squaredNorm();
     report.elastic = elastic;
     report.plastic_dissipation = internal_energy_ - elastic;
     report.external_work = external_work_;
     report.damping_work = damping_work_;
+    report.released_by_fracture = released_energy_;
     report.balance_ = kinetic_energy_ + 0.5 * (previous_internal_energy_ + internal_energy_) +
                       damping_work_ - external_work_;
     return report;
@@ -432,16 +454,15 @@ class Solver {
     const double spacing = model_.maximum_spacing();
     smoothing_length_ =
         options_.support_radius_factor * spacing / Approx::kernel_type::support_radius_factor;
-    std::vector<TangentFrame> stress_frames, particle_frames;
-    for (const Vector3& normal : model_.stress_point_normal) stress_frames.push_back(tangent_frame(normal));
-    for (const Vector3& normal : model_.particle_normal) particle_frames.push_back(tangent_frame(normal));
+    for (const Vector3& normal : model_.stress_point_normal) frames_[0].push_back(tangent_frame(normal));
+    for (const Vector3& normal : model_.particle_normal) frames_[1].push_back(tangent_frame(normal));
     shape_[0] = Approx::build(model_.particle_position, model_.particle_area,
-                              model_.stress_point_position, stress_frames, smoothing_length_);
+                              model_.stress_point_position, frames_[0], smoothing_length_);
     const bool particles_integrate =
         options_.particle_integration_share > 0.0 || options_.particle_shear_weight > 0.0;
     if (particles_integrate)
       shape_[1] = Approx::build(model_.particle_position, model_.particle_area,
-                                model_.particle_position, particle_frames, smoothing_length_);
+                                model_.particle_position, frames_[1], smoothing_length_);
 
     const std::size_t stress_points = model_.stress_point_count();
     const std::size_t particle_points = particles_integrate ? model_.particle_count() : 0;
@@ -479,7 +500,10 @@ class Solver {
     membrane_.assign(total, StressVoigt::Zero());
     moment_.assign(total, StressVoigt::Zero());
     work_increment_.assign(total, 0.0);
+    active_.assign(total, 1);
+    fragment_.assign(model_.particle_count(), 0);
     build_slot_transpose();
+    if constexpr (Crack::enabled) initialize_cracks();
   }
 
   std::size_t point_count(int group) const {
@@ -530,6 +554,7 @@ class Solver {
   // Strains → material update → resultants → forces on the slots of one point.
   void integrate_point(int group, std::size_t row) {
     const std::size_t p = point_offset_[group] + row;
+    if (!active_[p]) return;
     const shell::SurfaceGradients current = gather(group, row, position_, director_);
     const shell::SurfaceGradients& reference = reference_[p];
     const shell::Strains strains = options_.nonlinear ? shell::green_strains(current, reference)
@@ -795,6 +820,135 @@ class Solver {
     return fields;
   }
 
+  const std::vector<Vector3>& evaluation_positions(int group) const {
+    return group == 0 ? model_.stress_point_position : model_.particle_position;
+  }
+
+  void initialize_cracks() {
+    const double support_radius = smoothing_length_ * Approx::kernel_type::support_radius_factor;
+    crack_.initialize(model_.stress_point_position, model_.stress_point_normal, model_.maximum_spacing(),
+                      support_radius);
+    // The stress points around each particle: the cells it is a corner of, or,
+    // for a model without cells, the stress points within one spacing.
+    stress_points_of_particle_.assign(model_.particle_count(), {});
+    if (!model_.quads().empty()) {
+      for (std::size_t q = 0; q < model_.quads().size(); ++q)
+        for (int corner : model_.quads()[q]) stress_points_of_particle_[corner].push_back(static_cast<int>(q));
+    } else {
+      const double reach = model_.maximum_spacing();
+      for (std::size_t i = 0; i < model_.particle_count(); ++i)
+        for (std::size_t q = 0; q < model_.stress_point_count(); ++q)
+          if ((model_.stress_point_position[q] - model_.particle_position[i]).norm() < reach)
+            stress_points_of_particle_[i].push_back(static_cast<int>(q));
+    }
+  }
+
+  // Removes an integration point from the force integration, keeping its
+  // stored elastic energy in the books as released.
+  void deactivate(std::size_t p) {
+    released_energy_ += membrane_bending_weight_[p] * section_.elastic_energy(state_[p]) +
+                        0.5 * shear_weight_[p] * shear_[p].squaredNorm();
+    active_[p] = 0;
+    const int group = p < point_offset_[1] || point_offset_[1] == 0 ? 0 : 1;
+    const std::size_t row = p - point_offset_[group];
+    const approx::ShapeFunctions& shape = shape_[group];
+    for (std::size_t s = shape.row_begin[row]; s < shape.row_begin[row + 1]; ++s) {
+      slot_force_[slot_offset_[group] + s].setZero();
+      slot_director_force_[slot_offset_[group] + s].setZero();
+    }
+  }
+
+  // Per step: stress points whose integral points have all failed leave the
+  // integration and join the crack topology; their neighbourhoods get new,
+  // visibility-filtered shape functions; particles with every stress point
+  // damaged become fragments (design.md §2.6).
+  void update_cracks() {
+    std::vector<int> newly_damaged;
+    for (std::size_t p = 0; p < model_.stress_point_count(); ++p)
+      if (active_[p] && section_.all_failed(state_[p])) newly_damaged.push_back(static_cast<int>(p));
+    for (std::size_t i = 0; i < point_count(1); ++i) {
+      const std::size_t p = point_offset_[1] + i;
+      if (active_[p] && section_.all_failed(state_[p])) deactivate(p);
+    }
+    if (newly_damaged.empty()) return;
+    for (int p : newly_damaged) deactivate(static_cast<std::size_t>(p));
+    damaged_stress_points_ += newly_damaged.size();
+    const auto segments = crack_.add_damaged_stress_points(newly_damaged);
+    std::vector<int> new_fragments;
+    for (int p : newly_damaged)
+      for (int corner : corners_of(p))
+        if (!fragment_[corner] && all_damaged_around(corner)) {
+          fragment_[corner] = 1;
+          new_fragments.push_back(corner);
+        }
+    if (segments.empty() && new_fragments.empty()) return;
+    rebuild_near_segments(segments, new_fragments);
+  }
+
+  std::vector<int> corners_of(int stress_point) const {
+    std::vector<int> corners;
+    if (!model_.quads().empty()) {
+      const Quad& quad = model_.quads()[stress_point];
+      corners.assign(quad.begin(), quad.end());
+    } else {
+      for (std::size_t i = 0; i < stress_points_of_particle_.size(); ++i)
+        for (int q : stress_points_of_particle_[i])
+          if (q == stress_point) corners.push_back(static_cast<int>(i));
+    }
+    return corners;
+  }
+
+  bool all_damaged_around(int particle) const {
+    const std::vector<int>& around = stress_points_of_particle_[particle];
+    return !around.empty() &&
+           std::all_of(around.begin(), around.end(), [&](int q) { return !active_[q]; });
+  }
+
+  // Rebuilds the shape functions of every evaluation point within the support
+  // of a new crack segment or of a new fragment, hiding the pairs the cracks
+  // cut and the fragments. The strain bookkeeping restarts from the new
+  // approximation so the change of functions itself creates no strain.
+  template <class Segments>
+  void rebuild_near_segments(const Segments& segments, const std::vector<int>& new_fragments = {}) {
+    const double support_radius = smoothing_length_ * Approx::kernel_type::support_radius_factor;
+    for (int group = 0; group < 2; ++group) {
+      if (point_count(group) == 0) continue;
+      const std::vector<Vector3>& eval = evaluation_positions(group);
+      std::vector<std::size_t> rows = crack_.affected_points(eval, segments);
+      for (int particle : new_fragments)
+        for (std::size_t row = 0; row < eval.size(); ++row)
+          if ((eval[row] - model_.particle_position[particle]).norm() < support_radius) rows.push_back(row);
+      std::sort(rows.begin(), rows.end());
+      rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+      for (std::size_t row : rows) {
+        const std::size_t p = point_offset_[group] + row;
+        if (!active_[p]) continue;
+        const Vector3& x = eval[row];
+        const TangentFrame& frame = frames_[group][row];
+        auto visible = [&](std::size_t, std::size_t j) {
+          return !fragment_[j] && crack_.visible(x, model_.particle_position[j], frame);
+        };
+        try {
+          Approx::rebuild_row(shape_[group], row, model_.particle_position, model_.particle_area, x,
+                              frame, smoothing_length_, visible);
+        } catch (const Error&) {
+          deactivate(p);  // nothing visible is left: the point is cut loose
+          continue;
+        }
+        reference_[p] = gather(group, row, model_.particle_position, model_.particle_normal);
+        const shell::SurfaceGradients current = gather(group, row, position_, director_);
+        const shell::Strains strains = options_.nonlinear ? shell::green_strains(current, reference_[p])
+                                                          : shell::linear_strains(current, reference_[p]);
+        membrane_strain_[p] = strains.membrane;
+        curvature_[p] = strains.curvature;
+        shear_[p] = strains.shear;
+      }
+    }
+    build_slot_transpose();
+    forces_current_ = false;
+    compute_internal_forces();
+  }
+
   void check_configuration() const {
     const std::size_t n = position_.size();
     for (std::size_t i = 0; i < n; ++i)
@@ -850,6 +1004,7 @@ class Solver {
   std::vector<Vector3> internal_force_, internal_director_force_, external_force_;
 
   std::array<approx::ShapeFunctions, 2> shape_;
+  std::array<std::vector<TangentFrame>, 2> frames_;  // evaluation frames, kept for rebuilds
   std::array<std::size_t, 2> point_offset_{};
   std::array<std::size_t, 2> slot_offset_{};
   // Integration weights: area share for membrane and bending; area × κs G d
@@ -861,6 +1016,12 @@ class Solver {
   std::vector<Vector2> shear_;
   std::vector<StressVoigt> membrane_, moment_;
   std::vector<double> work_increment_;
+  std::vector<unsigned char> active_;    // per integration point: still integrates forces
+  std::vector<unsigned char> fragment_;  // per particle: every stress point around it damaged
+  Crack crack_;
+  std::vector<std::vector<int>> stress_points_of_particle_;
+  std::size_t damaged_stress_points_ = 0;
+  double released_energy_ = 0.0;
   std::vector<Vector3> slot_force_, slot_director_force_;
   std::vector<std::size_t> particle_slot_begin_, particle_slots_;
 

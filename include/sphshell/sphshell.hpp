@@ -6,8 +6,7 @@
 #include <sphshell/core/types.hpp>
 
 #include <sphshell/approx/all.hpp>
-#include <sphshell/crack/crack.hpp>
-#include <sphshell/crack/none.hpp>
+#include <sphshell/crack/all.hpp>
 #include <sphshell/kernel/all.hpp>
 #include <sphshell/material/all.hpp>
 #include <sphshell/thickness/all.hpp>
