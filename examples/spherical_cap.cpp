@@ -12,6 +12,7 @@
 #include <sphshell/sphshell.hpp>
 
 #include <cmath>
+#include <filesystem>
 #include <cstdlib>
 #include <iostream>
 #include <string>
@@ -62,6 +63,7 @@ int run(const Arguments& arguments, const typename Material::Parameters& paramet
   solver.add_uniform_pressure(all, pressure);  // inward: normals point outward
   const int apex = model.set("apex")[0];
   const std::string csv = arguments.output.empty() ? "spherical_cap_apex.csv" : arguments.output + "/apex.csv";
+  if (!arguments.output.empty()) std::filesystem::create_directories(arguments.output);
   io::CsvProbe history(csv, {"t [s]", "u/d [-]"});
   double peak = 0.0, peak_time = 0.0;
   long next_report = 0;

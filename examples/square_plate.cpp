@@ -3,8 +3,12 @@
 // clamped, uniform step pressure q = 1 MPa, 51 × 51 particles and 50 × 50
 // stress points, 5 Gauss points through the thickness.
 //
-//   square_plate [--case linear|nonlinear|plastic|damage] [--rule gauss5|gauss3|gauss7|global]
+//   square_plate [--case linear|nonlinear|plastic|damage|fracture] [--rule gauss5|gauss3|gauss7|global]
 //                [--n 51] [--pressure 1e6] [--end-time 4e-3] [--output DIR]
+//
+// --case fracture is §3.2.4: q = 5 MPa (unless --pressure is given), Lemaitre
+// damage with crack::LineSegments; the history adds the crack length (Fig. 21)
+// beside the centre deflection (Fig. 22), and --output adds cracks.pvd.
 //
 // Test point A is the plate centre, B the stress point at the middle of an edge,
 // half a spacing from the clamped boundary. The history of both goes to
@@ -17,6 +21,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <string>
 
@@ -28,7 +33,7 @@ struct Arguments {
   std::string analysis = "plastic";
   std::string rule = "gauss5";
   int n = 51;
-  double pressure = 1e6;
+  double pressure = 0.0;  // 0: the case's default (1 MPa, 5 MPa for fracture)
   double end_time = 4e-3;
   std::string output;
 };
@@ -55,21 +60,22 @@ Arguments parse(int argc, char** argv) {
 constexpr double length = 0.5, thickness = 0.01, density = 7850.0, E = 210e9, nu = 0.3;
 constexpr double sigma_y0 = 235e6, Ep = 0.0, eps_s = 0.02, eps_c = 0.37, Dc = 0.24;
 
-template <class Rule, class Material>
+template <class Rule, class Material, class Crack = crack::None>
 int run(const Arguments& a, const typename Material::Parameters& parameters) {
+  const double pressure = a.pressure > 0.0 ? a.pressure : (Crack::enabled ? 5e6 : 1e6);
   SolverOptions options;
   options.density = density;
   options.nonlinear = a.analysis != "linear";
   options.output_directory = a.output;
   options.output_interval = a.output.empty() ? 0.0 : 1e-4;
   options.progress_interval = 500;
-  using PlateSolver = Solver<approx::MLS<kernel::CubicSpline>, Rule, Material>;
+  using PlateSolver = Solver<approx::MLS<kernel::CubicSpline>, Rule, Material, Crack>;
   PlateSolver solver(ShellModel::rectangular_plate(length, length, a.n, a.n, thickness), parameters, options);
   const ShellModel& model = solver.model();
   solver.clamp(model.set("boundary"));
   ParticleSet all;
   for (std::size_t i = 0; i < model.particle_count(); ++i) all.push_back(static_cast<int>(i));
-  solver.add_uniform_pressure(all, a.pressure);  // pushes along −z
+  solver.add_uniform_pressure(all, pressure);  // pushes along −z
   const int point_a = model.set("centre")[0];
   const int stress_point_a = model.nearest_stress_point(Vector3(length / 2, length / 2, 0));
   const double spacing = length / (a.n - 1);
@@ -82,12 +88,15 @@ int run(const Arguments& a, const typename Material::Parameters& parameters) {
   for (int k = 1; k <= points; ++k) columns.push_back("sigma_eq_B_ip" + std::to_string(k) + " [Pa]");
   for (int k = 1; k <= points; ++k) columns.push_back("eps_p_B_ip" + std::to_string(k));
   for (int k = 1; k <= points; ++k) columns.push_back("D_B_ip" + std::to_string(k));
+  if constexpr (Crack::enabled)
+    columns.insert(columns.end(), {"crack_length [m]", "cracks", "damaged_stress_points", "fragments"});
   const std::string csv = a.output.empty() ? "square_plate.csv" : a.output + "/history.csv";
+  if (!a.output.empty()) std::filesystem::create_directories(a.output);
   io::CsvProbe history(csv, columns);
 
   std::cout << "square plate: " << model.particle_count() << " particles, " << model.stress_point_count()
             << " stress points, " << Rule::name << ", " << Material::name << ", "
-            << (options.nonlinear ? "nonlinear" : "linear") << " analysis, q = " << a.pressure
+            << (options.nonlinear ? "nonlinear" : "linear") << " analysis, q = " << pressure
             << " Pa, dt = " << solver.time_step() << " s\n";
   double peak = 0.0, peak_time = 0.0;
   const auto start = std::chrono::steady_clock::now();
@@ -104,6 +113,9 @@ int run(const Arguments& a, const typename Material::Parameters& parameters) {
     for (int k = 0; k < points; ++k) row.push_back(s.equivalent_stress(stress_point_b, k));
     for (int k = 0; k < points; ++k) row.push_back(s.equivalent_plastic_strain(stress_point_b, k));
     for (int k = 0; k < points; ++k) row.push_back(s.damage(stress_point_b, k));
+    if constexpr (Crack::enabled)
+      row.insert(row.end(), {s.crack().total_length(), double(s.crack().crack_count()),
+                             double(s.damaged_stress_point_count()), double(s.fragment_count())});
     history.write_row(row);
   });
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -114,9 +126,13 @@ int run(const Arguments& a, const typename Material::Parameters& parameters) {
             << "energy at the end: kinetic " << energy.kinetic << " J, internal " << energy.internal
             << " J (plastic dissipation " << energy.plastic_dissipation << " J), external work "
             << energy.external_work << " J, balance " << energy.balance() << " J\n";
+  if constexpr (Crack::enabled)
+    std::cout << "cracks: " << solver.crack().crack_count() << " cracks, total length "
+              << solver.crack().total_length() << " m, " << solver.damaged_stress_point_count()
+              << " damaged stress points, " << solver.fragment_count() << " fragment particles\n";
   if (a.analysis == "linear") {
     const double D = E * thickness * thickness * thickness / (12 * (1 - nu * nu));
-    const double static_deflection = 0.0012754 * a.pressure * std::pow(length, 4) / D;  // Mindlin, L/d = 50
+    const double static_deflection = 0.0012754 * pressure * std::pow(length, 4) / D;  // Mindlin, L/d = 50
     const double period = 2 * M_PI / (35.99 / (length * length) * std::sqrt(D / (density * thickness)));
     std::cout << "closed forms: static Mindlin deflection " << static_deflection * 1e3
               << " mm (dynamic peak ≈ twice that: " << 2e3 * static_deflection
@@ -131,9 +147,10 @@ template <class Rule>
 int run_case(const Arguments& a) {
   if (a.analysis == "linear" || a.analysis == "nonlinear") return run<Rule, material::Elastic>(a, {E, nu});
   if (a.analysis == "plastic") return run<Rule, material::J2Plasticity>(a, {E, nu, sigma_y0, Ep});
-  if (a.analysis == "damage")
-    return run<Rule, material::LemaitreDamage>(a, {E, nu, sigma_y0, Ep, eps_s, eps_c, Dc});
-  throw Error("square_plate: unknown --case " + a.analysis + " (linear, nonlinear, plastic, damage)");
+  const material::LemaitreDamage::Parameters damage{E, nu, sigma_y0, Ep, eps_s, eps_c, Dc};
+  if (a.analysis == "damage") return run<Rule, material::LemaitreDamage>(a, damage);
+  if (a.analysis == "fracture") return run<Rule, material::LemaitreDamage, crack::LineSegments>(a, damage);
+  throw Error("square_plate: unknown --case " + a.analysis + " (linear, nonlinear, plastic, damage, fracture)");
 }
 
 }  // namespace

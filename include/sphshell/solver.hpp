@@ -247,6 +247,7 @@ class Solver {
     particle_collection_->add(time_, particle_file);
     io::write_vtu_points(stress_file, stress_point_positions(), stress_point_fields());
     stress_point_collection_->add(time_, stress_file);
+    if constexpr (Crack::enabled) write_crack_frame(suffix.str());
   }
 
   // Current stress point positions, interpolated from the particles.
@@ -786,8 +787,46 @@ class Solver {
       displacement_values[i] = displacement(static_cast<int>(i));
       rotation_values[i] = rotation(static_cast<int>(i));
     }
-    return {vector_field("displacement", displacement_values), vector_field("velocity", velocity_),
-            vector_field("rotation", rotation_values), vector_field("director", director_)};
+    std::vector<io::PointField> fields{vector_field("displacement", displacement_values),
+                                       vector_field("velocity", velocity_),
+                                       vector_field("rotation", rotation_values),
+                                       vector_field("director", director_)};
+    if constexpr (Crack::enabled) {
+      io::PointField fragment{"fragment", 1, {}};
+      for (unsigned char flag : fragment_) fragment.values.push_back(flag);
+      fields.push_back(fragment);
+    }
+    return fields;
+  }
+
+  // The crack segments as a ParaView line set, in the current configuration:
+  // a damaged stress point's crack point follows the interpolated motion of the
+  // stress point, a pre-crack point the displacement of its nearest particle.
+  void write_crack_frame(const std::string& suffix) {
+    if (!crack_collection_)
+      crack_collection_ = std::make_unique<io::PvdCollection>(options_.output_directory + "/cracks.pvd");
+    const std::vector<Vector3>& reference = crack_.points();
+    std::vector<Vector3> points(reference.size());
+    std::vector<char> placed(reference.size(), 0);
+    const std::vector<Vector3> stress_positions = stress_point_positions();
+    for (std::size_t p = 0; p < model_.stress_point_count(); ++p) {
+      const int k = crack_.crack_point_of_stress_point(static_cast<int>(p));
+      if (k >= 0) {
+        points[k] = stress_positions[p];
+        placed[k] = 1;
+      }
+    }
+    for (std::size_t k = 0; k < points.size(); ++k)
+      if (!placed[k]) points[k] = reference[k] + displacement(model_.nearest_particle(reference[k]));
+    std::vector<std::array<int, 2>> lines;
+    io::CellField crack_id{"crack_id", 1, {}};
+    for (const auto& segment : crack_.segments()) {
+      lines.push_back({segment.start_point, segment.end_point});
+      crack_id.values.push_back(segment.crack_id);
+    }
+    const std::string file = options_.output_directory + "/cracks_" + suffix + ".vtu";
+    io::write_vtu_lines(file, points, lines, {}, {crack_id});
+    crack_collection_->add(time_, file);
   }
 
   // Per stress point: one array per quantity with a component per thickness
@@ -815,6 +854,11 @@ class Solver {
     }
     std::vector<io::PointField> fields{stress, plastic};
     if constexpr (Material::has_damage) fields.push_back(damage_field);
+    if constexpr (Crack::enabled) {
+      io::PointField removed{"removed", 1, {}};
+      for (std::size_t s = 0; s < m; ++s) removed.values.push_back(active_[s] ? 0.0 : 1.0);
+      fields.push_back(removed);
+    }
     fields.push_back(membrane);
     fields.push_back(moment);
     return fields;
@@ -1026,7 +1070,7 @@ class Solver {
   std::vector<std::size_t> particle_slot_begin_, particle_slots_;
 
   std::vector<Probe> probes_;
-  std::unique_ptr<io::PvdCollection> particle_collection_, stress_point_collection_;
+  std::unique_ptr<io::PvdCollection> particle_collection_, stress_point_collection_, crack_collection_;
   long frames_written_ = 0;
   double next_frame_time_ = 0.0;
   double next_probe_time_ = 0.0;
