@@ -14,6 +14,7 @@
 // zero-energy modes of stress-point-only quadrature without shear locking.
 
 #include <sphshell/approx/approx.hpp>
+#include <sphshell/approx/neighbour_search.hpp>
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
@@ -37,6 +38,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -171,12 +173,22 @@ class Solver {
   // time) imposed on all three translations of the set.
   template <class DisplacementFunction>
   void prescribe_displacement(const ParticleSet& set, DisplacementFunction displacement) {
+    static_assert(std::is_invocable_r_v<Vector3, DisplacementFunction, const Vector3&, double>,
+                  "prescribe_displacement: the function must be callable as Vector3 u(const Vector3& X, double t)");
+    for (int i : checked(set)) {
+      const Vector3 start = displacement(model_.particle_position[i], time_);
+      if (steps_ == 0 && start.norm() > 0.0)
+        detail::invalid_parameter("prescribed displacement at t = 0, particle " + std::to_string(i),
+                                  start.transpose(), "must be zero: the run starts from the reference configuration");
+    }
     add_motion(set, std::make_unique<detail::PrescribedDisplacement<DisplacementFunction>>(
                         std::move(displacement)));
   }
   // Prescribed velocity v(X, t) imposed on all three translations of the set.
   template <class VelocityFunction>
   void prescribe_velocity(const ParticleSet& set, VelocityFunction velocity) {
+    static_assert(std::is_invocable_r_v<Vector3, VelocityFunction, const Vector3&, double>,
+                  "prescribe_velocity: the function must be callable as Vector3 v(const Vector3& X, double t)");
     add_motion(set, std::make_unique<detail::PrescribedVelocity<VelocityFunction>>(
                         std::move(velocity)));
   }
@@ -185,6 +197,8 @@ class Solver {
   template <class PressureFunction>
   void add_pressure(const ParticleSet& set, PressureFunction pressure,
                     PressureDirection direction = PressureDirection::follower) {
+    static_assert(std::is_invocable_r_v<double, PressureFunction, const Vector3&, double>,
+                  "add_pressure: the pressure must be callable as double p(const Vector3& X, double t)");
     loads_.push_back(std::make_unique<detail::PressureLoad<PressureFunction>>(
         checked(set), std::move(pressure), direction));
   }
@@ -273,7 +287,10 @@ class Solver {
   const Crack& crack() const { return crack_; }
   // Stress points removed from the force integration (all integral points failed).
   std::size_t damaged_stress_point_count() const { return damaged_stress_points_; }
-  bool is_fragment(int particle) const { return fragment_[particle] != 0; }
+  bool is_fragment(int particle) const {
+    check_particle(particle);
+    return fragment_[particle] != 0;
+  }
   std::size_t fragment_count() const {
     return static_cast<std::size_t>(std::count(fragment_.begin(), fragment_.end(), 1));
   }
@@ -281,6 +298,11 @@ class Solver {
   // One explicit step of size time_step().
   void step() {
     if (!forces_current_) compute_internal_forces();
+    if (steps_ == 0 && frames_written_ == 0 && !options_.output_directory.empty() &&
+        options_.output_interval > 0.0) {
+      write_frame();  // the reference configuration at t = 0
+      next_frame_time_ = options_.output_interval;
+    }
     const double dt = steps_ == 0 ? 0.5 * time_step_ : time_step_;  // leapfrog start-up
     apply_external_loads(time_);
     advance_velocities(dt);
@@ -323,10 +345,12 @@ class Solver {
   const std::vector<Vector3>& velocities() const { return velocity_; }
   const std::vector<Vector3>& angular_velocities() const { return angular_velocity_; }
   Vector3 displacement(int particle) const {
+    check_particle(particle);
     return position_[particle] - model_.particle_position[particle];
   }
   // Rotation vector taking the reference director to the current one.
   Vector3 rotation(int particle) const {
+    check_particle(particle);
     const Vector3& from = model_.particle_normal[particle];
     const Vector3& to = director_[particle];
     const Vector3 axis = from.cross(to);
@@ -340,14 +364,23 @@ class Solver {
   // ∂Π/∂d_j: the internal generalized force on each director.
   const std::vector<Vector3>& internal_director_forces() const { return internal_director_force_; }
 
-  // Sets positions and directors (e.g. for a restart or a test); velocities are
-  // kept. Internal forces are recomputed from the material states at the next step.
+  // Moves the particles and directors to a new configuration at once (a
+  // kinematic jump, used e.g. to probe the discrete stiffness): the strain
+  // change goes through the material law like a step's, and the internal
+  // forces are recomputed. Velocities are kept.
   void set_configuration(std::vector<Vector3> positions, std::vector<Vector3> directors) {
     if (positions.size() != position_.size() || directors.size() != director_.size())
       detail::invalid_parameter("configuration size", positions.size(), "must equal the particle count");
+    for (std::size_t i = 0; i < positions.size(); ++i) {
+      if (!positions[i].allFinite())
+        detail::invalid_parameter("position of particle " + std::to_string(i), positions[i].transpose(), "must be finite");
+      const double length = directors[i].norm();
+      if (!(length > 0.0) || !std::isfinite(length))
+        detail::invalid_parameter("director length of particle " + std::to_string(i), length, "must be finite and non-zero");
+      directors[i] /= length;
+    }
     position_ = std::move(positions);
     director_ = std::move(directors);
-    for (Vector3& d : director_) d.normalize();
     compute_internal_forces();
   }
 
@@ -355,14 +388,27 @@ class Solver {
   static constexpr int output_points = Section::output_points;
   std::size_t stress_point_count() const { return model_.stress_point_count(); }
   double equivalent_stress(int stress_point, int k) const {
+    check_output_point(stress_point, k);
     return section_.equivalent_stress(state_[stress_point], k);
   }
   double equivalent_plastic_strain(int stress_point, int k) const {
+    check_output_point(stress_point, k);
     return section_.equivalent_plastic_strain(state_[stress_point], k);
   }
-  double damage(int stress_point, int k) const { return section_.damage(state_[stress_point], k); }
-  const StressVoigt& membrane_force(int stress_point) const { return membrane_[stress_point]; }
-  const StressVoigt& bending_moment(int stress_point) const { return moment_[stress_point]; }
+  double damage(int stress_point, int k) const {
+    check_output_point(stress_point, k);
+    return section_.damage(state_[stress_point], k);
+  }
+  // Membrane forces (N/m) and moments (N·m/m) at a stress point, Voigt (xx, yy, xy)
+  // in its reference tangent frame.
+  const StressVoigt& membrane_force(int stress_point) const {
+    check_output_point(stress_point, 0);
+    return membrane_[stress_point];
+  }
+  const StressVoigt& bending_moment(int stress_point) const {
+    check_output_point(stress_point, 0);
+    return moment_[stress_point];
+  }
 
   EnergyReport energy() const {
     EnergyReport report;
@@ -370,9 +416,7 @@ class Solver {
     report.internal = internal_energy_;
     double elastic = 0.0;
     for (std::size_t p = 0; p < state_.size(); ++p)
-      if (active_[p])
-        elastic += membrane_bending_weight_[p] * section_.elastic_energy(state_[p]) +
-                 0.5 * shear_weight_[p] * shear_[p].squaredNorm();
+      if (active_[p]) elastic += stored_energy(p);
     report.elastic = elastic;
     report.plastic_dissipation = internal_energy_ - elastic;
     report.external_work = external_work_;
@@ -399,6 +443,19 @@ class Solver {
     detail::require_nonnegative("particle_shear_weight", options_.particle_shear_weight);
     detail::require_nonnegative("particle_shear_softening", options_.particle_shear_softening);
     detail::require_positive("energy_tolerance", options_.energy_tolerance);
+    detail::require_nonnegative("output_interval", options_.output_interval);
+    detail::require_nonnegative("probe_interval", options_.probe_interval);
+  }
+
+  void check_particle(int particle) const {
+    if (particle < 0 || static_cast<std::size_t>(particle) >= position_.size())
+      detail::invalid_parameter("particle index", particle, "out of range");
+  }
+  void check_output_point(int stress_point, int k) const {
+    if (stress_point < 0 || static_cast<std::size_t>(stress_point) >= model_.stress_point_count())
+      detail::invalid_parameter("stress point index", stress_point, "out of range");
+    if (k < 0 || k >= output_points)
+      detail::invalid_parameter("thickness output point", k, "out of range");
   }
 
   ParticleSet checked(const ParticleSet& set) const {
@@ -411,8 +468,15 @@ class Solver {
 
   template <class Motion>
   void add_motion(const ParticleSet& set, std::unique_ptr<Motion> motion) {
+    const ParticleSet particles = checked(set);
+    for (int i : particles) {
+      const Vector3 v = motion->velocity(i, model_.particle_position[i], time_, time_step_);
+      if (!v.allFinite())
+        detail::invalid_parameter("prescribed motion at particle " + std::to_string(i), v.transpose(),
+                                  "must be finite");
+    }
     const detail::PrescribedMotion* owned = constraints_.own(std::move(motion));
-    for (int i : checked(set)) {
+    for (int i : particles) {
       constraints_.fix_all_translations(i);
       constraints_.add_motion(i, owned);
     }
@@ -465,6 +529,14 @@ class Solver {
       shape_[1] = Approx::build(model_.particle_position, model_.particle_area,
                                 model_.particle_position, frames_[1], smoothing_length_);
 
+    // A row that fell back to the constant approximation has no gradient: the
+    // support is too small for the spacing.
+    for (int group = 0; group < 2; ++group)
+      for (std::size_t row = 0; row < shape_[group].rows(); ++row)
+        if (shape_[group].shepard[row])
+          detail::invalid_parameter("support_radius_factor", options_.support_radius_factor,
+                                    std::string("too few neighbours (fewer than 3) at ") +
+                                        (group == 0 ? "stress point " : "particle ") + std::to_string(row));
     const std::size_t stress_points = model_.stress_point_count();
     const std::size_t particle_points = particles_integrate ? model_.particle_count() : 0;
     point_offset_ = {0, stress_points};
@@ -498,6 +570,7 @@ class Solver {
     membrane_strain_.assign(total, StrainVoigt::Zero());
     curvature_.assign(total, StrainVoigt::Zero());
     shear_.assign(total, Vector2::Zero());
+    shear_force_.assign(total, Vector2::Zero());
     membrane_.assign(total, StressVoigt::Zero());
     moment_.assign(total, StressVoigt::Zero());
     work_increment_.assign(total, 0.0);
@@ -507,19 +580,20 @@ class Solver {
     if constexpr (Crack::enabled) initialize_cracks();
   }
 
-  std::size_t point_count(int group) const {
-    return group == 0 ? shape_[0].rows() : (point_offset_[1] == 0 ? 0 : shape_[1].rows());
-  }
-  std::size_t total_points() const { return state_.size(); }
+  std::size_t point_count(int group) const { return shape_[group].rows(); }
 
   // Maps every particle to the shape-function slots that reference it, so the
   // force gather is a deterministic per-particle sum (no atomics, identical
   // results for any thread count).
+  // Rows keep their capacity when cracks shrink them, so the slot arrays are
+  // sized once; only the map is rebuilt.
   void build_slot_transpose() {
     slot_offset_ = {0, shape_[0].neighbour.size()};
     const std::size_t slots = shape_[0].neighbour.size() + shape_[1].neighbour.size();
-    slot_force_.assign(slots, Vector3::Zero());
-    slot_director_force_.assign(slots, Vector3::Zero());
+    if (slot_force_.size() != slots) {
+      slot_force_.assign(slots, Vector3::Zero());
+      slot_director_force_.assign(slots, Vector3::Zero());
+    }
     std::vector<std::size_t> count(model_.particle_count() + 1, 0);
     auto for_each_slot = [&](auto&& visit) {
       for (int group = 0; group < 2; ++group) {
@@ -552,35 +626,46 @@ class Solver {
     return g;
   }
 
+  shell::Strains strains_of(const shell::SurfaceGradients& current, const shell::SurfaceGradients& reference) const {
+    return options_.nonlinear ? shell::green_strains(current, reference)
+                              : shell::linear_strains(current, reference);
+  }
+
   // Strains → material update → resultants → forces on the slots of one point.
   void integrate_point(int group, std::size_t row) {
     const std::size_t p = point_offset_[group] + row;
     if (!active_[p]) return;
     const shell::SurfaceGradients current = gather(group, row, position_, director_);
-    const shell::SurfaceGradients& reference = reference_[p];
-    const shell::Strains strains = options_.nonlinear ? shell::green_strains(current, reference)
-                                                      : shell::linear_strains(current, reference);
+    const shell::Strains strains = strains_of(current, reference_[p]);
     const StrainVoigt d_membrane = strains.membrane - membrane_strain_[p];
     const StrainVoigt d_curvature = strains.curvature - curvature_[p];
     const Vector2 d_shear = strains.shear - shear_[p];
     const thickness::Resultants resultants = section_.update(state_[p], d_membrane, d_curvature);
+    // The elastic transverse shear force (weighted: shear_weight_ holds κs G d A)
+    // is updated incrementally like the other resultants, so a change of shape
+    // functions (after a crack) leaves it continuous.
+    const Vector2 shear_force = shear_force_[p] + shear_weight_[p] * d_shear;
     const double w = membrane_bending_weight_[p];
-    // Trapezoidal work of the generalized stresses over the strain increment;
-    // the elastic shear force is shear_weight_ × γ (the weight holds κs G d A).
-    work_increment_[p] =
-        w * (0.5 * (membrane_[p] + resultants.membrane).dot(d_membrane) +
-             0.5 * (moment_[p] + resultants.moment).dot(d_curvature)) +
-        shear_weight_[p] * 0.5 * (shear_[p] + strains.shear).dot(d_shear);
+    // Trapezoidal work of the generalized stresses over the strain increment.
+    work_increment_[p] = w * (0.5 * (membrane_[p] + resultants.membrane).dot(d_membrane) +
+                              0.5 * (moment_[p] + resultants.moment).dot(d_curvature)) +
+                         0.5 * (shear_force_[p] + shear_force).dot(d_shear);
     membrane_strain_[p] = strains.membrane;
     curvature_[p] = strains.curvature;
     shear_[p] = strains.shear;
     membrane_[p] = resultants.membrane;
     moment_[p] = resultants.moment;
+    shear_force_[p] = shear_force;
+    scatter_point(group, row, current);
+  }
 
-    const shell::WeightedStresses weighted{w * resultants.membrane, w * resultants.moment,
-                                           shear_weight_[p] * strains.shear};
+  // Forces of one point's stored resultants on the slots of its row (no material update).
+  void scatter_point(int group, std::size_t row, const shell::SurfaceGradients& current) {
+    const std::size_t p = point_offset_[group] + row;
+    const double w = membrane_bending_weight_[p];
+    const shell::WeightedStresses weighted{w * membrane_[p], w * moment_[p], shear_force_[p]};
     const shell::ConjugateForces f =
-        shell::conjugate_forces(options_.nonlinear ? current : reference, weighted);
+        shell::conjugate_forces(options_.nonlinear ? current : reference_[p], weighted);
     const approx::ShapeFunctions& shape = shape_[group];
     const std::size_t end = shape.row_begin[row] + shape.row_size[row];
     for (std::size_t s = shape.row_begin[row]; s < end; ++s) {
@@ -588,6 +673,27 @@ class Solver {
       slot_force_[slot] = shape.dphi_d1[s] * f.a1 + shape.dphi_d2[s] * f.a2;
       slot_director_force_[slot] = shape.phi[s] * f.n + shape.dphi_d1[s] * f.n1 + shape.dphi_d2[s] * f.n2;
     }
+  }
+
+  // Deterministic per-particle sums of the slot forces.
+  void gather_particle_forces() {
+    const long particles = static_cast<long>(model_.particle_count());
+#pragma omp parallel for schedule(static)
+    for (long i = 0; i < particles; ++i) {
+      Vector3 force = Vector3::Zero(), director_force = Vector3::Zero();
+      for (std::size_t k = particle_slot_begin_[i]; k < particle_slot_begin_[i + 1]; ++k) {
+        force += slot_force_[particle_slots_[k]];
+        director_force += slot_director_force_[particle_slots_[k]];
+      }
+      internal_force_[i] = force;
+      internal_director_force_[i] = director_force;
+    }
+  }
+
+  // Elastic energy held by one integration point (membrane, bending, shear).
+  double stored_energy(std::size_t p) const {
+    const double shear = shear_weight_[p] > 0.0 ? 0.5 * shear_force_[p].squaredNorm() / shear_weight_[p] : 0.0;
+    return membrane_bending_weight_[p] * section_.elastic_energy(state_[p]) + shear;
   }
 
   void compute_internal_forces() {
@@ -609,21 +715,13 @@ class Solver {
           }
         }
       }
+      // The points before the failure are already updated: the solver cannot
+      // continue after this error.
       if (failed_row < rows)
         fail_unstable(std::string(group == 0 ? "stress point " : "particle ") + std::to_string(failed_row) +
                       ": " + failure);
     }
-    const long particles = static_cast<long>(model_.particle_count());
-#pragma omp parallel for schedule(static)
-    for (long i = 0; i < particles; ++i) {
-      Vector3 force = Vector3::Zero(), director_force = Vector3::Zero();
-      for (std::size_t k = particle_slot_begin_[i]; k < particle_slot_begin_[i + 1]; ++k) {
-        force += slot_force_[particle_slots_[k]];
-        director_force += slot_director_force_[particle_slots_[k]];
-      }
-      internal_force_[i] = force;
-      internal_director_force_[i] = director_force;
-    }
+    gather_particle_forces();
     previous_internal_energy_ = internal_energy_;
     for (double work : work_increment_) internal_energy_ += work;
     std::fill(work_increment_.begin(), work_increment_.end(), 0.0);
@@ -635,6 +733,10 @@ class Solver {
     detail::LoadContext context{t, model_.particle_position, model_.particle_normal, director_,
                                 model_.particle_area, external_force_};
     for (const auto& load : loads_) load->apply(context);
+    for (std::size_t i = 0; i < external_force_.size(); ++i)
+      if (!external_force_[i].allFinite())
+        fail_unstable("non-finite external load at particle " + std::to_string(i) +
+                      " (a pressure or force function returned NaN or infinity)");
   }
 
   // v^{n+½} = v^{n−½} + dt M⁻¹ (f_ext − f_int) with mass-proportional damping
@@ -649,9 +751,9 @@ class Solver {
     for (std::size_t i = 0; i < n; ++i) {
       const Vector3 force = external_force_[i] - internal_force_[i];
       velocity_[i] = keep * velocity_[i] + gain * force / mass_[i];
-      // Moment of the director forces: δΠ = g·δd with δd = δθ × d gives d × g.
+      // δΠ = g·δd with δd = δθ × d gives ∂Π/∂θ = d × g, so the moment is −d × g.
       const Vector3 moment = -director_[i].cross(internal_director_force_[i]);
-      Vector3 omega = keep * angular_velocity_[i] + gain * moment / rotary_inertia_[i];
+      const Vector3 omega = keep * angular_velocity_[i] + gain * moment / rotary_inertia_[i];
       angular_velocity_[i] = omega - omega.dot(director_[i]) * director_[i];  // no drilling
     }
     // Velocity the unconstrained update produced, for the reaction work below.
@@ -660,13 +762,22 @@ class Solver {
     for (std::size_t k = 0; k < constraints_.particles().size(); ++k) {
       const int i = constraints_.particles()[k];
       const detail::ParticleConstraint& constraint = constraints_.at(k);
+      // The position update always spans time_step_ (also on the half-step
+      // start-up of the velocities), so the imposed velocity does too.
       Vector3 prescribed = Vector3::Zero();
       for (const detail::PrescribedMotion* motion : constraint.motions)
-        prescribed += motion->velocity(i, model_.particle_position[i], time_, dt);
+        prescribed += motion->velocity(i, model_.particle_position[i], time_, time_step_);
+      if (!prescribed.allFinite())
+        fail_unstable("prescribed motion of particle " + std::to_string(i) + " is not finite");
       velocity_[i] = constraint.free_translation * velocity_[i] +
                      (Matrix3::Identity() - constraint.free_translation) * prescribed;
-      const Vector3 omega = constraint.free_rotation * angular_velocity_[i];
-      angular_velocity_[i] = omega - omega.dot(director_[i]) * director_[i];
+      // Project onto the free rotations and the plane normal to the director at
+      // once: projecting one after the other would let the drilling removal
+      // reintroduce a fixed component when the director is tilted.
+      Matrix3 free = constraint.free_rotation;
+      const Vector3 drilling = free * director_[i];
+      if (drilling.squaredNorm() > 1e-24) free -= drilling * drilling.transpose() / drilling.squaredNorm();
+      angular_velocity_[i] = free * angular_velocity_[i];
     }
     // Energy: the work of each force over the step is f · dt · (v^{n−½} + v^{n+½})/2.
     double external = 0.0, damping = 0.0, kinetic = 0.0;
@@ -717,7 +828,7 @@ class Solver {
     const double E = law_.youngs_modulus(), nu = law_.poisson_ratio();
     const double rho = options_.density, d = model_.thickness();
     const double G = E / (2.0 * (1.0 + nu));
-    const double spacing = model_.minimum_spacing();
+    const double spacing = std::min(model_.minimum_spacing(), nearest_particle_distance());
     const double membrane_speed_squared = E / (rho * (1.0 - nu * nu));
     const double shear_speed_squared = options_.shear_correction * G / rho;
     const double membrane = 9.0 * membrane_speed_squared / (spacing * spacing);
@@ -730,7 +841,6 @@ class Solver {
   void write_scheduled_output() {
     const double tolerance = 1e-9 * time_step_;
     if (!options_.output_directory.empty() && options_.output_interval > 0.0) {
-      if (frames_written_ == 0) write_frame_at_start();
       if (time_ >= next_frame_time_ - tolerance) {
         write_frame();
         next_frame_time_ += options_.output_interval * std::max(1.0, std::floor((time_ - next_frame_time_) / options_.output_interval + 1.0));
@@ -740,18 +850,6 @@ class Solver {
       for (Probe& probe : probes_) write_probe(probe);
       next_probe_time_ = time_ + options_.probe_interval;
     }
-  }
-
-  // The first frame shows the reference configuration at t = 0.
-  void write_frame_at_start() {
-    const std::vector<Vector3> current = position_;
-    const double t = time_;
-    time_ = 0.0;
-    position_ = model_.particle_position;
-    write_frame();
-    position_ = current;
-    time_ = t;
-    next_frame_time_ = options_.output_interval;
   }
 
   struct Probe {
@@ -890,10 +988,9 @@ class Solver {
   // Removes an integration point from the force integration, keeping its
   // stored elastic energy in the books as released.
   void deactivate(std::size_t p) {
-    released_energy_ += membrane_bending_weight_[p] * section_.elastic_energy(state_[p]) +
-                        0.5 * shear_weight_[p] * shear_[p].squaredNorm();
+    released_energy_ += stored_energy(p);
     active_[p] = 0;
-    const int group = p < point_offset_[1] || point_offset_[1] == 0 ? 0 : 1;
+    const int group = p < point_offset_[1] ? 0 : 1;
     const std::size_t row = p - point_offset_[group];
     const approx::ShapeFunctions& shape = shape_[group];
     for (std::size_t s = shape.row_begin[row]; s < shape.row_begin[row + 1]; ++s) {
@@ -908,13 +1005,20 @@ class Solver {
   // damaged become fragments (design.md §2.6).
   void update_cracks() {
     std::vector<int> newly_damaged;
+    bool removed_particle_point = false;
     for (std::size_t p = 0; p < model_.stress_point_count(); ++p)
       if (active_[p] && section_.all_failed(state_[p])) newly_damaged.push_back(static_cast<int>(p));
     for (std::size_t i = 0; i < point_count(1); ++i) {
       const std::size_t p = point_offset_[1] + i;
-      if (active_[p] && section_.all_failed(state_[p])) deactivate(p);
+      if (active_[p] && section_.all_failed(state_[p])) {
+        deactivate(p);
+        removed_particle_point = true;
+      }
     }
-    if (newly_damaged.empty()) return;
+    if (newly_damaged.empty()) {
+      if (removed_particle_point) gather_particle_forces();
+      return;
+    }
     for (int p : newly_damaged) deactivate(static_cast<std::size_t>(p));
     damaged_stress_points_ += newly_damaged.size();
     const auto segments = crack_.add_damaged_stress_points(newly_damaged);
@@ -924,8 +1028,8 @@ class Solver {
         if (!fragment_[corner] && all_damaged_around(corner)) {
           fragment_[corner] = 1;
           new_fragments.push_back(corner);
+          if (point_count(1) > 0 && active_[point_offset_[1] + corner]) deactivate(point_offset_[1] + corner);
         }
-    if (segments.empty() && new_fragments.empty()) return;
     rebuild_near_segments(segments, new_fragments);
   }
 
@@ -979,24 +1083,45 @@ class Solver {
           deactivate(p);  // nothing visible is left: the point is cut loose
           continue;
         }
+        if (shape_[group].shepard[row]) {
+          deactivate(p);  // no gradient left: the point can carry no strain
+          continue;
+        }
         reference_[p] = gather(group, row, model_.particle_position, model_.particle_normal);
         const shell::SurfaceGradients current = gather(group, row, position_, director_);
-        const shell::Strains strains = options_.nonlinear ? shell::green_strains(current, reference_[p])
-                                                          : shell::linear_strains(current, reference_[p]);
+        const shell::Strains strains = strains_of(current, reference_[p]);
         membrane_strain_[p] = strains.membrane;
         curvature_[p] = strains.curvature;
         shear_[p] = strains.shear;
+        for (std::size_t s = shape_[group].row_begin[row]; s < shape_[group].row_begin[row + 1]; ++s) {
+          slot_force_[slot_offset_[group] + s].setZero();
+          slot_director_force_[slot_offset_[group] + s].setZero();
+        }
+        scatter_point(group, row, current);
       }
     }
     build_slot_transpose();
-    forces_current_ = false;
-    compute_internal_forces();
+    gather_particle_forces();
+  }
+
+  // Smallest distance between two particles: on distorted grids (the corners
+  // of a spherical cap) it is shorter than the square root of the cell area.
+  double nearest_particle_distance() const {
+    const double reach = 2.0 * model_.maximum_spacing();
+    const approx::CellList cells(model_.particle_position, reach);
+    double nearest = reach;
+    for (std::size_t i = 0; i < model_.particle_count(); ++i)
+      cells.for_each_within(model_.particle_position[i], reach, [&](int j, double distance_squared) {
+        if (static_cast<std::size_t>(j) != i) nearest = std::min(nearest, std::sqrt(distance_squared));
+      });
+    return nearest;
   }
 
   void check_configuration() const {
     const std::size_t n = position_.size();
     for (std::size_t i = 0; i < n; ++i)
-      if (!position_[i].allFinite() || !director_[i].allFinite() || !velocity_[i].allFinite())
+      if (!position_[i].allFinite() || !director_[i].allFinite() || !velocity_[i].allFinite() ||
+          !angular_velocity_[i].allFinite())
         fail_unstable("non-finite state at particle " + std::to_string(i) + " (external force " +
                       to_string(external_force_[i].norm()) + " N, internal force " +
                       to_string(internal_force_[i].norm()) + " N)");
@@ -1057,7 +1182,7 @@ class Solver {
   std::vector<shell::SurfaceGradients> reference_;
   std::vector<SectionState> state_;
   std::vector<StrainVoigt> membrane_strain_, curvature_;
-  std::vector<Vector2> shear_;
+  std::vector<Vector2> shear_, shear_force_;
   std::vector<StressVoigt> membrane_, moment_;
   std::vector<double> work_increment_;
   std::vector<unsigned char> active_;    // per integration point: still integrates forces

@@ -16,9 +16,9 @@
 
 namespace sphshell::detail {
 
-// Prescribed motion of a set of particles: the velocity to impose along
-// `direction` (or the full velocity when direction is zero) at time t over the
-// step dt, given the particle's reference position.
+// Prescribed motion of a particle: the velocity to impose on its fixed
+// translation subspace over the step from t to t + dt, given its reference
+// position.
 class PrescribedMotion {
  public:
   virtual ~PrescribedMotion() = default;
@@ -57,7 +57,7 @@ class PrescribedVelocity final : public PrescribedMotion {
 struct ParticleConstraint {
   Matrix3 free_translation = Matrix3::Identity();
   Matrix3 free_rotation = Matrix3::Identity();
-  std::vector<const PrescribedMotion*> motions;  // summed, each projected on the fixed subspace
+  std::vector<const PrescribedMotion*> motions;  // summed, then projected on the fixed subspace
 };
 
 class Constraints {
@@ -98,7 +98,7 @@ class Constraints {
       invalid_parameter(name, direction.transpose(), "must be finite and non-zero");
     const Vector3 projected = free * direction.normalized();
     const double length = projected.norm();
-    if (length < 1e-12) return;  // already fixed
+    if (length < 1e-8) return;  // (numerically) already fixed
     const Vector3 c = projected / length;
     free -= c * c.transpose();
   }

@@ -23,7 +23,7 @@ struct Step {
 };
 // f(t) rises linearly from 0 at t_start to 1 at t_start + rise_time, then stays 1.
 struct Ramp {
-  double rise_time;
+  double rise_time = 0.0;  // s; 0 makes it a step at t_start
   double t_start = 0.0;
   double operator()(double t) const {
     if (t <= t_start) return 0.0;
@@ -42,7 +42,9 @@ namespace detail {
 
 // Sign convention: a positive pressure acts on the face the normal points out
 // of and pushes the shell against its normal, f = −p A n (for a spherical cap
-// with outward normals, positive pressure is inward).
+// with outward normals, positive pressure is inward). A is the reference area
+// of the particle. A point force applies its full value to every particle of
+// its set.
 struct LoadContext {
   double time;
   const std::vector<Vector3>& reference_position;
