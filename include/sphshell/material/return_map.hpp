@@ -38,6 +38,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <sstream>
 
@@ -66,11 +68,13 @@ struct ClosedFormConstants {
         plastic_modulus(plastic_modulus),
         inverse_max_slope(1.0 / std::max(slope_1, slope_2)),
         inverse_min_slope(1.0 / std::min(slope_1, slope_2)),
-        inverse_slope_2(1.0 / slope_2) {}
+        inverse_slope_2(1.0 / slope_2),
+        slope_difference(slope_2 - slope_1) {}
   double kappa_1, kappa_2;  // eigenvalues of ΓΞ: E/(2(1−ν)) and 3G
   double slope_1, slope_2;  // κᵢ + Ep
   double plastic_modulus;
   double inverse_max_slope, inverse_min_slope, inverse_slope_2;
+  double slope_difference;  // slope₂ − slope₁ = κ₂ − κ₁
 };
 
 namespace detail {
@@ -108,10 +112,11 @@ namespace detail {
 // replaced by bisection (or doubling), so convergence never hinges on the
 // initial value. The kernel arrives evaluated at `increment` and is left
 // evaluated at the returned Δε̄p. Returns the number of corrections applied.
+// `iterations` and `distrust_newton` let a caller that has already applied
+// corrections itself (the closed form's fast path) continue exactly where it stopped.
 template <class Kernel>
-inline int solve_safeguarded(Kernel& kernel, double& increment, double lower, double upper) {
-  bool distrust_newton = false;
-  int iterations = 0;
+inline int solve_safeguarded(Kernel& kernel, double& increment, double lower, double upper,
+                             int iterations = 0, bool distrust_newton = false) {
   while (!(std::abs(kernel.relative_yield_residual()) <= relative_tolerance)) {
     if (kernel.relative_yield_residual() > 0.0)
       lower = increment;
@@ -313,8 +318,11 @@ class GenericKernel {
 
 }  // namespace detail
 
-inline Solution closed_form(const ClosedFormConstants& constants, const StressVoigt& trial,
-                            double yield_stress, const ReturnMapOptions& options = {}) {
+namespace detail {
+
+// Every option combination, through the kernel: the reference path of the closed form.
+inline Solution closed_form_general(const ClosedFormConstants& constants, const StressVoigt& trial,
+                                   double yield_stress, const ReturnMapOptions& options) {
   detail::ClosedFormKernel kernel(constants, trial, yield_stress, options.newton_function);
   const double excess = kernel.trial_equivalent() - yield_stress;
   // A trial stress on or inside the surface (callers check first; this catches round-off) needs no
@@ -351,6 +359,175 @@ inline Solution closed_form(const ClosedFormConstants& constants, const StressVo
                                            std::max(kernel.upper_bound(excess), increment));
   }
   return Solution{kernel.stress(), increment, iterations};
+}
+
+// The fast path's way out when anything is unusual: the same solve from scratch.
+[[gnu::noinline, gnu::cold]] inline Solution closed_form_fallback(
+    const ClosedFormConstants& constants, const StressVoigt& trial, double yield_stress) {
+  return closed_form_general(constants, trial, yield_stress, ReturnMapOptions{});
+}
+
+// The fast path's continuation when one correction did not reach the tolerance:
+// the safeguarded iteration picks up with the same bracket, count and trust flag.
+[[gnu::noinline, gnu::cold]] inline Solution closed_form_continue(
+    const ClosedFormConstants& constants, const StressVoigt& trial, double yield_stress,
+    double increment, double lower, double upper, bool distrust_newton) {
+  ClosedFormKernel kernel(constants, trial, yield_stress, NewtonFunction::normalized);
+  kernel.evaluate(increment);
+  const int iterations =
+      solve_safeguarded(kernel, increment, lower, upper, /*iterations=*/1, distrust_newton);
+  return Solution{kernel.stress(), increment, iterations};
+}
+
+// A power of two close to 1/x (x finite, > 0): scaling by it is exact and keeps
+// the products below in range whatever the unit system.
+inline double power_of_two_near_reciprocal(double x) {
+  static_assert(std::numeric_limits<double>::is_iec559 && sizeof(double) == sizeof(std::uint64_t));
+  std::uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  const std::uint64_t exponent = std::clamp<std::uint64_t>((bits >> 52) & 0x7ffu, 1u, 2045u);
+  const std::uint64_t reciprocal_bits = (2046u - exponent) << 52;
+  double reciprocal;
+  std::memcpy(&reciprocal, &reciprocal_bits, sizeof reciprocal);
+  return reciprocal;
+}
+
+// Above this |ε₀| the series for the first correction is not used (the general path takes over).
+inline constexpr double series_limit = 1.0 / 4096.0;
+// Above this |slopeᵢ·correction/uᵢ| the reciprocals at the corrected Δε̄p come from a division.
+inline constexpr double reciprocal_series_limit = 1.0 / 128.0;
+
+// The default options (Appendix-B start, φ, converged, safeguarded), with the
+// same arithmetic as closed_form_general reorganized so that the dependency
+// chain from the trial stress to the returned stress holds one square root and
+// two divisions instead of two square roots and three divisions:
+// - The start Δε̄p⁰ = excess·σ̄*²/D (D = slope₁A + slope₂B) is used in fraction
+//   form uᵢ = nᵢ/D (as evaluate_fraction), with nᵢ = σs,n(D − slopeᵢσ̄*²) +
+//   slopeᵢσ̄*²·σ̄* so the square root feeds one multiply-add; D and nᵢ are scaled
+//   by an exact power of two λ ≈ 1/D.
+// - At the start S² = (λD)²N/M with N = An₂² + Bn₁², M = (n₁n₂)², and
+//   dS²/dΔε̄p = −2(λD)³Y/(n₁n₂)³ with Y = A·slope₁n₂³ + B·slope₂n₁³. The φ-Newton
+//   correction −2S²(S − 1)/dS² = q(ε)·(n₁n₂)³/(2(λD)³Y) with ε = S² − 1 and
+//   q(ε) = 2(1 + ε)(√(1 + ε) − 1) = ε + ¾ε² − ⅛ε³ + 3/64 ε⁴ − 3/128 ε⁵ + …; for
+//   |ε| ≤ 2⁻¹⁰ the truncation after ε⁴ changes the correction by < 3e-17
+//   relative, so no second square root; the reciprocals of M and Y run in parallel.
+// - The convergence test |g| ≤ tol·σs² at the new Δε̄p is the one of the
+//   kernel (S² − 1 from the same 1/(u₁u₂)), and the returned stress is formed
+//   from products prepared while that division runs.
+// The safeguards are those of solve_safeguarded: the analytic bracket, updated
+// by the sign of g at the start, the collapse test, and the Newton step only
+// accepted strictly inside it. Anything else — a start already within the
+// tolerance, |ε₀| above the series limit, a step outside the bracket, a
+// non-finite intermediate — leaves for closed_form_general, which then runs the
+// very same iteration from scratch; a correction that misses the tolerance
+// continues in solve_safeguarded with the same bracket and counters.
+inline Solution closed_form_default(const ClosedFormConstants& constants, const StressVoigt& trial,
+                                   double yield_stress) {
+  const double sum = trial.x() + trial.y();
+  const double diff = trial.x() - trial.y();
+  const double shear = trial.z();
+  const double equibiaxial = 0.25 * sum * sum;                          // A
+  const double deviatoric = 0.75 * diff * diff + 3.0 * shear * shear;  // B
+  const double trial_squared = von_mises_squared(trial);               // σ̄*² = A + B
+  const double trial_equivalent = std::sqrt(trial_squared);
+  const double excess = trial_equivalent - yield_stress;
+  if (!(excess > 0.0)) {
+    if (!std::isfinite(excess)) throw_non_finite_trial(trial, yield_stress);
+    return Solution{trial, 0.0, 0};
+  }
+  const double slope_1 = constants.slope_1, slope_2 = constants.slope_2;
+  // Off the square root's path: the scaled denominator and the nᵢ coefficients.
+  const double denominator = slope_1 * equibiaxial + slope_2 * deviatoric;
+  const double scale = power_of_two_near_reciprocal(denominator);
+  const double scaled_denominator = denominator * scale;
+  const double weight_1 = slope_1 * trial_squared * scale;
+  const double weight_2 = slope_2 * trial_squared * scale;
+  const double base_1 = yield_stress * (constants.slope_difference * deviatoric * scale);
+  const double base_2 = -yield_stress * (constants.slope_difference * equibiaxial * scale);
+  const double start = excess * trial_squared / denominator;  // eq. (B.8), Δε̄p⁰
+  // uᵢ(Δε̄p⁰)·λD:
+  const double n1 = base_1 + weight_1 * trial_equivalent;
+  const double n2 = base_2 + weight_2 * trial_equivalent;
+  const double product = n1 * n2;
+  const double n1_squared = n1 * n1, n2_squared = n2 * n2;
+  const double m = product * product;
+  const double inverse_m = 1.0 / m;
+  const double denominator_squared = scaled_denominator * scaled_denominator;
+  const double twice_denominator_cubed = 2.0 * denominator_squared * scaled_denominator;
+  const double c1 = twice_denominator_cubed * equibiaxial * slope_1;
+  const double c2 = twice_denominator_cubed * deviatoric * slope_2;
+  const double inverse_y = 1.0 / (c1 * (n2_squared * n2) + c2 * (n1_squared * n1));  // 1/(2(λD)³Y)
+  // ε₀·M, from the nᵢ themselves.
+  const double residual_0_numerator = (denominator_squared * equibiaxial) * n2_squared +
+                                      (denominator_squared * deviatoric) * n1_squared - m;
+  const double residual_0 = residual_0_numerator * inverse_m;  // ε₀
+  if (!(std::abs(residual_0) > relative_tolerance && std::abs(residual_0) <= series_limit))
+    return closed_form_fallback(constants, trial, yield_stress);
+  // Bracket of solve_safeguarded's first pass.
+  double lower = std::min(excess * constants.inverse_max_slope, start);
+  double upper = std::max(excess * constants.inverse_min_slope, start);
+  if (residual_0 > 0.0)
+    lower = start;
+  else
+    upper = start;
+  // −2S²(S − 1)/dS² = q(ε)/ε · ε₀M·n₁n₂/(2(λD)³Y) with q(ε)/ε = 1 + ¾ε − ⅛ε² + 3/64 ε³ − …;
+  // the dropped terms are < 7e-13 of the correction for |ε| ≤ 2⁻¹², which moves the new
+  // residual by < 4e-16.
+  const double first_order = (residual_0_numerator * product) * inverse_y;
+  const double series = (1.0 + (0.75 * residual_0_numerator) * inverse_m) -
+                        (0.125 * residual_0_numerator * residual_0_numerator) *
+                            (inverse_m * inverse_m);
+  const double correction = first_order * series;
+  const double increment = start + correction;
+  if (!(upper - lower > 4.0 * std::numeric_limits<double>::epsilon() * upper && increment > lower &&
+        increment < upper))
+    return closed_form_fallback(constants, trial, yield_stress);
+  // Evaluation at Δε̄p¹ (ClosedFormKernel::evaluate). 1/uᵢ(Δε̄p¹) follows from
+  // 1/uᵢ(Δε̄p⁰) = λD·n_j·n₁n₂/M without a division: with xᵢ = slopeᵢ·correction/uᵢ(Δε̄p⁰),
+  // 1/uᵢ(Δε̄p¹) = 1/uᵢ(Δε̄p⁰)·(1 − xᵢ)(1 + xᵢ²)(1 + xᵢ⁴)·(1 − xᵢ⁸/(1 + xᵢ)), and for
+  // |xᵢ| ≤ 2⁻⁷ the last factor is 1 to below 1e-16 (larger xᵢ: a division).
+  const double sigma_s = yield_stress + constants.plastic_modulus * increment;
+  const double inverse_u1_start = (scaled_denominator * n2 * product) * inverse_m;
+  const double inverse_u2_start = (scaled_denominator * n1 * product) * inverse_m;
+  const double x1 = (slope_1 * inverse_u1_start) * correction;
+  const double x2 = (slope_2 * inverse_u2_start) * correction;
+  double inverse_u1, inverse_u2;
+  if (std::abs(x1) <= reciprocal_series_limit && std::abs(x2) <= reciprocal_series_limit) {
+    const double x1_squared = x1 * x1, x2_squared = x2 * x2;
+    inverse_u1 = inverse_u1_start *
+                 (((1.0 - x1) * (1.0 + x1_squared)) * (1.0 + x1_squared * x1_squared));
+    inverse_u2 = inverse_u2_start *
+                 (((1.0 - x2) * (1.0 + x2_squared)) * (1.0 + x2_squared * x2_squared));
+  } else {
+    const double u1 = yield_stress + slope_1 * increment;
+    const double u2 = yield_stress + slope_2 * increment;
+    const double inverse_product = 1.0 / (u1 * u2);
+    inverse_u1 = u2 * inverse_product;
+    inverse_u2 = u1 * inverse_product;
+  }
+  const double residual_1 =
+      (equibiaxial * inverse_u1 * inverse_u1 + deviatoric * inverse_u2 * inverse_u2) - 1.0;
+  if (!(std::abs(residual_1) <= relative_tolerance))
+    return closed_form_continue(constants, trial, yield_stress, increment, lower, upper,
+                                std::abs(residual_1) > 0.5 * std::abs(residual_0));
+  // σ = L⁻¹σ*: each eigen-component scaled by σs/uᵢ.
+  const double half_sigma_s = 0.5 * sigma_s;
+  const double returned_half_sum = (sum * half_sigma_s) * inverse_u1;
+  const double returned_half_diff = (diff * half_sigma_s) * inverse_u2;
+  return Solution{StressVoigt(returned_half_sum + returned_half_diff,
+                              returned_half_sum - returned_half_diff,
+                              (shear * sigma_s) * inverse_u2),
+                  increment, 1};
+}
+
+}  // namespace detail
+
+inline Solution closed_form(const ClosedFormConstants& constants, const StressVoigt& trial,
+                            double yield_stress, const ReturnMapOptions& options = {}) {
+  if (options.initial_guess == InitialGuess::appendix_b && options.fixed_iterations <= 0 &&
+      options.newton_function == NewtonFunction::normalized)
+    return detail::closed_form_default(constants, trial, yield_stress);
+  return detail::closed_form_general(constants, trial, yield_stress, options);
 }
 
 inline Solution closed_form(const PlaneStressElasticity& elasticity, const StressVoigt& trial,
