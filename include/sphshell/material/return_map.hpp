@@ -38,8 +38,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
-#include <cstring>
 #include <limits>
 #include <sstream>
 
@@ -379,48 +377,34 @@ inline Solution closed_form_general(const ClosedFormConstants& constants, const 
   return Solution{kernel.stress(), increment, iterations};
 }
 
-// A power of two close to 1/x (x finite, > 0): scaling by it is exact and keeps
-// the products below in range whatever the unit system.
-inline double power_of_two_near_reciprocal(double x) {
-  static_assert(std::numeric_limits<double>::is_iec559 && sizeof(double) == sizeof(std::uint64_t));
-  std::uint64_t bits;
-  std::memcpy(&bits, &x, sizeof bits);
-  const std::uint64_t exponent = std::clamp<std::uint64_t>((bits >> 52) & 0x7ffu, 1u, 2045u);
-  const std::uint64_t reciprocal_bits = (2046u - exponent) << 52;
-  double reciprocal;
-  std::memcpy(&reciprocal, &reciprocal_bits, sizeof reciprocal);
-  return reciprocal;
-}
-
 // Above this |ε₀| the series for the first correction is not used (the general path takes over).
 inline constexpr double series_limit = 1.0 / 4096.0;
 // Above this |slopeᵢ·correction/uᵢ| the reciprocals at the corrected Δε̄p come from a division.
-inline constexpr double reciprocal_series_limit = 1.0 / 128.0;
+inline constexpr double reciprocal_series_limit = 1.0 / 8192.0;
 
 // The default options (Appendix-B start, φ, converged, safeguarded), with the
-// same arithmetic as closed_form_general reorganized so that the dependency
-// chain from the trial stress to the returned stress holds one square root and
-// two divisions instead of two square roots and three divisions:
-// - The start Δε̄p⁰ = excess·σ̄*²/D (D = slope₁A + slope₂B) is used in fraction
-//   form uᵢ = nᵢ/D (as evaluate_fraction), with nᵢ = σs,n(D − slopeᵢσ̄*²) +
-//   slopeᵢσ̄*²·σ̄* so the square root feeds one multiply-add; D and nᵢ are scaled
-//   by an exact power of two λ ≈ 1/D.
-// - At the start S² = (λD)²N/M with N = An₂² + Bn₁², M = (n₁n₂)², and
-//   dS²/dΔε̄p = −2(λD)³Y/(n₁n₂)³ with Y = A·slope₁n₂³ + B·slope₂n₁³. The φ-Newton
-//   correction −2S²(S − 1)/dS² = q(ε)·(n₁n₂)³/(2(λD)³Y) with ε = S² − 1 and
-//   q(ε) = 2(1 + ε)(√(1 + ε) − 1) = ε + ¾ε² − ⅛ε³ + 3/64 ε⁴ − 3/128 ε⁵ + …; for
-//   |ε| ≤ 2⁻¹⁰ the truncation after ε⁴ changes the correction by < 3e-17
-//   relative, so no second square root; the reciprocals of M and Y run in parallel.
-// - The convergence test |g| ≤ tol·σs² at the new Δε̄p is the one of the
-//   kernel (S² − 1 from the same 1/(u₁u₂)), and the returned stress is formed
-//   from products prepared while that division runs.
+// same equations as closed_form_general reorganized so that the dependency chain
+// from the trial stress to the returned stress holds one square root and two
+// divisions side by side instead of two square roots and three divisions in a row:
+// - uᵢ(Δε̄p⁰) = σs,n + slopeᵢΔε̄p⁰ at the start Δε̄p⁰ = excess·σ̄*²/D (eq. B.8,
+//   D = slope₁A + slope₂B) is written as a multiply-add in σ̄*, with 1/D taken
+//   while the square root runs.
+// - At the start, ε₀ = S² − 1 = (Au₂² + Bu₁² − M)/M with M = (u₁u₂)², and
+//   dS²/dΔε̄p = −2Y/(u₁u₂)³ with Y = A·slope₁u₂³ + B·slope₂u₁³. The φ-Newton
+//   correction −2S²(S − 1)/dS² = q(ε)·(u₁u₂)³/(2Y), q(ε) = 2(1 + ε)(√(1 + ε) − 1)
+//   = ε(1 + ¾ε − ⅛ε² + …), is taken from the series (|ε| ≤ 2⁻¹²), so no second
+//   square root; its one division runs alongside 1/M.
+// - 1/uᵢ at the corrected Δε̄p¹ follow from 1/uᵢ(Δε̄p⁰) by a series in
+//   xᵢ = slopeᵢ·correction/uᵢ(Δε̄p⁰) (a division when |xᵢ| > 2⁻¹³); the convergence
+//   test is the kernel's, |S² − 1| ≤ tol at Δε̄p¹, and the returned stress is
+//   σs/uᵢ times the trial components, as in ClosedFormKernel::stress().
 // The safeguards are those of solve_safeguarded: the analytic bracket, updated
 // by the sign of g at the start, the collapse test, and the Newton step only
 // accepted strictly inside it. Anything else — a start already within the
 // tolerance, |ε₀| above the series limit, a step outside the bracket, a
-// non-finite intermediate — leaves for closed_form_general, which then runs the
-// very same iteration from scratch; a correction that misses the tolerance
-// continues in solve_safeguarded with the same bracket and counters.
+// non-finite or out-of-range intermediate — leaves for closed_form_general,
+// which then runs the very same iteration from scratch; a correction that misses
+// the tolerance continues in solve_safeguarded with the same bracket and counters.
 inline Solution closed_form_default(const ClosedFormConstants& constants, const StressVoigt& trial,
                                    double yield_stress) {
   const double sum = trial.x() + trial.y();
@@ -428,7 +412,7 @@ inline Solution closed_form_default(const ClosedFormConstants& constants, const 
   const double shear = trial.z();
   const double equibiaxial = 0.25 * sum * sum;                          // A
   const double deviatoric = 0.75 * diff * diff + 3.0 * shear * shear;  // B
-  const double trial_squared = von_mises_squared(trial);               // σ̄*² = A + B
+  const double trial_squared = equibiaxial + deviatoric;               // σ̄*²
   const double trial_equivalent = std::sqrt(trial_squared);
   const double excess = trial_equivalent - yield_stress;
   if (!(excess > 0.0)) {
@@ -436,31 +420,26 @@ inline Solution closed_form_default(const ClosedFormConstants& constants, const 
     return Solution{trial, 0.0, 0};
   }
   const double slope_1 = constants.slope_1, slope_2 = constants.slope_2;
-  // Off the square root's path: the scaled denominator and the nᵢ coefficients.
-  const double denominator = slope_1 * equibiaxial + slope_2 * deviatoric;
-  const double scale = power_of_two_near_reciprocal(denominator);
-  const double scaled_denominator = denominator * scale;
-  const double weight_1 = slope_1 * trial_squared * scale;
-  const double weight_2 = slope_2 * trial_squared * scale;
-  const double base_1 = yield_stress * (constants.slope_difference * deviatoric * scale);
-  const double base_2 = -yield_stress * (constants.slope_difference * equibiaxial * scale);
-  const double start = excess * trial_squared / denominator;  // eq. (B.8), Δε̄p⁰
-  // uᵢ(Δε̄p⁰)·λD:
-  const double n1 = base_1 + weight_1 * trial_equivalent;
-  const double n2 = base_2 + weight_2 * trial_equivalent;
-  const double product = n1 * n2;
-  const double n1_squared = n1 * n1, n2_squared = n2 * n2;
+  // Off the square root's path: 1/D and the coefficients of uᵢ(Δε̄p⁰) as functions of σ̄*.
+  const double inverse_denominator = 1.0 / (slope_1 * equibiaxial + slope_2 * deviatoric);
+  const double scaled_trial_squared = trial_squared * inverse_denominator;
+  const double start = excess * scaled_trial_squared;  // eq. (B.8), Δε̄p⁰
+  // uᵢ(Δε̄p⁰) = σs,n + slopeᵢΔε̄p⁰ = σs,n(1 − slopeᵢσ̄*²/D) + (slopeᵢσ̄*²/D)·σ̄*, with
+  // 1 − slope₁σ̄*²/D = (slope₂ − slope₁)B/D and 1 − slope₂σ̄*²/D = −(slope₂ − slope₁)A/D.
+  const double difference_scaled = constants.slope_difference * inverse_denominator * yield_stress;
+  const double u1 = difference_scaled * deviatoric + (slope_1 * scaled_trial_squared) * trial_equivalent;
+  const double u2 = (slope_2 * scaled_trial_squared) * trial_equivalent - difference_scaled * equibiaxial;
+  const double product = u1 * u2;
+  const double u1_squared = u1 * u1, u2_squared = u2 * u2;
   const double m = product * product;
   const double inverse_m = 1.0 / m;
-  const double denominator_squared = scaled_denominator * scaled_denominator;
-  const double twice_denominator_cubed = 2.0 * denominator_squared * scaled_denominator;
-  const double c1 = twice_denominator_cubed * equibiaxial * slope_1;
-  const double c2 = twice_denominator_cubed * deviatoric * slope_2;
-  const double inverse_y = 1.0 / (c1 * (n2_squared * n2) + c2 * (n1_squared * n1));  // 1/(2(λD)³Y)
-  // ε₀·M, from the nᵢ themselves.
-  const double residual_0_numerator = (denominator_squared * equibiaxial) * n2_squared +
-                                      (denominator_squared * deviatoric) * n1_squared - m;
-  const double residual_0 = residual_0_numerator * inverse_m;  // ε₀
+  // 1/(−dS²/dΔε̄p) = (u₁u₂)³/(2Y), Y = A·slope₁u₂³ + B·slope₂u₁³.
+  const double twice_y = ((2.0 * slope_1 * equibiaxial) * u2) * u2_squared +
+                         ((2.0 * slope_2 * deviatoric) * u1) * u1_squared;
+  // ε₀·M = A u₂² + B u₁² − (u₁u₂)², subtracted before the division completes.
+  const double residual_0_numerator =
+      equibiaxial * u2_squared + deviatoric * u1_squared - m;
+  const double residual_0 = residual_0_numerator * inverse_m;  // ε₀ = S² − 1 at Δε̄p⁰
   if (!(std::abs(residual_0) > relative_tolerance && std::abs(residual_0) <= series_limit))
     return closed_form_fallback(constants, trial, yield_stress);
   // Bracket of solve_safeguarded's first pass.
@@ -470,40 +449,39 @@ inline Solution closed_form_default(const ClosedFormConstants& constants, const 
     lower = start;
   else
     upper = start;
-  // −2S²(S − 1)/dS² = q(ε)/ε · ε₀M·n₁n₂/(2(λD)³Y) with q(ε)/ε = 1 + ¾ε − ⅛ε² + 3/64 ε³ − …;
+  // −2S²(S − 1)/dS² = q(ε)/ε · ε₀M·u₁u₂/(2Y) with q(ε)/ε = 1 + ¾ε − ⅛ε² + 3/64 ε³ − …;
   // the dropped terms are < 7e-13 of the correction for |ε| ≤ 2⁻¹², which moves the new
-  // residual by < 4e-16.
-  const double first_order = (residual_0_numerator * product) * inverse_y;
-  const double series = (1.0 + (0.75 * residual_0_numerator) * inverse_m) -
-                        (0.125 * residual_0_numerator * residual_0_numerator) *
-                            (inverse_m * inverse_m);
-  const double correction = first_order * series;
+  // residual by < 4e-16. With ε = ε₀M/M the truncated series is (M² + ¾ε₀M·M − ⅛(ε₀M)²)/M²,
+  // so the correction takes one division, by 2Y·M², which runs alongside that of M.
+  const double series_numerator =
+      (m * m + (0.75 * residual_0_numerator) * m) -
+      0.125 * residual_0_numerator * residual_0_numerator;
+  const double correction = ((residual_0_numerator * product) * series_numerator) /
+                            (twice_y * (m * m));
   const double increment = start + correction;
   if (!(upper - lower > 4.0 * std::numeric_limits<double>::epsilon() * upper && increment > lower &&
         increment < upper))
     return closed_form_fallback(constants, trial, yield_stress);
   // Evaluation at Δε̄p¹ (ClosedFormKernel::evaluate). 1/uᵢ(Δε̄p¹) follows from
-  // 1/uᵢ(Δε̄p⁰) = λD·n_j·n₁n₂/M without a division: with xᵢ = slopeᵢ·correction/uᵢ(Δε̄p⁰),
-  // 1/uᵢ(Δε̄p¹) = 1/uᵢ(Δε̄p⁰)·(1 − xᵢ)(1 + xᵢ²)(1 + xᵢ⁴)·(1 − xᵢ⁸/(1 + xᵢ)), and for
-  // |xᵢ| ≤ 2⁻⁷ the last factor is 1 to below 1e-16 (larger xᵢ: a division).
+  // 1/uᵢ(Δε̄p⁰) = u_j·u₁u₂/M without a division: with xᵢ = slopeᵢ·correction/uᵢ(Δε̄p⁰),
+  // 1/uᵢ(Δε̄p¹) = 1/uᵢ(Δε̄p⁰)·(1 − xᵢ)(1 + xᵢ²)·(1 − xᵢ⁴/(1 + xᵢ)), and for |xᵢ| ≤ 2⁻¹³
+  // the last factor is 1 to below 3e-16 (larger xᵢ: a division). |xᵢ| ≲ |ε₀|/2.
   const double sigma_s = yield_stress + constants.plastic_modulus * increment;
-  const double inverse_u1_start = (scaled_denominator * n2 * product) * inverse_m;
-  const double inverse_u2_start = (scaled_denominator * n1 * product) * inverse_m;
+  const double inverse_u1_start = (u2 * product) * inverse_m;
+  const double inverse_u2_start = (u1 * product) * inverse_m;
   const double x1 = (slope_1 * inverse_u1_start) * correction;
   const double x2 = (slope_2 * inverse_u2_start) * correction;
   double inverse_u1, inverse_u2;
   if (std::abs(x1) <= reciprocal_series_limit && std::abs(x2) <= reciprocal_series_limit) {
     const double x1_squared = x1 * x1, x2_squared = x2 * x2;
-    inverse_u1 = inverse_u1_start *
-                 (((1.0 - x1) * (1.0 + x1_squared)) * (1.0 + x1_squared * x1_squared));
-    inverse_u2 = inverse_u2_start *
-                 (((1.0 - x2) * (1.0 + x2_squared)) * (1.0 + x2_squared * x2_squared));
+    inverse_u1 = inverse_u1_start * ((1.0 - x1) * (1.0 + x1_squared));
+    inverse_u2 = inverse_u2_start * ((1.0 - x2) * (1.0 + x2_squared));
   } else {
-    const double u1 = yield_stress + slope_1 * increment;
-    const double u2 = yield_stress + slope_2 * increment;
-    const double inverse_product = 1.0 / (u1 * u2);
-    inverse_u1 = u2 * inverse_product;
-    inverse_u2 = u1 * inverse_product;
+    const double u1_new = yield_stress + slope_1 * increment;
+    const double u2_new = yield_stress + slope_2 * increment;
+    const double inverse_product = 1.0 / (u1_new * u2_new);
+    inverse_u1 = u2_new * inverse_product;
+    inverse_u2 = u1_new * inverse_product;
   }
   const double residual_1 =
       (equibiaxial * inverse_u1 * inverse_u1 + deviatoric * inverse_u2 * inverse_u2) - 1.0;
