@@ -214,6 +214,16 @@ class ClosedFormKernel {
     ratio_squared_ = term_1_ + term_2_;
   }
 
+  // The state evaluate(increment) leaves, from reciprocals 1/uᵢ obtained elsewhere.
+  void assume_evaluated(double increment, double inverse_u1, double inverse_u2) {
+    sigma_s_ = yield_stress_ + plastic_modulus_ * increment;
+    inverse_u1_ = inverse_u1;
+    inverse_u2_ = inverse_u2;
+    term_1_ = equibiaxial_part_ * inverse_u1_ * inverse_u1_;
+    term_2_ = deviatoric_part_ * inverse_u2_ * inverse_u2_;
+    ratio_squared_ = term_1_ + term_2_;
+  }
+
   double relative_yield_residual() const { return ratio_squared_ - 1.0; }
 
   double newton_correction() const {
@@ -369,9 +379,10 @@ inline Solution closed_form_general(const ClosedFormConstants& constants, const 
 // the safeguarded iteration picks up with the same bracket, count and trust flag.
 [[gnu::noinline, gnu::cold]] inline Solution closed_form_continue(
     const ClosedFormConstants& constants, const StressVoigt& trial, double yield_stress,
-    double increment, double lower, double upper, bool distrust_newton) {
+    double increment, double inverse_u1, double inverse_u2, double lower, double upper,
+    bool distrust_newton) {
   ClosedFormKernel kernel(constants, trial, yield_stress, NewtonFunction::normalized);
-  kernel.evaluate(increment);
+  kernel.assume_evaluated(increment, inverse_u1, inverse_u2);
   const int iterations =
       solve_safeguarded(kernel, increment, lower, upper, /*iterations=*/1, distrust_newton);
   return Solution{kernel.stress(), increment, iterations};
@@ -471,30 +482,35 @@ inline Solution closed_form_default(const ClosedFormConstants& constants, const 
   const double inverse_u2_start = (u1 * product) * inverse_m;
   const double x1 = (slope_1 * inverse_u1_start) * correction;
   const double x2 = (slope_2 * inverse_u2_start) * correction;
-  double inverse_u1, inverse_u2;
+  // 1/uᵢ(Δε̄p¹) = reciprocal_i·factor_i.
+  double reciprocal_1 = inverse_u1_start, reciprocal_2 = inverse_u2_start;
+  double factor_1, factor_2;
   if (std::abs(x1) <= reciprocal_series_limit && std::abs(x2) <= reciprocal_series_limit) {
-    const double x1_squared = x1 * x1, x2_squared = x2 * x2;
-    inverse_u1 = inverse_u1_start * ((1.0 - x1) * (1.0 + x1_squared));
-    inverse_u2 = inverse_u2_start * ((1.0 - x2) * (1.0 + x2_squared));
+    factor_1 = (1.0 - x1) * (1.0 + x1 * x1);
+    factor_2 = (1.0 - x2) * (1.0 + x2 * x2);
   } else {
     const double u1_new = yield_stress + slope_1 * increment;
     const double u2_new = yield_stress + slope_2 * increment;
     const double inverse_product = 1.0 / (u1_new * u2_new);
-    inverse_u1 = u2_new * inverse_product;
-    inverse_u2 = u1_new * inverse_product;
+    reciprocal_1 = u2_new * inverse_product;
+    reciprocal_2 = u1_new * inverse_product;
+    factor_1 = factor_2 = 1.0;
   }
+  const double inverse_u1 = reciprocal_1 * factor_1, inverse_u2 = reciprocal_2 * factor_2;
   const double residual_1 =
       (equibiaxial * inverse_u1 * inverse_u1 + deviatoric * inverse_u2 * inverse_u2) - 1.0;
   if (!(std::abs(residual_1) <= relative_tolerance))
-    return closed_form_continue(constants, trial, yield_stress, increment, lower, upper,
+    return closed_form_continue(constants, trial, yield_stress, increment, inverse_u1,
+                                inverse_u2, lower, upper,
                                 std::abs(residual_1) > 0.5 * std::abs(residual_0));
-  // σ = L⁻¹σ*: each eigen-component scaled by σs/uᵢ.
+  // σ = L⁻¹σ*: each eigen-component scaled by σs/uᵢ (the factors applied last).
   const double half_sigma_s = 0.5 * sigma_s;
-  const double returned_half_sum = (sum * half_sigma_s) * inverse_u1;
-  const double returned_half_diff = (diff * half_sigma_s) * inverse_u2;
+  const double returned_half_sum = ((sum * half_sigma_s) * reciprocal_1) * factor_1;
+  const double deviatoric_scale = sigma_s * reciprocal_2;
+  const double returned_half_diff = ((0.5 * diff) * deviatoric_scale) * factor_2;
   return Solution{StressVoigt(returned_half_sum + returned_half_diff,
                               returned_half_sum - returned_half_diff,
-                              (shear * sigma_s) * inverse_u2),
+                              (shear * deviatoric_scale) * factor_2),
                   increment, 1};
 }
 
