@@ -172,3 +172,37 @@ TEST_CASE("Fuzz: damage stays within (1-D) sigma_s, D and eps_p never decrease, 
   CHECK(form_mismatch_stress.value <= 1e-9);
   CHECK(form_mismatch_damage.value <= 1e-10);
 }
+
+// The default closed form runs a reorganized fast path (return_map.hpp,
+// closed_form_default) and leaves for the kernel path on anything unusual; both
+// must give the same converged return, within what the tolerance allows.
+TEST_CASE("Fuzz: the closed form's fast path agrees with the kernel path", "[material]") {
+  Sampler sampler;
+  std::uniform_real_distribution<double> exponent(-9.0, 1.0);
+  int fast_one_correction = 0;
+  for (const double nu : {-0.5, 0.0, 0.3, 0.49}) {
+    for (const double scale : {1.0, 1e6, 210e9}) {
+      const PlaneStressElasticity elasticity(scale, nu);
+      for (const double plastic_fraction : {0.0, 1e-3, 0.3}) {
+        const return_map::ClosedFormConstants constants(elasticity, plastic_fraction * scale);
+        for (int draw = 0; draw < 2000; ++draw) {
+          const double yield_stress = scale * 1e-3 * (0.5 + sampler.uniform(sampler.engine));
+          // σ̄* from just above the surface to 11× it: both series limits and the bracket get hit.
+          const StressVoigt trial = sampler.stress_with_equivalent(
+              yield_stress * (1.0 + std::pow(10.0, exponent(sampler.engine))));
+          if (!(mises(trial) > yield_stress)) continue;
+          const auto fast = return_map::closed_form(constants, trial, yield_stress);
+          const auto reference =
+              return_map::detail::closed_form_general(constants, trial, yield_stress, {});
+          const double sigma_s =
+              yield_stress + plastic_fraction * scale * fast.plastic_strain_increment;
+          CHECK(std::abs(mises(fast.stress) / sigma_s - 1.0) <= 1e-12);
+          CHECK((fast.stress - reference.stress).norm() <= 2e-12 * yield_stress);
+          CHECK(std::abs(fast.iterations - reference.iterations) <= 1);
+          if (fast.iterations == 1) ++fast_one_correction;
+        }
+      }
+    }
+  }
+  CHECK(fast_one_correction > 0);
+}

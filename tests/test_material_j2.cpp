@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "material_test_support.hpp"
@@ -148,7 +149,10 @@ TEST_CASE("J2 uniaxial stress path: sigma = sigma_y0 + Ep eps_p with eps_p measu
       uniaxial_step(law, state, -d_eps, &result);
       if (result.plastic) {
         yielded = true;
-        CHECK(before > -hardened);
+        // The grid of this test lands the last elastic state exactly on −σs in exact arithmetic
+        // (σs + 80·(−σs/40)), so which side of −σs it rounds to is decided by the last ulp of
+        // the tension-phase return; allow that ulp-level tie and nothing more.
+        CHECK(before > -hardened * (1.0 + 4.0 * std::numeric_limits<double>::epsilon()));
         compressive = state.stress.x();
       }
     }

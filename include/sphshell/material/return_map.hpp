@@ -66,11 +66,13 @@ struct ClosedFormConstants {
         plastic_modulus(plastic_modulus),
         inverse_max_slope(1.0 / std::max(slope_1, slope_2)),
         inverse_min_slope(1.0 / std::min(slope_1, slope_2)),
-        inverse_slope_2(1.0 / slope_2) {}
+        inverse_slope_2(1.0 / slope_2),
+        slope_difference(slope_2 - slope_1) {}
   double kappa_1, kappa_2;  // eigenvalues of ΓΞ: E/(2(1−ν)) and 3G
   double slope_1, slope_2;  // κᵢ + Ep
   double plastic_modulus;
   double inverse_max_slope, inverse_min_slope, inverse_slope_2;
+  double slope_difference;  // slope₂ − slope₁ = κ₂ − κ₁
 };
 
 namespace detail {
@@ -108,10 +110,11 @@ namespace detail {
 // replaced by bisection (or doubling), so convergence never hinges on the
 // initial value. The kernel arrives evaluated at `increment` and is left
 // evaluated at the returned Δε̄p. Returns the number of corrections applied.
+// `iterations` and `distrust_newton` let a caller that has already applied
+// corrections itself (the closed form's fast path) continue exactly where it stopped.
 template <class Kernel>
-inline int solve_safeguarded(Kernel& kernel, double& increment, double lower, double upper) {
-  bool distrust_newton = false;
-  int iterations = 0;
+inline int solve_safeguarded(Kernel& kernel, double& increment, double lower, double upper,
+                             int iterations = 0, bool distrust_newton = false) {
   while (!(std::abs(kernel.relative_yield_residual()) <= relative_tolerance)) {
     if (kernel.relative_yield_residual() > 0.0)
       lower = increment;
@@ -206,6 +209,16 @@ class ClosedFormKernel {
     const double inverse_product = denominator / (n1 * n2);
     inverse_u1_ = n2 * inverse_product;
     inverse_u2_ = n1 * inverse_product;
+    term_1_ = equibiaxial_part_ * inverse_u1_ * inverse_u1_;
+    term_2_ = deviatoric_part_ * inverse_u2_ * inverse_u2_;
+    ratio_squared_ = term_1_ + term_2_;
+  }
+
+  // The state evaluate(increment) leaves, from reciprocals 1/uᵢ obtained elsewhere.
+  void assume_evaluated(double increment, double inverse_u1, double inverse_u2) {
+    sigma_s_ = yield_stress_ + plastic_modulus_ * increment;
+    inverse_u1_ = inverse_u1;
+    inverse_u2_ = inverse_u2;
     term_1_ = equibiaxial_part_ * inverse_u1_ * inverse_u1_;
     term_2_ = deviatoric_part_ * inverse_u2_ * inverse_u2_;
     ratio_squared_ = term_1_ + term_2_;
@@ -313,8 +326,11 @@ class GenericKernel {
 
 }  // namespace detail
 
-inline Solution closed_form(const ClosedFormConstants& constants, const StressVoigt& trial,
-                            double yield_stress, const ReturnMapOptions& options = {}) {
+namespace detail {
+
+// Every option combination, through the kernel: the reference path of the closed form.
+inline Solution closed_form_general(const ClosedFormConstants& constants, const StressVoigt& trial,
+                                   double yield_stress, const ReturnMapOptions& options) {
   detail::ClosedFormKernel kernel(constants, trial, yield_stress, options.newton_function);
   const double excess = kernel.trial_equivalent() - yield_stress;
   // A trial stress on or inside the surface (callers check first; this catches round-off) needs no
@@ -351,6 +367,161 @@ inline Solution closed_form(const ClosedFormConstants& constants, const StressVo
                                            std::max(kernel.upper_bound(excess), increment));
   }
   return Solution{kernel.stress(), increment, iterations};
+}
+
+// The fast path's way out when anything is unusual: the same solve from scratch.
+[[gnu::noinline, gnu::cold]] inline Solution closed_form_fallback(
+    const ClosedFormConstants& constants, const StressVoigt& trial, double yield_stress) {
+  return closed_form_general(constants, trial, yield_stress, ReturnMapOptions{});
+}
+
+// The fast path's continuation when one correction did not reach the tolerance:
+// the safeguarded iteration picks up with the same bracket, count and trust flag.
+[[gnu::noinline, gnu::cold]] inline Solution closed_form_continue(
+    const ClosedFormConstants& constants, const StressVoigt& trial, double yield_stress,
+    double increment, double inverse_u1, double inverse_u2, double lower, double upper,
+    bool distrust_newton) {
+  ClosedFormKernel kernel(constants, trial, yield_stress, NewtonFunction::normalized);
+  kernel.assume_evaluated(increment, inverse_u1, inverse_u2);
+  const int iterations =
+      solve_safeguarded(kernel, increment, lower, upper, /*iterations=*/1, distrust_newton);
+  return Solution{kernel.stress(), increment, iterations};
+}
+
+// Above this |ε₀| the series for the first correction is not used (the general path takes over).
+inline constexpr double series_limit = 1.0 / 4096.0;
+// Above this |slopeᵢ·correction/uᵢ| the reciprocals at the corrected Δε̄p come from a division.
+inline constexpr double reciprocal_series_limit = 1.0 / 8192.0;
+
+// The default options (Appendix-B start, φ, converged, safeguarded), with the
+// same equations as closed_form_general reorganized so that the dependency chain
+// from the trial stress to the returned stress holds one square root and two
+// divisions side by side instead of two square roots and three divisions in a row:
+// - uᵢ(Δε̄p⁰) = σs,n + slopeᵢΔε̄p⁰ at the start Δε̄p⁰ = excess·σ̄*²/D (eq. B.8,
+//   D = slope₁A + slope₂B) is written as a multiply-add in σ̄*, with 1/D taken
+//   while the square root runs.
+// - At the start, ε₀ = S² − 1 = (Au₂² + Bu₁² − M)/M with M = (u₁u₂)², and
+//   dS²/dΔε̄p = −2Y/(u₁u₂)³ with Y = A·slope₁u₂³ + B·slope₂u₁³. The φ-Newton
+//   correction −2S²(S − 1)/dS² = q(ε)·(u₁u₂)³/(2Y), q(ε) = 2(1 + ε)(√(1 + ε) − 1)
+//   = ε(1 + ¾ε − ⅛ε² + …), is taken from the series (|ε| ≤ 2⁻¹²), so no second
+//   square root; its one division runs alongside 1/M.
+// - 1/uᵢ at the corrected Δε̄p¹ follow from 1/uᵢ(Δε̄p⁰) by a series in
+//   xᵢ = slopeᵢ·correction/uᵢ(Δε̄p⁰) (a division when |xᵢ| > 2⁻¹³); the convergence
+//   test is the kernel's, |S² − 1| ≤ tol at Δε̄p¹, and the returned stress is
+//   σs/uᵢ times the trial components, as in ClosedFormKernel::stress().
+// The safeguards are those of solve_safeguarded: the analytic bracket, updated
+// by the sign of g at the start, the collapse test, and the Newton step only
+// accepted strictly inside it. Anything else — a start already within the
+// tolerance, |ε₀| above the series limit, a step outside the bracket, a
+// non-finite or out-of-range intermediate — leaves for closed_form_general,
+// which then runs the very same iteration from scratch; a correction that misses
+// the tolerance continues in solve_safeguarded with the same bracket and counters.
+inline Solution closed_form_default(const ClosedFormConstants& constants, const StressVoigt& trial,
+                                   double yield_stress) {
+  const double sum = trial.x() + trial.y();
+  const double diff = trial.x() - trial.y();
+  const double shear = trial.z();
+  const double equibiaxial = 0.25 * sum * sum;                          // A
+  const double deviatoric = 0.75 * diff * diff + 3.0 * shear * shear;  // B
+  const double trial_squared = equibiaxial + deviatoric;               // σ̄*²
+  const double trial_equivalent = std::sqrt(trial_squared);
+  const double excess = trial_equivalent - yield_stress;
+  if (!(excess > 0.0)) {
+    if (!std::isfinite(excess)) throw_non_finite_trial(trial, yield_stress);
+    return Solution{trial, 0.0, 0};
+  }
+  const double slope_1 = constants.slope_1, slope_2 = constants.slope_2;
+  // Off the square root's path: 1/D and the coefficients of uᵢ(Δε̄p⁰) as functions of σ̄*.
+  const double inverse_denominator = 1.0 / (slope_1 * equibiaxial + slope_2 * deviatoric);
+  const double scaled_trial_squared = trial_squared * inverse_denominator;
+  const double start = excess * scaled_trial_squared;  // eq. (B.8), Δε̄p⁰
+  // uᵢ(Δε̄p⁰) = σs,n + slopeᵢΔε̄p⁰ = σs,n(1 − slopeᵢσ̄*²/D) + (slopeᵢσ̄*²/D)·σ̄*, with
+  // 1 − slope₁σ̄*²/D = (slope₂ − slope₁)B/D and 1 − slope₂σ̄*²/D = −(slope₂ − slope₁)A/D.
+  const double difference_scaled = constants.slope_difference * inverse_denominator * yield_stress;
+  const double u1 = difference_scaled * deviatoric + (slope_1 * scaled_trial_squared) * trial_equivalent;
+  const double u2 = (slope_2 * scaled_trial_squared) * trial_equivalent - difference_scaled * equibiaxial;
+  const double product = u1 * u2;
+  const double u1_squared = u1 * u1, u2_squared = u2 * u2;
+  const double m = product * product;
+  const double inverse_m = 1.0 / m;
+  // 1/(−dS²/dΔε̄p) = (u₁u₂)³/(2Y), Y = A·slope₁u₂³ + B·slope₂u₁³.
+  const double twice_y = ((2.0 * slope_1 * equibiaxial) * u2) * u2_squared +
+                         ((2.0 * slope_2 * deviatoric) * u1) * u1_squared;
+  // ε₀·M = A u₂² + B u₁² − (u₁u₂)², subtracted before the division completes.
+  const double residual_0_numerator =
+      equibiaxial * u2_squared + deviatoric * u1_squared - m;
+  const double residual_0 = residual_0_numerator * inverse_m;  // ε₀ = S² − 1 at Δε̄p⁰
+  if (!(std::abs(residual_0) > relative_tolerance && std::abs(residual_0) <= series_limit))
+    return closed_form_fallback(constants, trial, yield_stress);
+  // Bracket of solve_safeguarded's first pass.
+  double lower = std::min(excess * constants.inverse_max_slope, start);
+  double upper = std::max(excess * constants.inverse_min_slope, start);
+  if (residual_0 > 0.0)
+    lower = start;
+  else
+    upper = start;
+  // −2S²(S − 1)/dS² = q(ε)/ε · ε₀M·u₁u₂/(2Y) with q(ε)/ε = 1 + ¾ε − ⅛ε² + 3/64 ε³ − …;
+  // the dropped terms are < 7e-13 of the correction for |ε| ≤ 2⁻¹², which moves the new
+  // residual by < 4e-16. With ε = ε₀M/M the truncated series is (M² + ¾ε₀M·M − ⅛(ε₀M)²)/M²,
+  // so the correction takes one division, by 2Y·M², which runs alongside that of M.
+  const double series_numerator =
+      (m * m + (0.75 * residual_0_numerator) * m) -
+      0.125 * residual_0_numerator * residual_0_numerator;
+  const double correction = ((residual_0_numerator * product) * series_numerator) /
+                            (twice_y * (m * m));
+  const double increment = start + correction;
+  if (!(upper - lower > 4.0 * std::numeric_limits<double>::epsilon() * upper && increment > lower &&
+        increment < upper))
+    return closed_form_fallback(constants, trial, yield_stress);
+  // Evaluation at Δε̄p¹ (ClosedFormKernel::evaluate). 1/uᵢ(Δε̄p¹) follows from
+  // 1/uᵢ(Δε̄p⁰) = u_j·u₁u₂/M without a division: with xᵢ = slopeᵢ·correction/uᵢ(Δε̄p⁰),
+  // 1/uᵢ(Δε̄p¹) = 1/uᵢ(Δε̄p⁰)·(1 − xᵢ)(1 + xᵢ²)·(1 − xᵢ⁴/(1 + xᵢ)), and for |xᵢ| ≤ 2⁻¹³
+  // the last factor is 1 to below 3e-16 (larger xᵢ: a division). |xᵢ| ≲ |ε₀|/2.
+  const double sigma_s = yield_stress + constants.plastic_modulus * increment;
+  const double inverse_u1_start = (u2 * product) * inverse_m;
+  const double inverse_u2_start = (u1 * product) * inverse_m;
+  const double x1 = (slope_1 * inverse_u1_start) * correction;
+  const double x2 = (slope_2 * inverse_u2_start) * correction;
+  // 1/uᵢ(Δε̄p¹) = reciprocal_i·factor_i.
+  double reciprocal_1 = inverse_u1_start, reciprocal_2 = inverse_u2_start;
+  double factor_1, factor_2;
+  if (std::abs(x1) <= reciprocal_series_limit && std::abs(x2) <= reciprocal_series_limit) {
+    factor_1 = (1.0 - x1) * (1.0 + x1 * x1);
+    factor_2 = (1.0 - x2) * (1.0 + x2 * x2);
+  } else {
+    const double u1_new = yield_stress + slope_1 * increment;
+    const double u2_new = yield_stress + slope_2 * increment;
+    const double inverse_product = 1.0 / (u1_new * u2_new);
+    reciprocal_1 = u2_new * inverse_product;
+    reciprocal_2 = u1_new * inverse_product;
+    factor_1 = factor_2 = 1.0;
+  }
+  const double inverse_u1 = reciprocal_1 * factor_1, inverse_u2 = reciprocal_2 * factor_2;
+  const double residual_1 =
+      (equibiaxial * inverse_u1 * inverse_u1 + deviatoric * inverse_u2 * inverse_u2) - 1.0;
+  if (!(std::abs(residual_1) <= relative_tolerance))
+    return closed_form_continue(constants, trial, yield_stress, increment, inverse_u1,
+                                inverse_u2, lower, upper,
+                                std::abs(residual_1) > 0.5 * std::abs(residual_0));
+  // σ = L⁻¹σ*: each eigen-component scaled by σs/uᵢ (the factors applied last).
+  const double half_sigma_s = 0.5 * sigma_s;
+  const double returned_half_sum = ((sum * half_sigma_s) * reciprocal_1) * factor_1;
+  const double deviatoric_scale = sigma_s * reciprocal_2;
+  const double returned_half_diff = ((0.5 * diff) * deviatoric_scale) * factor_2;
+  return Solution{StressVoigt(returned_half_sum + returned_half_diff,
+                              returned_half_sum - returned_half_diff,
+                              (shear * deviatoric_scale) * factor_2),
+                  increment, 1};
+}
+
+}  // namespace detail
+
+inline Solution closed_form(const ClosedFormConstants& constants, const StressVoigt& trial,
+                            double yield_stress, const ReturnMapOptions& options = {}) {
+  if (options.initial_guess == InitialGuess::appendix_b && options.fixed_iterations <= 0 &&
+      options.newton_function == NewtonFunction::normalized)
+    return detail::closed_form_default(constants, trial, yield_stress);
+  return detail::closed_form_general(constants, trial, yield_stress, options);
 }
 
 inline Solution closed_form(const PlaneStressElasticity& elasticity, const StressVoigt& trial,
