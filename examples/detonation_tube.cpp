@@ -2,14 +2,16 @@
 // §4.2 (Fig. 28–32, Table 6), after the experiments of Chao & Shepherd (2005)
 // modelled by Song & Belytschko (2009) and Becker & Noels (2013).
 //
-//   detonation_tube [--spacing 2.5e-3] [--radius 0.019] [--length 0.914]
-//                   [--end-time 4e-4] [--rotary-scale 10] [--output DIR] [--csv FILE]
+//   detonation_tube [--spacing 1.5e-3] [--radius 0.019] [--length 0.914]
+//                   [--end-time 4e-4] [--rotary-scale S] [--output DIR] [--csv FILE]
 //
 //   --spacing       target particle spacing, m (circumferential and axial)
 //   --radius        mid-surface radius, m
 //   --length        tube length, m (the detonation source is at z = 0)
 //   --end-time      simulated time, s
-//   --rotary-scale  rotary-inertia scale (SolverOptions::rotary_inertia_scale)
+//   --rotary-scale  rotary-inertia scale (SolverOptions::rotary_inertia_scale);
+//                   default: the smallest scale ≥ 1 at which the rotation limit
+//                   no longer controls the time step (see below)
 //   --output DIR    ParaView frames every 10 µs (particles.pvd,
 //                   stress_points.pvd, cracks.pvd) and DIR/crack_tips.csv
 //   --csv FILE      history file when no --output (default detonation_tube.csv)
@@ -52,10 +54,18 @@
 // axial extent; Fig. 32 likewise shows the speeds before bifurcation.
 //
 // Time step and cost: the shear–rotation limit of the 0.89 mm wall would force
-// dt ≈ 0.1 µs; the rotary inertia is scaled by 10 (as explicit FE shell codes
-// do), which lifts it to about the membrane limit (≈ 0.25 µs at 2.5 mm
-// spacing). The default run (≈ 17 000 particles, 400 µs) takes a few minutes on
-// 2 cores.
+// a step below the membrane one; the rotary inertia is scaled (as explicit FE
+// shell codes do) so that the membrane limit controls the step: twice the
+// crossover scale of the solver's bound, ω_r² = (12 c_s²/d² + 9 c_m²/Δ²)/s
+// + 9 c_s²/Δ² ≤ ω_m² = 9 c_m²/Δ² (scale ≈ 6 at 1.5 mm spacing, ≈ 11 at
+// 2.5 mm; at the crossover itself the 2.5 mm run went unstable). This
+// slows only the short-wavelength rotational (thickness-shear) modes. The
+// default run (1.5 mm: 80 × 610 ≈ 49 000 particles, 400 µs, ≈ 2 600 steps)
+// takes about 5 minutes on 2 cores; --spacing 2.5e-3 takes about 1 minute.
+//
+// The CSV also holds the circumferential half-extent of the notch crack
+// (largest arc distance of its points from the notch line): the crack turning
+// round the tube instead of running axially shows there.
 
 #include <sphshell/sphshell.hpp>
 
@@ -81,11 +91,11 @@ constexpr double p_cj = 6.2e6, v_cj = 2390.0;
 double notch_length() { return 0.0508; }
 
 struct Arguments {
-  double spacing = 2.5e-3;
+  double spacing = 1.5e-3;
   double radius = 0.019;
   double length = 0.914;
   double end_time = 4e-4;
-  double rotary_scale = 10.0;
+  double rotary_scale = 0.0;  // 0: automatic
   std::string output;
   std::string csv = "detonation_tube.csv";
 };
@@ -110,7 +120,7 @@ Arguments parse(int argc, char** argv) {
   detail::require_positive("--spacing", a.spacing);
   detail::require_positive("--radius", a.radius);
   detail::require_positive("--end-time", a.end_time);
-  detail::require_positive("--rotary-scale", a.rotary_scale);
+  detail::require_nonnegative("--rotary-scale", a.rotary_scale);
   if (!(a.length > notch_length() + 4 * a.spacing))
     detail::invalid_parameter("--length", a.length, "must exceed the notch (50.8 mm) by a few spacings");
   return a;
@@ -132,7 +142,19 @@ int run(const Arguments& a) {
   SolverOptions options;
   options.density = density;
   options.nonlinear = true;
-  options.rotary_inertia_scale = a.rotary_scale;
+  double rotary_scale = a.rotary_scale;
+  if (rotary_scale == 0.0) {
+    // The solver's bounds (Solver::compute_stable_time_step) with the spacing
+    // of this grid: the smallest scale that leaves the membrane limit in control.
+    const double spacing = std::min(2 * kPi * a.radius / n_circ, a.length / (n_axial - 1));
+    const double cm2 = E / (density * (1 - nu * nu)), cs2 = 5.0 / 6.0 * E / (2 * (1 + nu)) / density;
+    const double membrane = 9 * cm2 / (spacing * spacing);
+    // Twice the crossover: at the crossover itself (scale 5.7 at 2.5 mm) the
+    // run became unstable at ≈ 140 µs although dt was 0.8 × the bound.
+    rotary_scale = std::max(1.0, 2.0 * (12 * cs2 / (thickness * thickness) + membrane) /
+                                     (membrane - 9 * cs2 / (spacing * spacing)));
+  }
+  options.rotary_inertia_scale = rotary_scale;
   options.output_directory = a.output;
   options.output_interval = a.output.empty() ? 0.0 : 1e-5;
   TubeSolver solver(ShellModel::cylindrical_panel(a.radius, a.length, 2 * kPi, n_circ, n_axial, thickness),
@@ -160,10 +182,11 @@ int run(const Arguments& a) {
             << model.particle_count() << " particles, " << model.stress_point_count() << " stress points\n"
             << "  notch 50.8 mm centred at z = " << notch_centre << " m (wave arrives at its rear end at "
             << (notch_centre - 0.5 * notch_length()) / v_cj * 1e6 << " µs), dt = " << solver.time_step()
-            << " s (stable " << solver.stable_time_step() << " s), end " << a.end_time * 1e6 << " µs\n";
+            << " s (stable " << solver.stable_time_step() << " s), rotary-inertia scale " << rotary_scale
+            << ", end " << a.end_time * 1e6 << " µs\n";
 
   struct Sample {
-    double t, rear, front, length, radial;
+    double t, rear, front, length, radial, arc;
     std::size_t damaged;
     int cracks;
   };
@@ -181,6 +204,18 @@ int run(const Arguments& a) {
       }
     return std::make_pair(rear, front);
   };
+  // Largest arc distance of the notch crack's points from the notch line.
+  auto arc_extent = [&](const TubeSolver& s) {
+    double arc = 0.0;
+    const auto& points = s.crack().points();
+    const auto& id = s.crack().crack_of_point();
+    for (std::size_t k = 0; k < points.size(); ++k)
+      if (id[k] == 0) {
+        const double angle = std::atan2(points[k].y(), points[k].x()) - theta;
+        arc = std::max(arc, a.radius * std::abs(std::remainder(angle, 2 * kPi)));
+      }
+    return arc;
+  };
   const int notch_particle = model.nearest_particle(a.radius * radial + Vector3(0, 0, notch_centre));
   const auto start = std::chrono::steady_clock::now();
   long next_progress = 0;
@@ -188,7 +223,7 @@ int run(const Arguments& a) {
     if (s.time() >= next_sample - 1e-12) {
       const auto [rear, front] = tips(s);
       const double radial_displacement = s.displacement(notch_particle).dot(model.particle_normal[notch_particle]);
-      samples.push_back({s.time(), rear, front, s.crack().total_length(), radial_displacement,
+      samples.push_back({s.time(), rear, front, s.crack().total_length(), radial_displacement, arc_extent(s),
                          s.damaged_stress_point_count(), s.crack().crack_count()});
       next_sample += sample_interval;
     }
@@ -207,7 +242,7 @@ int run(const Arguments& a) {
   // Speeds: central differences over ±10 µs (±5 samples).
   const std::size_t half = 5;
   io::CsvProbe history(csv, {"t [s]", "rear_tip_z [m]", "front_tip_z [m]", "rear_speed [m/s]",
-                             "front_speed [m/s]", "crack_total_length [m]", "notch_radial_displacement [m]",
+                             "front_speed [m/s]", "crack_total_length [m]", "notch_radial_displacement [m]", "crack_arc_half_extent [m]",
                              "damaged_stress_points", "cracks"});
   std::vector<double> rear_speed(samples.size(), 0.0), front_speed(samples.size(), 0.0);
   for (std::size_t k = 0; k < samples.size(); ++k) {
@@ -218,14 +253,14 @@ int run(const Arguments& a) {
       front_speed[k] = (samples[hi].front - samples[lo].front) / dt;
     }
     const Sample& s = samples[k];
-    history.write_row({s.t, s.rear, s.front, rear_speed[k], front_speed[k], s.length, s.radial,
+    history.write_row({s.t, s.rear, s.front, rear_speed[k], front_speed[k], s.length, s.radial, s.arc,
                        double(s.damaged), double(s.cracks)});
   }
-  std::printf("\n   t [µs]  rear tip z [mm]  front tip z [mm]  rear speed [m/s]  front speed [m/s]  crack length [mm]\n");
+  std::printf("\n   t [µs]  rear tip z [mm]  front tip z [mm]  rear speed [m/s]  front speed [m/s]  crack length [mm]  arc half-extent [mm]\n");
   for (std::size_t k = 0; k < samples.size(); k += 10) {
     const Sample& s = samples[k];
-    std::printf("  %7.0f  %15.1f  %16.1f  %16.0f  %17.0f  %17.1f\n", s.t * 1e6, s.rear * 1e3, s.front * 1e3,
-                rear_speed[k], front_speed[k], s.length * 1e3);
+    std::printf("  %7.0f  %15.1f  %16.1f  %16.0f  %17.0f  %17.1f  %20.1f\n", s.t * 1e6, s.rear * 1e3, s.front * 1e3,
+                rear_speed[k], front_speed[k], s.length * 1e3, s.arc * 1e3);
   }
   const double max_rear = samples.empty() ? 0.0 : *std::max_element(rear_speed.begin(), rear_speed.end());
   const double max_front = samples.empty() ? 0.0 : *std::max_element(front_speed.begin(), front_speed.end());

@@ -19,7 +19,7 @@
 //   --precrack          pre-crack length from the left edge, m
 //   --rotary-scale      rotary-inertia scale (SolverOptions::rotary_inertia_scale)
 //   --output DIR        ParaView frames (particles.pvd, stress_points.pvd,
-//                       cracks.pvd) every 0.5 mm of Δ, and DIR/history.csv
+//                       cracks.pvd) every 1 mm of Δ, and DIR/history.csv
 //   --csv FILE          history file when no --output (default plate_tearing.csv)
 //
 // Units SI throughout. Material, Table 5: d 0.01 m, ρ 7800 kg/m³, E 200 GPa,
@@ -64,8 +64,9 @@
 //
 // Speed: explicit dynamics with a real crosshead speed. The paper's Fig. 25
 // times (Δ ≈ 120 mm by ~12 ms) imply ≈ 10 m/s; 5 m/s is used by default,
-// which keeps the kinetic energy a few per cent of the plastic work (printed
-// at the end) and the run at a few minutes on 2 cores at --n 61. The rotary
+// which keeps the kinetic energy below 0.1 % of the plastic work (printed at
+// the end: 33 J against 48 kJ) and the run (24 000 steps of 1 µs) at ≈ 9
+// minutes on 2 cores shared with other jobs at --n 61. The rotary
 // inertia is scaled by 400 (as explicit FE shell codes do) to lift the
 // shear–rotation time-step limit of the 10 mm plate to the membrane one; the
 // tearing is an in-plane problem and bending plays little part.
@@ -170,7 +171,9 @@ int run(const Arguments& a) {
   using TearingSolver =
       Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<5>, material::LemaitreDamage, crack::LineSegments>;
   const double spacing = width / (a.n - 1);
-  const int ny = static_cast<int>(std::lround(0.59 / spacing)) / 2 * 2 + 1 + 1;  // even particle count: odd cells
+  // An even particle count across the height (odd cell count), so mid-height
+  // is a stress-point row between two particle rows; 60 at 10 mm spacing.
+  const int ny = static_cast<int>(std::lround(0.59 / spacing)) / 2 * 2 + 2;
   const double height = (ny - 1) * spacing;
   if (!(a.precrack > spacing && a.precrack < width - 3 * spacing))
     detail::invalid_parameter("--precrack", a.precrack, "must lie between one spacing and the plate width");
@@ -180,7 +183,7 @@ int run(const Arguments& a) {
   options.nonlinear = true;
   options.rotary_inertia_scale = a.rotary_scale;
   options.output_directory = a.output;
-  options.output_interval = a.output.empty() ? 0.0 : 5e-4 / a.speed;  // every 0.5 mm of stroke
+  options.output_interval = a.output.empty() ? 0.0 : 1e-3 / a.speed;  // every 1 mm of stroke
   ShellModel plate = ShellModel::rectangular_plate(width, height, a.n, ny, thickness);
   const double grip_depth = 1.5 * spacing;
   plate.define_set("upper_grip", [&](const Vector3& x) { return x.y() > height - grip_depth; });
