@@ -74,7 +74,7 @@
 // 156 m/s in ±10 µs differences, below the paper's ≈ 300 m/s), while the crack
 // also turns round the tube at both ends (arc half-extent 27 mm by 400 µs;
 // the paper sees circumferential growth mainly at the front end). At 2.5 mm
-// spacing: start ≈ 240 µs, peak 126 m/s.
+// spacing (rotary scale 10): start ≈ 240 µs, peak 126 m/s.
 
 #include <sphshell/sphshell.hpp>
 
@@ -114,7 +114,7 @@ Arguments parse(int argc, char** argv) {
   for (int k = 1; k < argc; ++k) {
     const std::string flag = argv[k];
     auto value = [&]() -> std::string {
-      if (k + 1 >= argc) throw Error("detonation_tube: " + flag + " needs a value");
+      if (k + 1 >= argc) throw Error(flag + " needs a value");
       return argv[++k];
     };
     if (flag == "--spacing") a.spacing = std::stod(value());
@@ -124,7 +124,7 @@ Arguments parse(int argc, char** argv) {
     else if (flag == "--rotary-scale") a.rotary_scale = std::stod(value());
     else if (flag == "--output") a.output = value();
     else if (flag == "--csv") a.csv = value();
-    else throw Error("detonation_tube: unknown option " + flag + " (see the comment at the top of detonation_tube.cpp)");
+    else throw Error("unknown option " + flag + " (see the comment at the top of detonation_tube.cpp)");
   }
   detail::require_positive("--spacing", a.spacing);
   detail::require_positive("--radius", a.radius);

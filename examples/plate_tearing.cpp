@@ -116,7 +116,7 @@ Arguments parse(int argc, char** argv) {
   for (int k = 1; k < argc; ++k) {
     const std::string flag = argv[k];
     auto value = [&]() -> std::string {
-      if (k + 1 >= argc) throw Error("plate_tearing: " + flag + " needs a value");
+      if (k + 1 >= argc) throw Error(flag + " needs a value");
       return argv[++k];
     };
     if (flag == "--n") a.n = std::stoi(value());
@@ -126,7 +126,7 @@ Arguments parse(int argc, char** argv) {
     else if (flag == "--rotary-scale") a.rotary_scale = std::stod(value());
     else if (flag == "--output") a.output = value();
     else if (flag == "--csv") a.csv = value();
-    else throw Error("plate_tearing: unknown option " + flag + " (see the comment at the top of plate_tearing.cpp)");
+    else throw Error("unknown option " + flag + " (see the comment at the top of plate_tearing.cpp)");
   }
   if (a.n < 11) detail::invalid_parameter("--n", a.n, "must be at least 11");
   detail::require_positive("--speed", a.speed);
@@ -271,7 +271,7 @@ int run(const Arguments& a) {
       peak_force = p_cross;
       peak_stroke = delta;
     }
-    const bool table_row = delta >= next_table - 1e-3 * table_step;
+    const bool table_row = delta >= next_table - std::max(1e-3 * table_step, 2.0 * speed * s.time_step());
     if (s.steps() % 20 != 0 && !table_row) return;
     const double tip = crack_tip(s);
     const double grown = s.crack().total_length() - precrack_length;
