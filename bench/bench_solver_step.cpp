@@ -15,11 +15,6 @@ using namespace sphshell;
 
 namespace {
 
-ParticleSet all_particles(const ShellModel& model) {
-  ParticleSet all;
-  for (std::size_t i = 0; i < model.particle_count(); ++i) all.push_back(static_cast<int>(i));
-  return all;
-}
 
 template <class Rule>
 void elastic_plate_step(benchmark::State& state) {
@@ -27,7 +22,7 @@ void elastic_plate_step(benchmark::State& state) {
   Solver<approx::MLS<kernel::CubicSpline>, Rule, material::Elastic> solver(
       ShellModel::rectangular_plate(0.5, 0.5, 51, 51, 0.01), {210e9, 0.3}, options);
   solver.clamp(solver.model().set("boundary"));
-  solver.add_uniform_pressure(all_particles(solver.model()), 1e6);
+  solver.add_uniform_pressure(solver.model().all_particles(), 1e6);
   for (auto _ : state) solver.step();
   state.counters["particles"] = double(solver.particle_count());
 }
@@ -41,7 +36,7 @@ void fracture_plate_step(benchmark::State& state) {
         ShellModel::rectangular_plate(0.5, 0.5, 51, 51, 0.01), {210e9, 0.3, 235e6, 0.0, 0.02, 0.37, 0.24},
         options);
     solver.clamp(solver.model().set("boundary"));
-    solver.add_uniform_pressure(all_particles(solver.model()), 5e6);
+    solver.add_uniform_pressure(solver.model().all_particles(), 5e6);
     solver.run_until(1.55e-3);
     const long first = solver.steps();
     const auto start = std::chrono::steady_clock::now();

@@ -17,8 +17,7 @@ int main() {
   options.output_interval = 2e-4;          // s
   PlateSolver solver(plate, steel, options);
   solver.clamp(plate.set("boundary"));
-  ParticleSet all;
-  for (std::size_t i = 0; i < plate.particle_count(); ++i) all.push_back(static_cast<int>(i));
+  const ParticleSet all = plate.all_particles();
   solver.add_uniform_pressure(all, 1e6, time_function::Step{});  // 1 MPa step load
   const int centre = plate.set("centre")[0];
   solver.add_particle_probe("plate_out/centre.csv", centre);

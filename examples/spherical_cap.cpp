@@ -58,8 +58,7 @@ int run(const Arguments& arguments, const typename Material::Parameters& paramet
       ShellModel::spherical_cap(radius, half_angle, arguments.n, thickness), parameters, options);
   const ShellModel& model = solver.model();
   solver.clamp(model.set("boundary"));
-  ParticleSet all;
-  for (std::size_t i = 0; i < model.particle_count(); ++i) all.push_back(static_cast<int>(i));
+  const ParticleSet all = model.all_particles();
   solver.add_uniform_pressure(all, pressure);  // inward: normals point outward
   const int apex = model.set("apex")[0];
   const std::string csv = arguments.output.empty() ? "spherical_cap_apex.csv" : arguments.output + "/apex.csv";

@@ -73,8 +73,7 @@ int run(const Arguments& a, const typename Material::Parameters& parameters) {
   PlateSolver solver(ShellModel::rectangular_plate(length, length, a.n, a.n, thickness), parameters, options);
   const ShellModel& model = solver.model();
   solver.clamp(model.set("boundary"));
-  ParticleSet all;
-  for (std::size_t i = 0; i < model.particle_count(); ++i) all.push_back(static_cast<int>(i));
+  const ParticleSet all = model.all_particles();
   solver.add_uniform_pressure(all, pressure);  // pushes along −z
   const int point_a = model.set("centre")[0];
   const int stress_point_a = model.nearest_stress_point(Vector3(length / 2, length / 2, 0));

@@ -13,11 +13,6 @@ namespace {
 
 using ElasticSolver = Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<2>, material::Elastic>;
 
-ParticleSet all_particles(const ShellModel& model) {
-  ParticleSet all;
-  for (std::size_t i = 0; i < model.particle_count(); ++i) all.push_back(static_cast<int>(i));
-  return all;
-}
 
 SolverOptions relaxation(double fundamental_frequency) {
   SolverOptions options;
@@ -37,7 +32,7 @@ TEST_CASE("A quarter plate with two symmetry planes matches the full plate", "[s
 
   ElasticSolver full(ShellModel::rectangular_plate(L, L, 21, 21, d), {E, nu}, relaxation(omega));
   full.clamp(full.model().set("boundary"));
-  full.add_uniform_pressure(all_particles(full.model()), q);
+  full.add_uniform_pressure(full.model().all_particles(), q);
   full.run_until(end);
   const double full_centre = full.displacement(full.model().set("centre")[0]).z();
 
@@ -48,7 +43,7 @@ TEST_CASE("A quarter plate with two symmetry planes matches the full plate", "[s
   quarter.clamp(model.set("y_min"));
   quarter.symmetry_plane(model.set("x_max"), Vector3::UnitX());
   quarter.symmetry_plane(model.set("y_max"), Vector3::UnitY());
-  quarter.add_uniform_pressure(all_particles(model), q);
+  quarter.add_uniform_pressure(model.all_particles(), q);
   quarter.run_until(end);
   const double quarter_centre = quarter.displacement(model.nearest_particle(Vector3(L / 2, L / 2, 0))).z();
   WARN("centre deflection: full plate " << full_centre << " m, quarter with symmetry " << quarter_centre << " m");
@@ -102,7 +97,7 @@ TEST_CASE("Cutting a pre-crack mid-run keeps the energy balance", "[solver][frac
       ShellModel::rectangular_plate(0.2, 0.1, 21, 11, 0.005), {210e9, 0.3});
   const ShellModel& model = solver.model();
   solver.clamp(model.set("x_min"));
-  solver.add_uniform_pressure(all_particles(model), 2e4, time_function::Ramp{1e-4});
+  solver.add_uniform_pressure(model.all_particles(), 2e4, time_function::Ramp{1e-4});
   solver.run_until(2e-4);
   solver.add_precrack({Vector3(0.1025, -0.002, 0.0), Vector3(0.1025, 0.06, 0.0)});
   solver.run_until(4e-4);

@@ -20,11 +20,6 @@ using CrackSolver =
     Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<3>, material::LemaitreDamage, crack::LineSegments>;
 const material::LemaitreDamage::Parameters table_3_steel{210e9, 0.3, 235e6, 0.0, 0.02, 0.37, 0.24};
 
-ParticleSet all_particles(const ShellModel& model) {
-  ParticleSet all;
-  for (std::size_t i = 0; i < model.particle_count(); ++i) all.push_back(static_cast<int>(i));
-  return all;
-}
 
 double total_mass(const CrackSolver& solver) {
   double mass = 0.0;
@@ -47,7 +42,7 @@ TearingRun tear_plate(double end_time) {
   CrackSolver solver(ShellModel::rectangular_plate(0.5, 0.5, 21, 21, 0.01), table_3_steel);
   const ShellModel& model = solver.model();
   solver.clamp(model.set("boundary"));
-  solver.add_uniform_pressure(all_particles(model), 12e6);
+  solver.add_uniform_pressure(model.all_particles(), 12e6);
   TearingRun run;
   run.mass_before = total_mass(solver);
   solver.run_until(end_time, [&](const CrackSolver& s) {

@@ -47,8 +47,7 @@ StaticResult static_centre_deflection(int n, double slenderness, Support support
     solver.simply_support_hard(model.set("y_min"), Vector3::UnitX());
     solver.simply_support_hard(model.set("y_max"), Vector3::UnitX());
   }
-  ParticleSet all;
-  for (std::size_t i = 0; i < model.particle_count(); ++i) all.push_back(static_cast<int>(i));
+  const ParticleSet all = model.all_particles();
   solver.add_uniform_pressure(all, q, time_function::Step{}, PressureDirection::fixed);
   const int centre = model.set("centre")[0];
   const double period = 2 * M_PI / omega;

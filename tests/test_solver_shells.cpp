@@ -17,11 +17,6 @@ namespace {
 
 using ElasticSolver = Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<3>, material::Elastic>;
 
-ParticleSet all_particles(const ShellModel& model) {
-  ParticleSet all;
-  for (std::size_t i = 0; i < model.particle_count(); ++i) all.push_back(static_cast<int>(i));
-  return all;
-}
 
 // Cantilever strip (ν = 0, so the strip bends like a beam) under a fixed
 // vertical end load P = α EI/L², solved by dynamic relaxation; returns the tip
@@ -73,7 +68,7 @@ TEST_CASE("Clamped spherical cap under step pressure: apex response of the class
       ShellModel::spherical_cap(0.5657, 26.67 * M_PI / 180, 17, thickness), {72.4e9, 0.3}, options);
   const ShellModel& model = solver.model();
   solver.clamp(model.set("boundary"));
-  solver.add_uniform_pressure(all_particles(model), 600 * 6894.757);
+  solver.add_uniform_pressure(model.all_particles(), 600 * 6894.757);
   const int apex = model.set("apex")[0];
   double first_peak = 0.0, overall_peak = 0.0;
   solver.run_until(1e-3, [&](const auto& s) {
@@ -94,7 +89,7 @@ TEST_CASE("Undamped elastic vibration conserves energy", "[solver][energy]") {
   SolverOptions options;
   ElasticSolver solver(ShellModel::rectangular_plate(0.3, 0.3, 13, 13, 0.01), {210e9, 0.3}, options);
   solver.clamp(solver.model().set("boundary"));
-  solver.add_uniform_pressure(all_particles(solver.model()), 2e5, time_function::Ramp{2e-4});
+  solver.add_uniform_pressure(solver.model().all_particles(), 2e5, time_function::Ramp{2e-4});
   solver.run_until(2e-3);
   const EnergyReport energy = solver.energy();
   INFO("kinetic " << energy.kinetic << " internal " << energy.internal << " external " << energy.external_work);
@@ -146,7 +141,7 @@ TEST_CASE("ParaView frames, collections and probes are written", "[solver][outpu
   options.output_interval = 1e-5;
   ElasticSolver solver(ShellModel::rectangular_plate(0.1, 0.1, 5, 5, 0.01), {210e9, 0.3}, options);
   solver.clamp(solver.model().set("boundary"));
-  solver.add_uniform_pressure(all_particles(solver.model()), 1e5);
+  solver.add_uniform_pressure(solver.model().all_particles(), 1e5);
   solver.add_particle_probe(directory + "/centre.csv", solver.model().set("centre")[0]);
   solver.add_stress_point_probe(directory + "/sp0.csv", 0);
   solver.run_until(5e-5);

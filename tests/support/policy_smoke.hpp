@@ -25,8 +25,7 @@ void run_policy_smoke_test(const std::string& label) {
   Solver<Approx, Rule, Material> solver(ShellModel::rectangular_plate(0.06, 0.06, 7, 7, 0.01),
                                         steel_parameters<Material>(), options);
   solver.clamp(solver.model().set("x_min"));
-  ParticleSet all;
-  for (std::size_t i = 0; i < solver.particle_count(); ++i) all.push_back(static_cast<int>(i));
+  const ParticleSet all = solver.all_particles();
   // Large enough to yield near the clamped edge within the few steps.
   solver.add_uniform_pressure(all, 5e7);
   for (int step = 0; step < 10; ++step) solver.step();

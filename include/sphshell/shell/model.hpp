@@ -238,6 +238,13 @@ class ShellModel {
     return names;
   }
 
+  // Every particle, e.g. for a load over the whole shell.
+  ParticleSet all_particles() const {
+    ParticleSet all(particle_position.size());
+    for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
+    return all;
+  }
+
   int nearest_particle(const Vector3& point) const {
     return nearest(particle_position, point);
   }
