@@ -25,7 +25,7 @@ void run_policy_smoke_test(const std::string& label) {
   Solver<Approx, Rule, Material> solver(ShellModel::rectangular_plate(0.06, 0.06, 7, 7, 0.01),
                                         steel_parameters<Material>(), options);
   solver.clamp(solver.model().set("x_min"));
-  const ParticleSet all = solver.all_particles();
+  const ParticleSet all = solver.model().all_particles();
   // Large enough to yield near the clamped edge within the few steps.
   solver.add_uniform_pressure(all, 5e7);
   for (int step = 0; step < 10; ++step) solver.step();
