@@ -103,13 +103,15 @@ struct EnergyReport {
 
 template <class Approx, class Rule, class Material, class Crack = crack::None>
 class Solver {
-  static_assert(approx::is_approximation<Approx>::value,
+  // Each family's check names the member a policy lacks; the message here says
+  // which parameter it was.
+  static_assert(approx::check_approximation<Approx>(),
                 "Solver: the first parameter must be an approximation policy (approx::MLS<Kernel> or approx::NSPH<Kernel>)");
-  static_assert(thickness::is_thickness_rule<Rule>,
+  static_assert(thickness::check_thickness_rule<Rule>(),
                 "Solver: the second parameter must be a thickness rule (thickness::Gauss<N>, thickness::Simpson<N> or thickness::Global)");
-  static_assert(material::is_material_law<Material>::value,
+  static_assert(material::check_material_law<Material>(),
                 "Solver: the third parameter must be a material law (material::Elastic, J2Plasticity or LemaitreDamage)");
-  static_assert(crack::is_crack_policy<Crack>::value,
+  static_assert(crack::check_crack_policy<Crack>(),
                 "Solver: the fourth parameter must be a crack policy (crack::None or crack::LineSegments)");
 
  public:
@@ -972,18 +974,31 @@ class Solver {
     const double support_radius = smoothing_length_ * Approx::kernel_type::support_radius_factor;
     crack_.initialize(model_.stress_point_position, model_.stress_point_normal, model_.maximum_spacing(),
                       support_radius);
-    // The stress points around each particle: the cells it is a corner of, or,
-    // for a model without cells, the stress points within one spacing.
-    stress_points_of_particle_.assign(model_.particle_count(), {});
+    // The particles around each stress point: the corners of its cell, or, for
+    // a model without cells, the particles within one spacing; and the inverse.
+    particles_of_stress_point_.assign(model_.stress_point_count(), {});
     if (!model_.quads().empty()) {
       for (std::size_t q = 0; q < model_.quads().size(); ++q)
-        for (int corner : model_.quads()[q]) stress_points_of_particle_[corner].push_back(static_cast<int>(q));
+        particles_of_stress_point_[q].assign(model_.quads()[q].begin(), model_.quads()[q].end());
     } else {
       const double reach = model_.maximum_spacing();
-      for (std::size_t i = 0; i < model_.particle_count(); ++i)
-        for (std::size_t q = 0; q < model_.stress_point_count(); ++q)
-          if ((model_.stress_point_position[q] - model_.particle_position[i]).norm() < reach)
-            stress_points_of_particle_[i].push_back(static_cast<int>(q));
+      const approx::CellList cells(model_.particle_position, reach);
+      for (std::size_t q = 0; q < model_.stress_point_count(); ++q)
+        cells.for_each_within(model_.stress_point_position[q], reach, [&](int i, double) {
+          particles_of_stress_point_[q].push_back(i);
+        });
+    }
+    stress_points_of_particle_.assign(model_.particle_count(), {});
+    for (std::size_t q = 0; q < particles_of_stress_point_.size(); ++q)
+      for (int i : particles_of_stress_point_[q]) stress_points_of_particle_[i].push_back(static_cast<int>(q));
+  }
+
+  // Zeroes the forces a point left on the slots of its row.
+  void clear_slots(int group, std::size_t row) {
+    const approx::ShapeFunctions& shape = shape_[group];
+    for (std::size_t s = shape.row_begin[row]; s < shape.row_begin[row + 1]; ++s) {
+      slot_force_[slot_offset_[group] + s].setZero();
+      slot_director_force_[slot_offset_[group] + s].setZero();
     }
   }
 
@@ -993,12 +1008,7 @@ class Solver {
     released_energy_ += stored_energy(p);
     active_[p] = 0;
     const int group = p < point_offset_[1] ? 0 : 1;
-    const std::size_t row = p - point_offset_[group];
-    const approx::ShapeFunctions& shape = shape_[group];
-    for (std::size_t s = shape.row_begin[row]; s < shape.row_begin[row + 1]; ++s) {
-      slot_force_[slot_offset_[group] + s].setZero();
-      slot_director_force_[slot_offset_[group] + s].setZero();
-    }
+    clear_slots(group, p - point_offset_[group]);
   }
 
   // Per step: stress points whose integral points have all failed leave the
@@ -1026,26 +1036,13 @@ class Solver {
     const auto segments = crack_.add_damaged_stress_points(newly_damaged);
     std::vector<int> new_fragments;
     for (int p : newly_damaged)
-      for (int corner : corners_of(p))
+      for (int corner : particles_of_stress_point_[p])
         if (!fragment_[corner] && all_damaged_around(corner)) {
           fragment_[corner] = 1;
           new_fragments.push_back(corner);
           if (point_count(1) > 0 && active_[point_offset_[1] + corner]) deactivate(point_offset_[1] + corner);
         }
     rebuild_near_segments(segments, new_fragments);
-  }
-
-  std::vector<int> corners_of(int stress_point) const {
-    std::vector<int> corners;
-    if (!model_.quads().empty()) {
-      const Quad& quad = model_.quads()[stress_point];
-      corners.assign(quad.begin(), quad.end());
-    } else {
-      for (std::size_t i = 0; i < stress_points_of_particle_.size(); ++i)
-        for (int q : stress_points_of_particle_[i])
-          if (q == stress_point) corners.push_back(static_cast<int>(i));
-    }
-    return corners;
   }
 
   bool all_damaged_around(int particle) const {
@@ -1095,10 +1092,7 @@ class Solver {
         membrane_strain_[p] = strains.membrane;
         curvature_[p] = strains.curvature;
         shear_[p] = strains.shear;
-        for (std::size_t s = shape_[group].row_begin[row]; s < shape_[group].row_begin[row + 1]; ++s) {
-          slot_force_[slot_offset_[group] + s].setZero();
-          slot_director_force_[slot_offset_[group] + s].setZero();
-        }
+        clear_slots(group, row);
         scatter_point(group, row, current);
       }
     }
@@ -1190,7 +1184,7 @@ class Solver {
   std::vector<unsigned char> active_;    // per integration point: still integrates forces
   std::vector<unsigned char> fragment_;  // per particle: every stress point around it damaged
   Crack crack_;
-  std::vector<std::vector<int>> stress_points_of_particle_;
+  std::vector<std::vector<int>> particles_of_stress_point_, stress_points_of_particle_;
   std::size_t damaged_stress_points_ = 0;
   double released_energy_ = 0.0;
   std::vector<Vector3> slot_force_, slot_director_force_;

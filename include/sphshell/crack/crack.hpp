@@ -27,10 +27,11 @@ struct is_crack_policy
     : std::bool_constant<has_enabled_flag<Policy>::value && has_name<Policy>::value> {};
 
 template <class Policy>
-constexpr void check_crack_policy() {
+constexpr bool check_crack_policy() {
   static_assert(has_enabled_flag<Policy>::value,
                 "a crack policy needs `static constexpr bool enabled`");
   static_assert(has_name<Policy>::value, "a crack policy needs `static constexpr const char* name`");
+  return is_crack_policy<Policy>::value;
 }
 
 }  // namespace sphshell::crack
