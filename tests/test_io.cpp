@@ -1,11 +1,13 @@
 #include <sphshell/io/csv_probe.hpp>
 #include <sphshell/io/pvd_collection.hpp>
+#include <sphshell/io/svg_plot.hpp>
 #include <sphshell/io/vtu_writer.hpp>
 
 #include <catch2/catch.hpp>
 
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -455,4 +457,86 @@ TEST_CASE("CSV probe quotes awkward column names and rejects bad rows", "[io][cs
   CHECK_THROWS_AS(io::CsvProbe(path, {"time [s]", ""}), Error);
   const std::string unwritable = directory.file("missing/probe.csv");
   CHECK_THROWS_WITH(io::CsvProbe(unwritable, {"t"}), Catch::Contains(unwritable));
+}
+
+TEST_CASE("SVG plot: axis ticks are whole multiples of a 1, 2, 2.5 or 5 step", "[io][svg]") {
+  struct Case {
+    double minimum, maximum, lower, upper, step;
+  };
+  for (const Case& c : {Case{0.0, 9.3, 0.0, 10.0, 2.0}, Case{0.0, 10.0, 0.0, 10.0, 2.0},
+                        Case{0.0012, 0.0987, 0.0, 0.1, 0.02}, Case{-3.0, 7.0, -4.0, 8.0, 2.0},
+                        Case{150.0, 300.0, 150.0, 300.0, 25.0}, Case{5.0, 5.0, 4.4, 5.6, 0.2},
+                        Case{0.0, 0.0, -1.0, 1.0, 0.5}}) {
+    const io::AxisTicks ticks = io::nice_ticks(c.minimum, c.maximum);
+    INFO("range [" << c.minimum << ", " << c.maximum << "]");
+    CHECK(ticks.step == Approx(c.step).epsilon(1e-12));
+    CHECK(ticks.lower == Approx(c.lower).margin(1e-12));
+    CHECK(ticks.upper == Approx(c.upper).margin(1e-12));
+  }
+  CHECK_THROWS_WITH(io::nice_ticks(1.0, 0.0), Catch::Contains("[1, 0]"));
+  CHECK_THROWS_WITH(io::nice_ticks(0.0, std::numeric_limits<double>::quiet_NaN()), Catch::Contains("not a finite"));
+  CHECK_THROWS_WITH(io::nice_ticks(0.0, 1.0, 0), Catch::Contains("target_intervals = 0"));
+}
+
+TEST_CASE("SVG plot: data map onto the plot area, gaps break lines, labels are escaped", "[io][svg]") {
+  TemporaryDirectory directory;
+  const std::string path = directory.file("plot.svg");
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  io::PlotPanel first{"force <kN> & crack", "displacement [mm]", "force [kN]", {}};
+  first.series.push_back({"line", {0.0, 5.0, 10.0}, {0.0, 5.0, 10.0}, io::PlotStyle::line});
+  first.series.push_back({"gap", {0.0, 1.0, 2.0, 3.0, 4.0}, {1.0, 2.0, nan, 3.0, 4.0}, io::PlotStyle::dashed});
+  first.series.push_back({"reference", {2.0, 4.0, 6.0}, {2.0, 4.0, 6.0}, io::PlotStyle::points});
+  io::PlotPanel second{"second", "x", "y", {}};
+  second.series.push_back({"only", {0.0, 10.0}, {0.0, 10.0}, io::PlotStyle::line});
+  io::write_svg_plot(path, {first, second});
+  const std::string svg = read_whole_file(path);
+
+  // Independent mapping: x spans [0, 10]. The y axis gets headroom for the
+  // legend box (18 px per series + 14 px of the 308 px plot height): with three
+  // series 10 grows to 10 / (1 − 68/308) = 12.8, rounded up to 15 in steps of 2.5;
+  // with one series to 10 / (1 − 32/308) = 11.2, rounded up to 12. x = 0 is the
+  // left edge of the plot area, y = 0 its bottom edge; the second panel is
+  // shifted by one panel width.
+  const io::PlotLayout layout;
+  REQUIRE(layout.plot_height() == 308.0);
+  auto expected = [&](double offset, double y_upper, double x, double y) {
+    char buffer[64];
+    std::snprintf(buffer, sizeof(buffer), "%.2f,%.2f", offset + layout.margin_left + x / 10.0 * layout.plot_width(),
+                  layout.margin_top + (y_upper - y) / y_upper * layout.plot_height());
+    return std::string(buffer);
+  };
+  CHECK_THAT(svg, Catch::Contains("points=\"" + expected(0, 15, 0, 0) + " " + expected(0, 15, 5, 5) + " " +
+                                  expected(0, 15, 10, 10) + "\""));
+  CHECK_THAT(svg, Catch::Contains("points=\"" + expected(layout.panel_width, 12, 0, 0) + " " +
+                                  expected(layout.panel_width, 12, 10, 10) + "\""));
+  CHECK_THAT(svg, Catch::Contains("points=\"" + expected(0, 15, 0, 1) + " " + expected(0, 15, 1, 2) + "\""));
+  CHECK_THAT(svg, Catch::Contains("points=\"" + expected(0, 15, 3, 3) + " " + expected(0, 15, 4, 4) + "\""));
+  const std::regex polyline("<polyline ");
+  CHECK(std::distance(std::sregex_iterator(svg.begin(), svg.end(), polyline), std::sregex_iterator()) == 4);
+  const std::regex marker("<circle cx=\"[0-9.]+\" cy=\"[0-9.]+\" r=\"3.5\"");
+  CHECK(std::distance(std::sregex_iterator(svg.begin(), svg.end(), marker), std::sregex_iterator()) == 3 + 1);
+  CHECK_THAT(svg, Catch::Contains("force &lt;kN&gt; &amp; crack"));
+  CHECK_THAT(svg, Catch::Contains("width=\"" + std::to_string(int(2 * layout.panel_width)) + ".00\""));
+  CHECK_THAT(svg, Catch::EndsWith("</svg>\n"));
+}
+
+TEST_CASE("SVG plot errors name the series and leave existing output alone", "[io][svg]") {
+  TemporaryDirectory directory;
+  const std::string path = directory.file("plot.svg");
+  io::PlotPanel good{"panel", "x", "y", {{"ok", {0.0, 1.0}, {0.0, 1.0}, io::PlotStyle::line}}};
+  io::write_svg_plot(path, {good});
+  const std::string before = read_whole_file(path);
+  io::PlotPanel uneven{"panel", "x", "y", {{"uneven", {0.0, 1.0, 2.0}, {0.0, 1.0}, io::PlotStyle::line}}};
+  CHECK_THROWS_WITH(io::write_svg_plot(path, {uneven}), Catch::Contains("'uneven'") && Catch::Contains("3 x values but 2"));
+  io::PlotPanel infinite{"panel", "x", "y",
+                         {{"infinite", {0.0, std::numeric_limits<double>::infinity()}, {0.0, 1.0}, io::PlotStyle::line}}};
+  CHECK_THROWS_WITH(io::write_svg_plot(path, {infinite}), Catch::Contains("'infinite'") && Catch::Contains("inf"));
+  CHECK_THROWS_WITH(io::write_svg_plot(path, {}), Catch::Contains("at least one panel"));
+  io::PlotLayout cramped;
+  cramped.margin_left = 600.0;
+  CHECK_THROWS_WITH(io::write_svg_plot(path, {good}, cramped), Catch::Contains("no plot area"));
+  CHECK(read_whole_file(path) == before);
+  // A panel without data still gets axes (a run that ended before anything happened).
+  io::PlotPanel empty{"empty", "x", "y", {{"nothing", {}, {}, io::PlotStyle::line}}};
+  CHECK_NOTHROW(io::write_svg_plot(directory.file("empty.svg"), {empty}));
 }

@@ -13,6 +13,7 @@
 
 #include <sphshell/io/csv_probe.hpp>
 #include <sphshell/io/pvd_collection.hpp>
+#include <sphshell/io/svg_plot.hpp>
 #include <sphshell/io/vtu_writer.hpp>
 
 #include <sphshell/shell/model.hpp>
