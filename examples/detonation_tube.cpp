@@ -105,6 +105,7 @@ struct Arguments {
   double length = 0.914;
   double end_time = 4e-4;
   double rotary_scale = 0.0;  // 0: automatic
+  std::string pressure_direction = "follower";
   std::string output;
   std::string csv = "detonation_tube.csv";
 };
@@ -122,6 +123,7 @@ Arguments parse(int argc, char** argv) {
     else if (flag == "--length") a.length = std::stod(value());
     else if (flag == "--end-time") a.end_time = std::stod(value());
     else if (flag == "--rotary-scale") a.rotary_scale = std::stod(value());
+    else if (flag == "--pressure-direction") a.pressure_direction = value();
     else if (flag == "--output") a.output = value();
     else if (flag == "--csv") a.csv = value();
     else throw Error("unknown option " + flag + " (see the comment at the top of detonation_tube.cpp)");
@@ -130,6 +132,8 @@ Arguments parse(int argc, char** argv) {
   detail::require_positive("--radius", a.radius);
   detail::require_positive("--end-time", a.end_time);
   detail::require_nonnegative("--rotary-scale", a.rotary_scale);
+  if (a.pressure_direction != "follower" && a.pressure_direction != "fixed")
+    throw Error("--pressure-direction is '" + a.pressure_direction + "'; use follower or fixed");
   if (!(a.length > notch_length() + 4 * a.spacing))
     detail::invalid_parameter("--length", a.length, "must exceed the notch (50.8 mm) by a few spacings");
   return a;
@@ -175,7 +179,8 @@ int run(const Arguments& a) {
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
   // Outward internal pressure: negative in the library's convention (outward directors).
   solver.add_pressure(
-      all, [](const Vector3& X, double t) { return -detonation_pressure(X.z(), t); }, PressureDirection::follower);
+      all, [](const Vector3& X, double t) { return -detonation_pressure(X.z(), t); },
+      a.pressure_direction == "fixed" ? PressureDirection::fixed : PressureDirection::follower);
 
   const double notch_centre = 0.5 * a.length;
   const double theta = 0.25 * d_theta;
@@ -280,7 +285,26 @@ int run(const Arguments& a) {
               solver.fragment_count());
   std::printf("energy: kinetic %.4g J, plastic dissipation %.4g J, external work %.4g J, balance %.3g J\n",
               e.kinetic, e.plastic_dissipation, e.external_work, e.balance());
-  std::printf("%ld steps in %.1f s; history in %s\n", solver.steps(), seconds, csv.c_str());
+  io::PlotSeries rear{"rear tip", {}, {}}, front{"front tip", {}, {}}, arc{"circumferential half-extent", {}, {}, io::PlotStyle::dashed};
+  io::PlotSeries rear_position{"rear tip (distance behind the notch)", {}, {}}, front_position{"front tip (distance ahead)", {}, {}};
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    const double microseconds = samples[k].t * 1e6;
+    rear.x.push_back(microseconds);
+    rear.y.push_back(rear_speed[k]);
+    front.x.push_back(microseconds);
+    front.y.push_back(front_speed[k]);
+    rear_position.x.push_back(microseconds);
+    rear_position.y.push_back((notch_centre - 0.5 * notch_length() - samples[k].rear) * 1e3);
+    front_position.x.push_back(microseconds);
+    front_position.y.push_back((samples[k].front - notch_centre - 0.5 * notch_length()) * 1e3);
+    arc.x.push_back(microseconds);
+    arc.y.push_back(samples[k].arc * 1e3);
+  }
+  const std::string plot = std::filesystem::path(csv).replace_extension(".svg").string();
+  io::write_svg_plot(plot, {{"Axial crack-tip speeds (paper Fig. 32)", "t [µs]", "speed [m/s]", {rear, front}},
+                            {"Crack growth beyond the notch", "t [µs]", "extent [mm]",
+                             {rear_position, front_position, arc}}});
+  std::printf("%ld steps in %.1f s; history in %s, plot in %s\n", solver.steps(), seconds, csv.c_str(), plot.c_str());
   return 0;
 }
 

@@ -101,12 +101,20 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
+// Table 5.
+constexpr double thickness = 0.01, density = 7800.0, E = 200e9, nu = 0.3;
+constexpr double sigma_y0 = 270e6, Ep = 833e6, eps_s = 0.13, eps_c = 0.37, Dc = 0.22;
+// Assumed geometry (see the header).
+constexpr double width = 0.60;
+constexpr double pin_offset_x = 0.10, pin_offset_y = 0.05;
 struct Arguments {
   int n = 61;
   double speed = 5.0;
   double end_displacement = 0.12;
   double precrack = 0.10;
   double rotary_scale = 400.0;
+  double arm_length = 0.80;
+  double stroke_per_arm = 0.5;
   std::string output;
   std::string csv = "plate_tearing.csv";
 };
@@ -124,6 +132,8 @@ Arguments parse(int argc, char** argv) {
     else if (flag == "--end-displacement") a.end_displacement = std::stod(value());
     else if (flag == "--precrack") a.precrack = std::stod(value());
     else if (flag == "--rotary-scale") a.rotary_scale = std::stod(value());
+    else if (flag == "--arm-length") a.arm_length = std::stod(value());
+    else if (flag == "--stroke-per-arm") a.stroke_per_arm = std::stod(value());
     else if (flag == "--output") a.output = value();
     else if (flag == "--csv") a.csv = value();
     else throw Error("unknown option " + flag + " (see the comment at the top of plate_tearing.cpp)");
@@ -132,15 +142,13 @@ Arguments parse(int argc, char** argv) {
   detail::require_positive("--speed", a.speed);
   detail::require_positive("--end-displacement", a.end_displacement);
   detail::require_positive("--rotary-scale", a.rotary_scale);
+  if (!(a.arm_length > width + pin_offset_x))
+    detail::invalid_parameter("--arm-length", a.arm_length, "must reach past the plate's left edge (> 0.7 m)");
+  if (!(a.stroke_per_arm > 0.0 && a.stroke_per_arm <= 1.0))
+    detail::invalid_parameter("--stroke-per-arm", a.stroke_per_arm, "must lie in (0, 1]");
   return a;
 }
 
-// Table 5.
-constexpr double thickness = 0.01, density = 7800.0, E = 200e9, nu = 0.3;
-constexpr double sigma_y0 = 270e6, Ep = 833e6, eps_s = 0.13, eps_c = 0.37, Dc = 0.22;
-// Assumed geometry (see the header).
-constexpr double width = 0.60;
-constexpr double pin_offset_x = 0.10, pin_offset_y = 0.05, attachment_offset_x = 0.10;
 constexpr double start_time = 5e-4;  // smooth start of the crosshead
 
 // One arm: a rigid body rotating about its pin O (eq. 4.1–4.3). `sign` is +1
@@ -206,17 +214,17 @@ int run(const Arguments& a) {
 
   const double mid = 0.5 * height;
   const Arm upper{Vector3(width + pin_offset_x, height + pin_offset_y, 0.0),
-                  width + pin_offset_x + attachment_offset_x, kPi, 1.0};
+                  a.arm_length, kPi, 1.0};
   const Arm lower{Vector3(width + pin_offset_x, -pin_offset_y, 0.0), upper.l_OA, kPi, -1.0};
-  const double speed = a.speed;
-  solver.prescribe_displacement(model.set("upper_grip"), [upper, speed](const Vector3& X, double t) {
-    return upper.displacement(X, 0.5 * stroke(t, speed));
+  const double speed = a.speed, share = a.stroke_per_arm;
+  solver.prescribe_displacement(model.set("upper_grip"), [upper, speed, share](const Vector3& X, double t) {
+    return upper.displacement(X, share * stroke(t, speed));
   });
-  solver.prescribe_displacement(model.set("lower_grip"), [lower, speed](const Vector3& X, double t) {
-    return lower.displacement(X, 0.5 * stroke(t, speed));
+  solver.prescribe_displacement(model.set("lower_grip"), [lower, speed, share](const Vector3& X, double t) {
+    return lower.displacement(X, share * stroke(t, speed));
   });
   // Check the arm reach for the whole run before starting.
-  upper.beta(0.5 * a.end_displacement);
+  upper.beta(share * a.end_displacement);
 
   // Pre-crack a quarter spacing above mid-height (between the middle stress-point
   // row and the particle row above it), from just outside the left edge.
@@ -258,6 +266,8 @@ int run(const Arguments& a) {
             << solver.time_step() << " s (stable " << solver.stable_time_step() << " s)\n";
   struct Row { double stroke, p_grip, p_cross, advance, grown; };
   std::vector<Row> table;
+  io::PlotSeries force_curve{"P_crosshead (SPH shell)", {}, {}}, grip_curve{"P_grip", {}, {}, io::PlotStyle::dashed};
+  io::PlotSeries advance_curve{"crack advance", {}, {}};
   double next_table = 0.0, peak_force = 0.0, peak_stroke = 0.0;
   const double table_step = a.end_displacement / 12.0;
   const double end_time = a.end_displacement / speed + 0.5 * start_time;
@@ -265,7 +275,7 @@ int run(const Arguments& a) {
   long next_progress = 0;
   solver.run_until(end_time, [&](const TearingSolver& s) {
     const double delta = stroke(s.time(), speed);
-    const double travel = 0.5 * delta;
+    const double travel = share * delta;
     const auto [p_grip, p_cross] = forces(s, travel);
     if (p_cross > peak_force) {
       peak_force = p_cross;
@@ -279,6 +289,12 @@ int run(const Arguments& a) {
     history.write_row({s.time(), delta, upper.beta(travel), p_grip, p_cross, tip - a.precrack, grown, tip,
                        double(s.damaged_stress_point_count()), double(s.crack().crack_count()), e.kinetic,
                        e.plastic_dissipation, e.external_work});
+    force_curve.x.push_back(delta * 1e3);
+    force_curve.y.push_back(p_cross * 1e-3);
+    grip_curve.x.push_back(delta * 1e3);
+    grip_curve.y.push_back(p_grip * 1e-3);
+    advance_curve.x.push_back(delta * 1e3);
+    advance_curve.y.push_back((tip - a.precrack) * 1e3);
     if (table_row) {
       table.push_back({delta, p_grip, p_cross, tip - a.precrack, grown});
       next_table += table_step;
@@ -301,7 +317,12 @@ int run(const Arguments& a) {
   std::printf("\npeak crosshead force %.1f kN at stroke %.1f mm\n", peak_force * 1e-3, peak_stroke * 1e3);
   std::printf("energy: kinetic %.4g J, plastic dissipation %.4g J, external work %.4g J, balance %.3g J\n",
               e.kinetic, e.plastic_dissipation, e.external_work, e.balance());
-  std::printf("%ld steps in %.1f s; history in %s\n", solver.steps(), seconds, csv.c_str());
+  const std::string plot = std::filesystem::path(csv).replace_extension(".svg").string();
+  io::write_svg_plot(plot, {{"Crosshead force (paper Fig. 26)", "crosshead displacement [mm]", "force [kN]",
+                             {force_curve, grip_curve}},
+                            {"Crack length (paper Fig. 27)", "crosshead displacement [mm]",
+                             "crack advance beyond the pre-crack [mm]", {advance_curve}}});
+  std::printf("%ld steps in %.1f s; history in %s, plot in %s\n", solver.steps(), seconds, csv.c_str(), plot.c_str());
   return 0;
 }
 

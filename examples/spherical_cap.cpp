@@ -66,11 +66,14 @@ int run(const Arguments& arguments, const typename Material::Parameters& paramet
   io::CsvProbe history(csv, {"t [s]", "u/d [-]"});
   double peak = 0.0, peak_time = 0.0;
   long next_report = 0;
+  io::PlotSeries apex_curve{"apex (SPH shell)", {}, {}};
   std::cout << "spherical cap: " << model.particle_count() << " particles, " << model.stress_point_count()
             << " stress points, " << Material::name << ", dt = " << solver.time_step() << " s\n";
   solver.run_until(arguments.end_time, [&](const auto& s) {
     const double u = -s.displacement(apex).dot(model.particle_normal[apex]) / thickness;
     history.write_row({s.time(), u});
+    apex_curve.x.push_back(s.time() * 1e3);
+    apex_curve.y.push_back(u);
     if (u > peak) {
       peak = u;
       peak_time = s.time();
@@ -80,7 +83,10 @@ int run(const Arguments& arguments, const typename Material::Parameters& paramet
       next_report += 100;
     }
   });
-  std::cout << "peak apex u/d = " << peak << " at t = " << peak_time * 1e3 << " ms; history in " << csv << '\n';
+  const std::string plot = std::filesystem::path(csv).replace_extension(".svg").string();
+  io::write_svg_plot(plot, {{"Apex displacement (paper Fig. 7)", "t [ms]", "u/d [-]", {apex_curve}}});
+  std::cout << "peak apex u/d = " << peak << " at t = " << peak_time * 1e3 << " ms; history in " << csv
+            << ", plot in " << plot << '\n';
   return 0;
 }
 

@@ -59,6 +59,12 @@ Arguments parse(int argc, char** argv) {
 
 constexpr double length = 0.5, thickness = 0.01, density = 7850.0, E = 210e9, nu = 0.3;
 constexpr double sigma_y0 = 235e6, Ep = 0.0, eps_s = 0.02, eps_c = 0.37, Dc = 0.24;
+constexpr double bending_stiffness = E * thickness * thickness * thickness / (12 * (1 - nu * nu));
+
+// Static centre deflection of the clamped square Mindlin plate at L/d = 50.
+double static_mindlin_deflection(double pressure) {
+  return 0.0012754 * pressure * std::pow(length, 4) / bending_stiffness;
+}
 
 template <class Rule, class Material, class Crack = crack::None>
 int run(const Arguments& a, const typename Material::Parameters& parameters) {
@@ -98,6 +104,7 @@ int run(const Arguments& a, const typename Material::Parameters& parameters) {
             << (options.nonlinear ? "nonlinear" : "linear") << " analysis, q = " << pressure
             << " Pa, dt = " << solver.time_step() << " s\n";
   double peak = 0.0, peak_time = 0.0;
+  io::PlotSeries deflection{"w at the centre A", {}, {}}, crack_length{"total crack length", {}, {}};
   const auto start = std::chrono::steady_clock::now();
   solver.run_until(a.end_time, [&](const PlateSolver& s) {
     const double w = -s.displacement(point_a).z();
@@ -116,6 +123,12 @@ int run(const Arguments& a, const typename Material::Parameters& parameters) {
       row.insert(row.end(), {s.crack().total_length(), double(s.crack().crack_count()),
                              double(s.damaged_stress_point_count()), double(s.fragment_count())});
     history.write_row(row);
+    deflection.x.push_back(s.time() * 1e3);
+    deflection.y.push_back(w * 1e3);
+    if constexpr (Crack::enabled) {
+      crack_length.x.push_back(s.time() * 1e3);
+      crack_length.y.push_back(s.crack().total_length());
+    }
   });
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const EnergyReport energy = solver.energy();
@@ -130,15 +143,25 @@ int run(const Arguments& a, const typename Material::Parameters& parameters) {
               << solver.crack().total_length() << " m, " << solver.damaged_stress_point_count()
               << " damaged stress points, " << solver.fragment_count() << " fragment particles\n";
   if (a.analysis == "linear") {
-    const double D = E * thickness * thickness * thickness / (12 * (1 - nu * nu));
-    const double static_deflection = 0.0012754 * pressure * std::pow(length, 4) / D;  // Mindlin, L/d = 50
-    const double period = 2 * M_PI / (35.99 / (length * length) * std::sqrt(D / (density * thickness)));
+    const double static_deflection = static_mindlin_deflection(pressure);
+    const double period =
+        2 * M_PI / (35.99 / (length * length) * std::sqrt(bending_stiffness / (density * thickness)));
     std::cout << "closed forms: static Mindlin deflection " << static_deflection * 1e3
               << " mm (dynamic peak ≈ twice that: " << 2e3 * static_deflection
               << " mm), fundamental period " << period * 1e3 << " ms (first peak near "
               << period * 5e2 << " ms)\n";
   }
-  std::cout << "history written to " << csv << '\n';
+  std::vector<io::PlotPanel> panels{{"Centre deflection (paper Figs 8, 22)", "t [ms]", "w_A [mm]", {deflection}}};
+  if (a.analysis == "linear") {
+    const double twice_static = 2e3 * static_mindlin_deflection(pressure);
+    panels[0].series.push_back({"2 × static Mindlin deflection", {0.0, a.end_time * 1e3}, {twice_static, twice_static},
+                                io::PlotStyle::dashed});
+  }
+  if constexpr (Crack::enabled)
+    panels.push_back({"Crack length (paper Fig. 21)", "t [ms]", "total crack length [m]", {crack_length}});
+  const std::string plot = std::filesystem::path(csv).replace_extension(".svg").string();
+  io::write_svg_plot(plot, panels);
+  std::cout << "history written to " << csv << ", plot to " << plot << '\n';
   return 0;
 }
 
