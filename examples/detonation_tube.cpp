@@ -97,6 +97,8 @@
 
 #include <sphshell/sphshell.hpp>
 
+#include "example_arguments.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -137,11 +139,11 @@ Arguments parse(int argc, char** argv) {
       if (k + 1 >= argc) throw Error(flag + " needs a value");
       return argv[++k];
     };
-    if (flag == "--spacing") a.spacing = std::stod(value());
-    else if (flag == "--radius") a.radius = std::stod(value());
-    else if (flag == "--length") a.length = std::stod(value());
-    else if (flag == "--end-time") a.end_time = std::stod(value());
-    else if (flag == "--rotary-scale") a.rotary_scale = std::stod(value());
+    if (flag == "--spacing") a.spacing = example::parse_number(flag, value());
+    else if (flag == "--radius") a.radius = example::parse_number(flag, value());
+    else if (flag == "--length") a.length = example::parse_number(flag, value());
+    else if (flag == "--end-time") a.end_time = example::parse_number(flag, value());
+    else if (flag == "--rotary-scale") a.rotary_scale = example::parse_number(flag, value());
     else if (flag == "--pressure-direction") a.pressure_direction = value();
     else if (flag == "--output") a.output = value();
     else if (flag == "--csv") a.csv = value();

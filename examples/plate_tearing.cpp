@@ -102,6 +102,8 @@
 
 #include <sphshell/sphshell.hpp>
 
+#include "example_arguments.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -143,13 +145,13 @@ Arguments parse(int argc, char** argv) {
       if (k + 1 >= argc) throw Error(flag + " needs a value");
       return argv[++k];
     };
-    if (flag == "--n") a.n = std::stoi(value());
-    else if (flag == "--speed") a.speed = std::stod(value());
-    else if (flag == "--end-displacement") a.end_displacement = std::stod(value());
-    else if (flag == "--precrack") a.precrack = std::stod(value());
-    else if (flag == "--rotary-scale") a.rotary_scale = std::stod(value());
-    else if (flag == "--arm-length") a.arm_length = std::stod(value());
-    else if (flag == "--stroke-per-arm") a.stroke_per_arm = std::stod(value());
+    if (flag == "--n") a.n = example::parse_integer(flag, value());
+    else if (flag == "--speed") a.speed = example::parse_number(flag, value());
+    else if (flag == "--end-displacement") a.end_displacement = example::parse_number(flag, value());
+    else if (flag == "--precrack") a.precrack = example::parse_number(flag, value());
+    else if (flag == "--rotary-scale") a.rotary_scale = example::parse_number(flag, value());
+    else if (flag == "--arm-length") a.arm_length = example::parse_number(flag, value());
+    else if (flag == "--stroke-per-arm") a.stroke_per_arm = example::parse_number(flag, value());
     else if (flag == "--output") a.output = value();
     else if (flag == "--csv") a.csv = value();
     else throw Error("unknown option " + flag + " (see the comment at the top of plate_tearing.cpp)");

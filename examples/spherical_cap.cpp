@@ -11,6 +11,8 @@
 
 #include <sphshell/sphshell.hpp>
 
+#include "example_arguments.hpp"
+
 #include <cmath>
 #include <filesystem>
 #include <cstdlib>
@@ -37,11 +39,13 @@ Arguments parse(int argc, char** argv) {
       return argv[++k];
     };
     if (flag == "--plastic") arguments.plastic = true;
-    else if (flag == "--n") arguments.n = std::stoi(value());
-    else if (flag == "--end-time") arguments.end_time = std::stod(value());
+    else if (flag == "--n") arguments.n = example::parse_integer(flag, value());
+    else if (flag == "--end-time") arguments.end_time = example::parse_number(flag, value());
     else if (flag == "--output") arguments.output = value();
     else throw Error("spherical_cap: unknown option " + flag);
   }
+  if (arguments.n < 3) detail::invalid_parameter("--n", arguments.n, "must be at least 3");
+  detail::require_positive("--end-time", arguments.end_time);
   return arguments;
 }
 

@@ -19,6 +19,8 @@
 
 #include <sphshell/sphshell.hpp>
 
+#include "example_arguments.hpp"
+
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -48,12 +50,15 @@ Arguments parse(int argc, char** argv) {
     };
     if (flag == "--case") a.analysis = value();
     else if (flag == "--rule") a.rule = value();
-    else if (flag == "--n") a.n = std::stoi(value());
-    else if (flag == "--pressure") a.pressure = std::stod(value());
-    else if (flag == "--end-time") a.end_time = std::stod(value());
+    else if (flag == "--n") a.n = example::parse_integer(flag, value());
+    else if (flag == "--pressure") a.pressure = example::parse_number(flag, value());
+    else if (flag == "--end-time") a.end_time = example::parse_number(flag, value());
     else if (flag == "--output") a.output = value();
     else throw Error("square_plate: unknown option " + flag + " (see the comment at the top of square_plate.cpp)");
   }
+  if (a.n < 3) detail::invalid_parameter("--n", a.n, "must be at least 3");
+  detail::require_positive("--end-time", a.end_time);
+  if (a.pressure != 0.0) detail::require_positive("--pressure", a.pressure);
   return a;
 }
 

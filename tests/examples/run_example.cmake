@@ -1,7 +1,9 @@
 # Runs one example end to end in a scratch directory and checks that it exits
 # cleanly and writes its outputs: a CSV history with data rows, an SVG plot with
 # drawn curves, and the ParaView collections it announces.
-#   cmake -DEXAMPLE=<exe> -DARGUMENTS="a|b|c" -DWORK_DIR=<dir> -DOUTPUTS="x.csv|y.svg" -P run_example.cmake
+# With EXPECT_ERROR set, the run must instead fail with a message containing it.
+#   cmake -DEXAMPLE=<exe> -DARGUMENTS="a|b|c" -DWORK_DIR=<dir> -DOUTPUTS="x.csv|y.svg"
+#         [-DEXPECT_ERROR=text] -P run_example.cmake
 string(REPLACE "|" ";" arguments "${ARGUMENTS}")
 string(REPLACE "|" ";" outputs "${OUTPUTS}")
 file(REMOVE_RECURSE "${WORK_DIR}")
@@ -9,6 +11,17 @@ file(MAKE_DIRECTORY "${WORK_DIR}")
 execute_process(COMMAND "${EXAMPLE}" ${arguments}
                 WORKING_DIRECTORY "${WORK_DIR}"
                 RESULT_VARIABLE result OUTPUT_VARIABLE output ERROR_VARIABLE errors)
+if(DEFINED EXPECT_ERROR)
+  if(result EQUAL 0)
+    message(FATAL_ERROR "${EXAMPLE} ${arguments} succeeded; expected an error mentioning '${EXPECT_ERROR}'")
+  endif()
+  string(FIND "${errors}" "${EXPECT_ERROR}" position)
+  if(position EQUAL -1)
+    message(FATAL_ERROR "${EXAMPLE} ${arguments} failed without mentioning '${EXPECT_ERROR}':\n${errors}")
+  endif()
+  message(STATUS "${EXAMPLE} ${arguments}: ${errors}")
+  return()
+endif()
 if(NOT result EQUAL 0)
   message(FATAL_ERROR "${EXAMPLE} ${arguments} exited with ${result}\n${output}\n${errors}")
 endif()
