@@ -281,6 +281,42 @@ TEST_CASE("visibility does not depend on the order of damage insertion",
   CHECK(visibility_table(forward, plate.particles) == visibility_table(backward, plate.particles));
 }
 
+TEST_CASE("a pre-crack along a row of stress points takes them over as its crack points",
+          "[crack][line_segments]") {
+  const Plate plate(12, 12);
+  LineSegments crack = plate.crack();
+  // From inside cell (1, 5) along the stress-point row y = 5.5 to the stress
+  // point (6, 5) itself, which then stands for the end vertex.
+  const std::vector<int> absorbed = crack.add_precrack({node(1.2, 5.5), node(6.5, 5.5)});
+  std::vector<int> expected;
+  for (int i = 1; i <= 6; ++i) expected.push_back(plate.stress_point(i, 5));
+  std::sort(expected.begin(), expected.end());
+  CHECK(absorbed == expected);
+  CHECK(crack.points().size() == 7);  // the start vertex and six stress points
+  CHECK(crack.segments().size() == 6);
+  CHECK(crack.total_length() == Approx(5.3 * spacing));
+  CHECK(crack.damaged_count() == 0);  // taken over by the pre-crack, not damaged
+  for (int i = 1; i <= 6; ++i) {
+    INFO("stress point (" << i << ", 5)");
+    CHECK(crack.is_damaged(plate.stress_point(i, 5)));
+    CHECK(crack.points()[static_cast<std::size_t>(crack.crack_point_of_stress_point(plate.stress_point(i, 5)))]
+              .isApprox(plate.stress_points[static_cast<std::size_t>(plate.stress_point(i, 5))]));
+  }
+  CHECK_FALSE(crack.is_damaged(plate.stress_point(0, 5)));
+  CHECK_FALSE(crack.is_damaged(plate.stress_point(7, 5)));
+  CHECK_FALSE(crack.is_damaged(plate.stress_point(3, 4)));
+  CHECK_FALSE(visible_on_plate(crack, node(3, 5), node(3, 6)));
+  CHECK(visible_on_plate(crack, node(8, 5), node(8, 6)));
+  // Damage next along the row extends the same crack.
+  crack.add_damaged_stress_points({plate.stress_point(7, 5)});
+  CHECK(crack.crack_count() == 1);
+  CHECK(crack.total_length() == Approx(6.3 * spacing));
+  // A second pre-crack crossing the first does not take its stress points again.
+  const std::vector<int> crossing = crack.add_precrack({node(3.5, 2.2), node(3.5, 8.8)});
+  CHECK(std::find(crossing.begin(), crossing.end(), plate.stress_point(3, 5)) == crossing.end());
+  CHECK(crossing.size() == 6);  // rows 2, 3, 4, 6, 7, 8 of column x = 3.5
+}
+
 TEST_CASE("a pre-crack polyline cuts like a damage crack", "[crack][line_segments][visibility]") {
   const Plate plate(12, 12);
   LineSegments crack = plate.crack();

@@ -62,15 +62,14 @@ TearingRun tear_plate(double end_time) {
   return run;
 }
 
-}  // namespace
-
-TEST_CASE("A through pre-crack separates a strip under tension", "[fracture][solver]") {
-  // 0.2 m × 0.1 m strip, spacing 1 cm; the pre-crack at x = 0.1025 m runs
-  // between a particle column (x = 0.10) and a stress-point column (x = 0.105)
-  // and past both free edges.
+// 0.2 m × 0.1 m strip, spacing 1 cm, clamped at x = 0 and pulled at x = 0.2 m,
+// with a through pre-crack at x = crack_x past both free edges.
+void check_strip_separates(double crack_x, std::size_t expected_precrack_points) {
   CrackSolver solver(ShellModel::rectangular_plate(0.2, 0.1, 21, 11, 0.005), table_3_steel);
   const ShellModel& model = solver.model();
-  solver.add_precrack({Vector3(0.1025, -0.002, 0.0), Vector3(0.1025, 0.102, 0.0)});
+  solver.add_precrack({Vector3(crack_x, -0.002, 0.0), Vector3(crack_x, 0.102, 0.0)});
+  CHECK(solver.precrack_stress_point_count() == expected_precrack_points);
+  CHECK(solver.damaged_stress_point_count() == 0);
   solver.clamp(model.set("x_min"));
   solver.prescribe_velocity(model.set("x_max"), [](const Vector3&, double) { return Vector3(2.0, 0.0, 0.0); });
   const double mass = total_mass(solver);
@@ -81,7 +80,7 @@ TEST_CASE("A through pre-crack separates a strip under tension", "[fracture][sol
   for (std::size_t i = 0; i < solver.particle_count(); ++i) {
     const double x = model.particle_position[i].x();
     force_scale += solver.internal_forces()[i].norm();
-    if (x < 0.1025) {
+    if (x < crack_x) {
       left_force += solver.internal_forces()[i];
       left_motion = std::max(left_motion, solver.displacement(static_cast<int>(i)).norm());
     } else {
@@ -89,8 +88,8 @@ TEST_CASE("A through pre-crack separates a strip under tension", "[fracture][sol
       ++right_count;
     }
   }
-  INFO("left half: largest displacement " << left_motion << " m; right half mean x-displacement "
-                                          << right_motion / right_count << " m");
+  INFO("pre-crack at x = " << crack_x << " m; left half: largest displacement " << left_motion
+                           << " m; right half mean x-displacement " << right_motion / right_count << " m");
   CHECK(solver.crack().segments().size() >= 1);
   CHECK(left_force.norm() <= 1e-9 * (force_scale + 1.0));
   CHECK(left_motion < 1e-12);                                  // nothing pulls the left half
@@ -98,6 +97,24 @@ TEST_CASE("A through pre-crack separates a strip under tension", "[fracture][sol
   // half, cut off, does not move at all.
   CHECK(right_motion / right_count == Approx(2.0 * solver.time()).epsilon(0.1));
   CHECK(total_mass(solver) == mass);
+}
+
+}  // namespace
+
+TEST_CASE("A through pre-crack separates a strip under tension", "[fracture][solver]") {
+  SECTION("between a particle column (x = 0.10) and a stress-point column (x = 0.105)") {
+    check_strip_separates(0.1025, 0);
+  }
+  SECTION("along the stress-point column x = 0.105: its ten stress points leave the integration") {
+    check_strip_separates(0.105, 10);
+  }
+}
+
+TEST_CASE("A pre-crack through a particle is an error naming it", "[fracture][solver][errors]") {
+  CrackSolver solver(ShellModel::rectangular_plate(0.2, 0.1, 21, 11, 0.005), table_3_steel);
+  CHECK_THROWS_WITH(solver.add_precrack({Vector3(0.10, -0.002, 0.0), Vector3(0.10, 0.102, 0.0)}),
+                    Catch::Contains("particle 10 ") && Catch::Contains("tie its faces together"));
+  CHECK(solver.crack().segments().empty());
 }
 
 TEST_CASE("The paper's clamped plate tears from the mid-edges", "[fracture][solver][validation]") {

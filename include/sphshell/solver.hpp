@@ -277,14 +277,34 @@ class Solver {
   }
 
   // A pre-crack: a polyline on the shell (reference coordinates). Pairs across
-  // it stop interacting at once.
+  // it stop interacting at once. Stress points lying on it become its crack
+  // points and leave the integration, so a pre-crack drawn along a row of
+  // stress points is the crack that row's failure would form; a polyline
+  // through a particle is an Error (the particle would tie the faces together).
   void add_precrack(const std::vector<Vector3>& polyline) {
     static_assert(Crack::enabled,
                   "add_precrack needs a crack policy such as crack::LineSegments; a Solver with "
                   "crack::None has no cracks");
-    crack_.add_precrack(polyline);
-    rebuild_near_segments(crack_.segments());
+    reject_particles_on(polyline);
+    const std::vector<int> absorbed = crack_.add_precrack(polyline);
+    // Stress points on the pre-crack are its crack points: they leave the
+    // integration as damaged ones would, and particles left without any
+    // stress point become fragments.
+    std::vector<int> new_fragments;
+    for (int p : absorbed) {
+      if (active_[p]) deactivate(static_cast<std::size_t>(p));
+      for (int corner : particles_of_stress_point_[p])
+        if (!fragment_[corner] && all_damaged_around(corner)) {
+          fragment_[corner] = 1;
+          new_fragments.push_back(corner);
+          if (point_count(1) > 0 && active_[point_offset_[1] + corner]) deactivate(point_offset_[1] + corner);
+        }
+    }
+    precrack_stress_points_ += absorbed.size();
+    rebuild_near_segments(crack_.segments(), new_fragments);
   }
+  // Stress points removed because they lie on a pre-crack (not counted as damaged).
+  std::size_t precrack_stress_point_count() const { return precrack_stress_points_; }
   // The crack topology (reference configuration); crack::None has none.
   const Crack& crack() const { return crack_; }
   // Stress points removed from the force integration (all integral points failed).
@@ -1045,6 +1065,22 @@ class Solver {
     rebuild_near_segments(segments, new_fragments);
   }
 
+  // A particle on a crack line would see both faces and tie them together.
+  void reject_particles_on(const std::vector<Vector3>& polyline) const {
+    const double tolerance = Crack::on_precrack_in_spacings * crack_.spacing();
+    for (std::size_t k = 0; k + 1 < polyline.size(); ++k)
+      for (std::size_t i = 0; i < model_.particle_count(); ++i)
+        if (Crack::distance_to_precrack_piece(model_.particle_position[i], polyline[k], polyline[k + 1]) <=
+            tolerance) {
+          std::ostringstream message;
+          message << "sphshell: the pre-crack passes through particle " << i << " at ("
+                  << model_.particle_position[i].transpose()
+                  << "); a particle on a crack would tie its faces together: move the pre-crack off the particles "
+                     "(along a row of stress points, or a fraction of the spacing aside)";
+          throw Error(message.str());
+        }
+  }
+
   bool all_damaged_around(int particle) const {
     const std::vector<int>& around = stress_points_of_particle_[particle];
     return !around.empty() &&
@@ -1186,6 +1222,7 @@ class Solver {
   Crack crack_;
   std::vector<std::vector<int>> particles_of_stress_point_, stress_points_of_particle_;
   std::size_t damaged_stress_points_ = 0;
+  std::size_t precrack_stress_points_ = 0;
   double released_energy_ = 0.0;
   std::vector<Vector3> slot_force_, slot_director_force_;
   std::vector<std::size_t> particle_slot_begin_, particle_slots_;

@@ -69,6 +69,11 @@ class LineSegments {
   static constexpr double linking_distance_in_spacings = 1.5;
   // Pre-crack pieces shorter than this fraction of the spacing count as zero-length.
   static constexpr double zero_length_in_spacings = 1e-9;
+  // A point closer than this fraction of the spacing to a pre-crack lies on it.
+  static constexpr double on_precrack_in_spacings = 1e-6;
+  static double distance_to_precrack_piece(const Vector3& point, const Vector3& start, const Vector3& end) {
+    return distance_to_segment(point, start, end);
+  }
 
   LineSegments() = default;
 
@@ -106,7 +111,10 @@ class LineSegments {
     initialized_ = true;
   }
 
-  void add_precrack(const std::vector<Vector3>& polyline) {
+  // Adds a pre-crack along the polyline (reference configuration) and returns
+  // the stress points that lie on it (within on_precrack_in_spacings), which
+  // become its crack points and must leave the integration.
+  std::vector<int> add_precrack(const std::vector<Vector3>& polyline) {
     require_initialized("add_precrack");
     if (polyline.size() < 2)
       sphshell::detail::invalid_parameter("pre-crack polyline size", polyline.size(),
@@ -135,15 +143,73 @@ class LineSegments {
                                             "a pre-crack piece must not have zero length");
       }
     }
-    const int crack_id = crack_id_count_++;
-    const int first_point = static_cast<int>(points_.size());
-    for (const Vector3& point : polyline) {
-      points_.push_back(point);
-      crack_of_point_.push_back(crack_id);
+    // Stress points on the polyline become points of the pre-crack, in order
+    // along it, exactly as damage along that row would have made them: a
+    // pre-crack drawn through a row of stress points is the crack that row's
+    // failure forms, and later damage links to it anywhere along its length.
+    struct OnLine {
+      std::size_t piece;
+      double along;
+      int stress_point;
+    };
+    std::vector<OnLine> on_line;
+    const double tolerance = on_precrack_in_spacings * spacing_;
+    for (std::size_t k = 0; k + 1 < polyline.size(); ++k) {
+      const Vector3& start = polyline[k];
+      const Vector3& end = polyline[k + 1];
+      const double length = (end - start).norm();
+      // Queries of one spacing (the index's radius) every half spacing cover the piece.
+      const int samples = static_cast<int>(std::ceil(length / (0.5 * spacing_))) + 1;
+      for (int sample = 0; sample < samples; ++sample) {
+        const Vector3 centre = start + (end - start) * (double(sample) / double(samples - 1));
+        stress_point_index_->for_each_within(centre, spacing_, [&](int q, double) {
+          const auto slot = static_cast<std::size_t>(q);
+          const Vector3& position = stress_point_positions_[slot];
+          if (crack_point_of_stress_point_[slot] >= 0 || distance_to_segment(position, start, end) > tolerance)
+            return;
+          for (const OnLine& seen : on_line)
+            if (seen.stress_point == q) return;  // found already (or on a vertex shared by two pieces)
+          on_line.push_back({k, (position - start).dot(end - start) / (length * length), q});
+        });
+      }
     }
-    for (std::size_t k = 1; k < polyline.size(); ++k)
-      append_segment(first_point + static_cast<int>(k) - 1, first_point + static_cast<int>(k));
+    std::sort(on_line.begin(), on_line.end(), [](const OnLine& a, const OnLine& b) {
+      return a.piece != b.piece ? a.piece < b.piece : a.along < b.along;
+    });
+
+    struct PathPoint {
+      Vector3 point;
+      int stress_point;
+    };
+    std::vector<PathPoint> path;
+    std::size_t next = 0;
+    for (std::size_t k = 0; k < polyline.size(); ++k) {
+      path.push_back({polyline[k], -1});
+      for (; next < on_line.size() && on_line[next].piece == k; ++next)
+        path.push_back({stress_point_positions_[static_cast<std::size_t>(on_line[next].stress_point)],
+                        on_line[next].stress_point});
+    }
+    const int crack_id = crack_id_count_++;
+    std::vector<int> absorbed;
+    int previous = -1;
+    for (const PathPoint& entry : path) {
+      if (entry.stress_point >= 0) absorbed.push_back(entry.stress_point);
+      // A stress point on a vertex stands for that vertex.
+      if (previous >= 0 && (points_[static_cast<std::size_t>(previous)] - entry.point).norm() <= tolerance) {
+        if (entry.stress_point >= 0)
+          crack_point_of_stress_point_[static_cast<std::size_t>(entry.stress_point)] = previous;
+        continue;
+      }
+      const int index = static_cast<int>(points_.size());
+      points_.push_back(entry.point);
+      crack_of_point_.push_back(crack_id);
+      if (entry.stress_point >= 0) crack_point_of_stress_point_[static_cast<std::size_t>(entry.stress_point)] = index;
+      if (previous >= 0) append_segment(previous, index);
+      previous = index;
+    }
     rebuild_segment_index();
+    std::sort(absorbed.begin(), absorbed.end());
+    return absorbed;
   }
 
   std::vector<Segment> add_damaged_stress_points(const std::vector<int>& stress_points) {
