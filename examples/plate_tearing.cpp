@@ -42,9 +42,9 @@
 //     60 × 58 grid, which suggests a ~0.6 m square plate at 10 mm spacing; one
 //     particle row is added here so the mid-height falls between particle rows;
 //   - pre-crack: a straight cut from the left edge along mid-height, 0.10 m
-//     long, placed a quarter spacing above the middle stress-point row so no
-//     particle or stress point lies on it (a point on the line would see both
-//     faces and bridge the cut);
+//     long, placed a quarter spacing above the middle stress-point row, between
+//     it and the particle row above (no particle may lie on a pre-crack; stress
+//     points on one would become its crack points);
 //   - gripped edges: the two particle rows at the top edge belong to the upper
 //     arm, the two at the bottom edge to the lower arm (translations prescribed,
 //     rotations free);
