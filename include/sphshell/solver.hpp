@@ -122,7 +122,6 @@ class Solver {
   Solver(ShellModel model, const MaterialParameters& parameters, SolverOptions options = {})
       : model_(std::move(model)),
         law_(parameters),
-        section_(law_, model_.thickness()),
         options_(options) {
     validate_options();
     initialize_particles();
@@ -411,15 +410,15 @@ class Solver {
   std::size_t stress_point_count() const { return model_.stress_point_count(); }
   double equivalent_stress(int stress_point, int k) const {
     check_output_point(stress_point, k);
-    return section_.equivalent_stress(state_[stress_point], k);
+    return section_of(stress_point).equivalent_stress(state_[stress_point], k);
   }
   double equivalent_plastic_strain(int stress_point, int k) const {
     check_output_point(stress_point, k);
-    return section_.equivalent_plastic_strain(state_[stress_point], k);
+    return section_of(stress_point).equivalent_plastic_strain(state_[stress_point], k);
   }
   double damage(int stress_point, int k) const {
     check_output_point(stress_point, k);
-    return section_.damage(state_[stress_point], k);
+    return section_of(stress_point).damage(state_[stress_point], k);
   }
   // Membrane forces (N/m) and moments (N·m/m) at a stress point, Voigt (xx, yy, xy)
   // in its reference tangent frame.
@@ -518,7 +517,6 @@ class Solver {
 
   void initialize_particles() {
     const std::size_t n = model_.particle_count();
-    const double d = model_.thickness();
     position_ = model_.particle_position;
     director_ = model_.particle_normal;
     velocity_.assign(n, Vector3::Zero());
@@ -526,6 +524,7 @@ class Solver {
     mass_.resize(n);
     rotary_inertia_.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
+      const double d = model_.particle_thickness(i);
       mass_[i] = options_.density * d * model_.particle_area[i];
       rotary_inertia_[i] =
           options_.rotary_inertia_scale * options_.density * d * d * d / 12.0 * model_.particle_area[i];
@@ -563,18 +562,29 @@ class Solver {
     const std::size_t particle_points = particles_integrate ? model_.particle_count() : 0;
     point_offset_ = {0, stress_points};
     const std::size_t total = stress_points + particle_points;
-    const double d = model_.thickness();
     const double shear_modulus = law_.youngs_modulus() / (2.0 * (1.0 + law_.poisson_ratio()));
-    const double shear_stiffness = options_.shear_correction * shear_modulus * d;
+    // One section per distinct thickness; each integration point refers to its own.
+    section_index_.resize(total);
+    auto section_for = [&](double d) {
+      for (std::size_t k = 0; k < sections_.size(); ++k)
+        if (sections_[k].thickness() == d) return static_cast<int>(k);
+      sections_.emplace_back(law_, d);
+      return static_cast<int>(sections_.size() - 1);
+    };
 
     membrane_bending_weight_.resize(total);
     shear_weight_.resize(total);
     for (std::size_t p = 0; p < stress_points; ++p) {
+      const double d = model_.stress_point_thickness(p);
+      section_index_[p] = section_for(d);
       membrane_bending_weight_[p] =
           (1.0 - options_.particle_integration_share) * model_.stress_point_area[p];
-      shear_weight_[p] = model_.stress_point_area[p] * shear_stiffness;
+      shear_weight_[p] = model_.stress_point_area[p] * options_.shear_correction * shear_modulus * d;
     }
     for (std::size_t i = 0; i < particle_points; ++i) {
+      const double d = model_.particle_thickness(i);
+      const double shear_stiffness = options_.shear_correction * shear_modulus * d;
+      section_index_[stress_points + i] = section_for(d);
       const double local_spacing = std::sqrt(model_.particle_area[i]);
       const double softening =
           d * d / (d * d + options_.particle_shear_softening * local_spacing * local_spacing);
@@ -588,7 +598,7 @@ class Solver {
       for (std::size_t row = 0; row < point_count(group); ++row)
         reference_[point_offset_[group] + row] = gather(group, row, position_, director_);
 
-    state_.assign(total, section_.initial_state());
+    state_.assign(total, sections_.front().initial_state());
     membrane_strain_.assign(total, StrainVoigt::Zero());
     curvature_.assign(total, StrainVoigt::Zero());
     shear_.assign(total, Vector2::Zero());
@@ -662,7 +672,7 @@ class Solver {
     const StrainVoigt d_membrane = strains.membrane - membrane_strain_[p];
     const StrainVoigt d_curvature = strains.curvature - curvature_[p];
     const Vector2 d_shear = strains.shear - shear_[p];
-    const thickness::Resultants resultants = section_.update(state_[p], d_membrane, d_curvature);
+    const thickness::Resultants resultants = section_of(p).update(state_[p], d_membrane, d_curvature);
     // The elastic transverse shear force (weighted: shear_weight_ holds κs G d A)
     // is updated incrementally like the other resultants, so a change of shape
     // functions (after a crack) leaves it continuous.
@@ -715,7 +725,7 @@ class Solver {
   // Elastic energy held by one integration point (membrane, bending, shear).
   double stored_energy(std::size_t p) const {
     const double shear = shear_weight_[p] > 0.0 ? 0.5 * shear_force_[p].squaredNorm() / shear_weight_[p] : 0.0;
-    return membrane_bending_weight_[p] * section_.elastic_energy(state_[p]) + shear;
+    return membrane_bending_weight_[p] * section_of(p).elastic_energy(state_[p]) + shear;
   }
 
   void compute_internal_forces() {
@@ -850,7 +860,7 @@ class Solver {
   // tests check the bound against the exact spectrum of the assembled system.
   double compute_stable_time_step() const {
     const double E = law_.youngs_modulus(), nu = law_.poisson_ratio();
-    const double rho = options_.density, d = model_.thickness();
+    const double rho = options_.density, d = model_.minimum_thickness();
     const double G = E / (2.0 * (1.0 + nu));
     const double spacing = std::min(model_.minimum_spacing(), nearest_particle_distance());
     const double membrane_speed_squared = E / (rho * (1.0 - nu * nu));
@@ -1039,10 +1049,10 @@ class Solver {
     std::vector<int> newly_damaged;
     bool removed_particle_point = false;
     for (std::size_t p = 0; p < model_.stress_point_count(); ++p)
-      if (active_[p] && section_.all_failed(state_[p])) newly_damaged.push_back(static_cast<int>(p));
+      if (active_[p] && section_of(p).all_failed(state_[p])) newly_damaged.push_back(static_cast<int>(p));
     for (std::size_t i = 0; i < point_count(1); ++i) {
       const std::size_t p = point_offset_[1] + i;
-      if (active_[p] && section_.all_failed(state_[p])) {
+      if (active_[p] && section_of(p).all_failed(state_[p])) {
         deactivate(p);
         removed_particle_point = true;
       }
@@ -1190,7 +1200,9 @@ class Solver {
 
   ShellModel model_;
   Material law_;
-  Section section_;
+  std::vector<Section> sections_;
+  std::vector<int> section_index_;  // per integration point, into sections_
+  const Section& section_of(std::size_t p) const { return sections_[static_cast<std::size_t>(section_index_[p])]; }
   SolverOptions options_;
   double smoothing_length_ = 0.0;
   double stable_time_step_ = 0.0;

@@ -50,6 +50,8 @@ class ShellModel {
         stress_point_area(std::move(stress_areas)),
         thickness_(thickness) {
     validate();
+    particle_thickness_.assign(particle_position.size(), thickness_);
+    stress_point_thickness_.assign(stress_point_position.size(), thickness_);
   }
 
   // Particles at the nodes of user quads, stress points at the quad centres
@@ -199,7 +201,31 @@ class ShellModel {
     return model;
   }
 
+  // The thickness the model was built with; set_thickness can change it in regions.
   double thickness() const { return thickness_; }
+  // Wall thickness at a particle and at a stress point (m).
+  double particle_thickness(std::size_t i) const { return particle_thickness_.at(i); }
+  double stress_point_thickness(std::size_t p) const { return stress_point_thickness_.at(p); }
+  double minimum_thickness() const {
+    return std::min(*std::min_element(particle_thickness_.begin(), particle_thickness_.end()),
+                    *std::min_element(stress_point_thickness_.begin(), stress_point_thickness_.end()));
+  }
+  // Gives every particle and stress point whose reference position satisfies
+  // where(X) the thickness d (a thinned band such as a machined surface notch,
+  // a doubler, a tapered wall). The mid-surface stays where it is. Returns how
+  // many points changed; a region that holds no point is an Error.
+  template <class Predicate>
+  std::size_t set_thickness(Predicate&& where, double d) {
+    detail::require_positive("thickness", d);
+    std::size_t count = 0;
+    for (std::size_t i = 0; i < particle_position.size(); ++i)
+      if (where(particle_position[i])) particle_thickness_[i] = d, ++count;
+    for (std::size_t p = 0; p < stress_point_position.size(); ++p)
+      if (where(stress_point_position[p])) stress_point_thickness_[p] = d, ++count;
+    if (count == 0)
+      detail::invalid_parameter("set_thickness region", d, "holds no particle and no stress point");
+    return count;
+  }
   std::size_t particle_count() const { return particle_position.size(); }
   std::size_t stress_point_count() const { return stress_point_position.size(); }
   const std::vector<Quad>& quads() const { return quads_; }
@@ -339,6 +365,8 @@ class ShellModel {
   }
 
   double thickness_;
+  std::vector<double> particle_thickness_;
+  std::vector<double> stress_point_thickness_;
   std::vector<Quad> quads_;
   std::map<std::string, ParticleSet> sets_;
 };
