@@ -20,7 +20,10 @@
 //   --notch-ligament  model the notch as a surface notch instead of a through
 //                   slit: the wall keeps this thickness (m) along the notch, over
 //                   the stress-point row and the particle rows either side
-//                   (ShellModel::set_thickness); 0 (default) is the through slit
+//                   (ShellModel::set_thickness); 0 (default) is the through slit.
+//                   The thin wall inside the thick one lowers the stable step
+//                   several times, and with no pre-crack the tracked crack
+//                   (id 0) is the first to form, normally the torn notch
 //   --pressure-direction  follower (default: along the current director, as a
 //                   gas pressure on the opening flaps) or fixed (reference normal)
 //   --output DIR    ParaView frames every 10 µs (particles.pvd,
