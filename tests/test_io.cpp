@@ -473,6 +473,21 @@ TEST_CASE("SVG plot: axis ticks are whole multiples of a 1, 2, 2.5 or 5 step", "
     CHECK(ticks.lower == Approx(c.lower).margin(1e-12));
     CHECK(ticks.upper == Approx(c.upper).margin(1e-12));
   }
+  // A range over most of the doubles: (1e308 − (−1e308)) / 6 overflows unless
+  // halved first; by hand the step is 5e307 (3.3e307 rounded up to 5 × 10^307).
+  const io::AxisTicks widest = io::nice_ticks(-1e308, 1e308);
+  CHECK(widest.step == Approx(5e307).epsilon(1e-12));
+  CHECK(widest.lower == Approx(-1e308).epsilon(1e-12));
+  CHECK(widest.upper == Approx(1e308).epsilon(1e-12));
+  // A constant subnormal series: 10 % of it rounds to zero, so the range must
+  // be widened by a finite positive amount instead.
+  const double subnormal = std::numeric_limits<double>::denorm_min();
+  const io::AxisTicks tiny = io::nice_ticks(subnormal, subnormal);
+  CHECK(std::isfinite(tiny.step));
+  CHECK(tiny.step > 0.0);
+  CHECK(tiny.lower < subnormal);
+  CHECK(tiny.upper > subnormal);
+  CHECK((tiny.upper - tiny.lower) / tiny.step <= 12.0);
   CHECK_THROWS_WITH(io::nice_ticks(1.0, 0.0), Catch::Contains("[1, 0]"));
   CHECK_THROWS_WITH(io::nice_ticks(0.0, std::numeric_limits<double>::quiet_NaN()), Catch::Contains("not a finite"));
   CHECK_THROWS_WITH(io::nice_ticks(0.0, 1.0, 0), Catch::Contains("target_intervals = 0"));

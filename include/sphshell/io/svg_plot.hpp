@@ -67,11 +67,13 @@ inline AxisTicks nice_ticks(double minimum, double maximum, int target_intervals
   if (target_intervals < 1)
     throw Error("sphshell: plot target_intervals = " + std::to_string(target_intervals) + " must be ≥ 1");
   if (maximum == minimum) {
-    const double half_width = minimum == 0.0 ? 1.0 : 0.1 * std::abs(minimum);
+    const double half_width =
+        std::max(0.1 * std::abs(minimum), minimum == 0.0 ? 1.0 : std::numeric_limits<double>::min() * 1e10);
     minimum -= half_width;
     maximum += half_width;
   }
-  const double raw_step = (maximum - minimum) / target_intervals;
+  // Halves first, so that a range spanning most of the doubles does not overflow.
+  const double raw_step = (0.5 * maximum - 0.5 * minimum) / (0.5 * target_intervals);
   const double magnitude = std::pow(10.0, std::floor(std::log10(raw_step)));
   const double residual = raw_step / magnitude;
   double step = 10.0 * magnitude;
