@@ -3,10 +3,13 @@
 // enabled (`static constexpr bool enabled`) and gives a `name`; an enabled
 // policy also decides which particle pairs stay visible to each other and which
 // stress points are removed (design.md §2.6). An enabled policy
-// (crack::LineSegments) provides initialize, add_precrack,
-// add_damaged_stress_points, visible, affected_points and the introspection
-// members points, segments, is_damaged, damaged_count, crack_count,
-// total_length, crack_lengths and empty; crack::None has none of them.
+// (crack::LineSegments) provides initialize, add_precrack (returning the
+// stress points it takes over as crack points), add_damaged_stress_points,
+// visible, affected_points, spacing, the constant on_precrack_in_spacings and
+// distance_to_precrack_piece (the solver's check that no particle lies on a
+// pre-crack), and the introspection members points, segments, is_damaged,
+// crack_point_of_stress_point, damaged_count, crack_count, total_length,
+// crack_lengths and empty; crack::None has none of them.
 
 #include <type_traits>
 
