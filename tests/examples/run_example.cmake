@@ -2,8 +2,10 @@
 # cleanly and writes its outputs: a CSV history with data rows, an SVG plot with
 # drawn curves, and the ParaView collections it announces.
 # With EXPECT_ERROR set, the run must instead fail with a message containing it.
+# EXPECT_AT_LEAST lists pairs "text|minimum": the output must hold a line
+# "text <number>" with number ≥ minimum.
 #   cmake -DEXAMPLE=<exe> -DARGUMENTS="a|b|c" -DWORK_DIR=<dir> -DOUTPUTS="x.csv|y.svg"
-#         [-DEXPECT_ERROR=text] -P run_example.cmake
+#         [-DEXPECT_ERROR=text] [-DEXPECT_AT_LEAST="text|minimum|..."] -P run_example.cmake
 string(REPLACE "|" ";" arguments "${ARGUMENTS}")
 string(REPLACE "|" ";" outputs "${OUTPUTS}")
 file(REMOVE_RECURSE "${WORK_DIR}")
@@ -53,4 +55,22 @@ foreach(name IN LISTS outputs)
     endif()
   endif()
 endforeach()
+if(DEFINED EXPECT_AT_LEAST)
+  string(REPLACE "|" ";" expectations "${EXPECT_AT_LEAST}")
+  list(LENGTH expectations expectation_count)
+  math(EXPR last_pair "${expectation_count} - 1")
+  foreach(index RANGE 0 ${last_pair} 2)
+    math(EXPR minimum_index "${index} + 1")
+    list(GET expectations ${index} text)
+    list(GET expectations ${minimum_index} minimum)
+    if(NOT output MATCHES "${text} ([-+.0-9eE]+)")
+      message(FATAL_ERROR "${EXAMPLE} printed no line '${text} <number>'\n${output}")
+    endif()
+    set(value "${CMAKE_MATCH_1}")
+    if(value LESS minimum)
+      message(FATAL_ERROR "${EXAMPLE}: '${text}' is ${value}, expected at least ${minimum}\n${output}")
+    endif()
+    message(STATUS "${text} ${value} (at least ${minimum})")
+  endforeach()
+endif()
 message(STATUS "${EXAMPLE}: ran and wrote ${OUTPUTS}")
