@@ -12,6 +12,40 @@ using sphshell::crack::LineSegments;
 using sphshell::crack::Segment;
 
 static_assert(crack::is_crack_policy<LineSegments>::value && LineSegments::enabled);
+static_assert(crack::check_crack_policy<LineSegments>() && crack::check_crack_policy<crack::None>());
+
+// The enabled-policy traits reject what the solver could not use.
+namespace broken_policies {
+struct NonStaticConstant : LineSegments {
+  double on_precrack_in_spacings = 1e-6;
+};
+struct FloatPoints : LineSegments {
+  const std::vector<Eigen::Vector3f>& points() const { return float_points; }
+  std::vector<Eigen::Vector3f> float_points;
+};
+struct WideSegment {
+  std::size_t start_point, end_point;
+  int crack_id;
+};
+struct WideSegments : LineSegments {
+  const std::vector<WideSegment>& segments() const { return wide_segments; }
+  std::vector<WideSegment> wide_segments;
+};
+struct ConsumesSegments : LineSegments {
+  std::vector<std::size_t> affected_points(const std::vector<Vector3>&, std::vector<Segment>&&) const { return {}; }
+};
+struct NeedsArguments : LineSegments {
+  explicit NeedsArguments(int) {}
+};
+}  // namespace broken_policies
+static_assert(crack::detail::has_precrack_distance<LineSegments>::value);
+static_assert(!crack::detail::has_precrack_distance<broken_policies::NonStaticConstant>::value);
+static_assert(crack::detail::has_output_members<LineSegments>::value);
+static_assert(!crack::detail::has_output_members<broken_policies::FloatPoints>::value);
+static_assert(!crack::detail::has_output_members<broken_policies::WideSegments>::value);
+static_assert(crack::detail::has_affected_points<LineSegments>::value);
+static_assert(!crack::detail::has_affected_points<broken_policies::ConsumesSegments>::value);
+static_assert(!std::is_default_constructible_v<broken_policies::NeedsArguments>);
 
 namespace {
 

@@ -10,10 +10,10 @@
 // spacing(); points(), segments() (with start_point, end_point, crack_id) and
 // crack_point_of_stress_point(p) for output; and, to check that no particle
 // lies on a pre-crack, the constant on_precrack_in_spacings and the static
-// distance_to_precrack_piece(point, start, end). check_crack_policy asserts
-// each. LineSegments adds introspection for users (is_damaged, damaged_count,
-// crack_count, total_length, crack_lengths, empty). crack::None has none of
-// them.
+// distance_to_precrack_piece(point, start, end). It must also be
+// default-constructible. check_crack_policy asserts each. LineSegments adds
+// introspection for users (is_damaged, damaged_count, crack_count,
+// total_length, crack_lengths, empty). crack::None has none of them.
 
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
@@ -82,17 +82,21 @@ struct has_visible<Policy, std::void_t<decltype(bool{const_policy<Policy>().visi
                                argument<Vector3>(), argument<Vector3>(), argument<TangentFrame>())})>>
     : std::true_type {};
 
+// The solver passes both the new segments and segments() itself, as const lvalues.
 template <class Policy, class = void>
 struct has_affected_points : std::false_type {};
 template <class Policy>
 struct has_affected_points<
-    Policy, std::void_t<decltype(const_policy<Policy>().affected_points(
-                argument<std::vector<Vector3>>(),
-                policy<Policy>().add_damaged_stress_points(argument<std::vector<int>>())))>>
-    : std::is_convertible<decltype(const_policy<Policy>().affected_points(
-                              argument<std::vector<Vector3>>(),
-                              policy<Policy>().add_damaged_stress_points(argument<std::vector<int>>()))),
-                          std::vector<std::size_t>> {};
+    Policy,
+    std::void_t<decltype(const_policy<Policy>().affected_points(
+                    argument<std::vector<Vector3>>(),
+                    argument<decltype(policy<Policy>().add_damaged_stress_points(argument<std::vector<int>>()))>())),
+                decltype(const_policy<Policy>().affected_points(argument<std::vector<Vector3>>(),
+                                                                const_policy<Policy>().segments()))>>
+    : std::bool_constant<
+          std::is_convertible_v<decltype(const_policy<Policy>().affected_points(
+                                    argument<std::vector<Vector3>>(), const_policy<Policy>().segments())),
+                                std::vector<std::size_t>>> {};
 
 template <class Policy, class = void>
 struct has_spacing : std::false_type {};
@@ -103,19 +107,20 @@ template <class Policy, class = void>
 struct has_output_members : std::false_type {};
 template <class Policy>
 struct has_output_members<
-    Policy, std::void_t<decltype(const_policy<Policy>().points().size()),
-                        decltype(const_policy<Policy>().segments().begin()->start_point),
-                        decltype(const_policy<Policy>().segments().begin()->end_point),
-                        decltype(const_policy<Policy>().segments().begin()->crack_id),
-                        decltype(int{const_policy<Policy>().crack_point_of_stress_point(0)})>> : std::true_type {};
+    Policy, std::void_t<decltype(int{const_policy<Policy>().segments().begin()->start_point}),
+                        decltype(int{const_policy<Policy>().segments().begin()->end_point}),
+                        decltype(int{const_policy<Policy>().segments().begin()->crack_id}),
+                        decltype(int{const_policy<Policy>().crack_point_of_stress_point(0)})>>
+    : std::is_convertible<decltype(const_policy<Policy>().points()), const std::vector<Vector3>&> {};
 
+// A static data member: decltype names it `const double`, a non-static one `double`.
 template <class Policy, class = void>
 struct has_precrack_distance : std::false_type {};
 template <class Policy>
 struct has_precrack_distance<
-    Policy, std::void_t<decltype(double{Policy::on_precrack_in_spacings}),
-                        decltype(double{Policy::distance_to_precrack_piece(argument<Vector3>(), argument<Vector3>(),
-                                                                           argument<Vector3>())})>> : std::true_type {};
+    Policy, std::void_t<decltype(double{Policy::distance_to_precrack_piece(argument<Vector3>(), argument<Vector3>(),
+                                                                           argument<Vector3>())})>>
+    : std::is_same<decltype(Policy::on_precrack_in_spacings), const double> {};
 
 }  // namespace detail
 
@@ -125,6 +130,8 @@ constexpr bool check_crack_policy() {
                 "a crack policy needs `static constexpr bool enabled`");
   static_assert(has_name<Policy>::value, "a crack policy needs `static constexpr const char* name`");
   if constexpr (is_enabled<Policy>::value) {
+    static_assert(std::is_default_constructible_v<Policy>,
+                  "an enabled crack policy must be default-constructible (the solver holds one and initializes it)");
     static_assert(detail::has_initialize<Policy>::value,
                   "an enabled crack policy needs initialize(positions, normals, spacing, support_radius)");
     static_assert(detail::has_add_precrack<Policy>::value,
@@ -135,12 +142,12 @@ constexpr bool check_crack_policy() {
     static_assert(detail::has_visible<Policy>::value,
                   "an enabled crack policy needs `bool visible(a, b, frame) const`");
     static_assert(detail::has_affected_points<Policy>::value,
-                  "an enabled crack policy needs `affected_points(positions, new_segments) const` returning "
-                  "std::vector<std::size_t>");
+                  "an enabled crack policy needs `affected_points(positions, segments) const` taking the "
+                  "segments add_damaged_stress_points returns and segments() holds, returning std::vector<std::size_t>");
     static_assert(detail::has_spacing<Policy>::value, "an enabled crack policy needs `double spacing() const`");
     static_assert(detail::has_output_members<Policy>::value,
-                  "an enabled crack policy needs points(), segments() (start_point, end_point, crack_id) and "
-                  "crack_point_of_stress_point(p) for output");
+                  "an enabled crack policy needs `const std::vector<Vector3>& points() const`, segments() with int "
+                  "start_point, end_point and crack_id, and `int crack_point_of_stress_point(p) const` for output");
     static_assert(detail::has_precrack_distance<Policy>::value,
                   "an enabled crack policy needs `static constexpr double on_precrack_in_spacings` and "
                   "`static double distance_to_precrack_piece(point, start, end)`");
