@@ -535,6 +535,24 @@ TEST_CASE("SVG plot: data map onto the plot area, gaps break lines, labels are e
   CHECK_THAT(svg, Catch::EndsWith("</svg>\n"));
 }
 
+TEST_CASE("SVG plot: data over most of the doubles still map into the plot area", "[io][svg]") {
+  TemporaryDirectory directory;
+  const std::string path = directory.file("wide.svg");
+  const double largest = std::numeric_limits<double>::max();
+  io::PlotPanel panel{"wide", "x", "y", {}};
+  panel.series.push_back({"edges", {-largest, largest}, {-0.9 * largest, 0.9 * largest}, io::PlotStyle::line});
+  io::write_svg_plot(path, {panel});
+  const std::string svg = read_whole_file(path);
+  CHECK_THAT(svg, !Catch::Contains("nan") && !Catch::Contains("inf"));
+  // The x axis is the data range itself (rounding it out to whole steps would
+  // overflow), so the line starts at the plot's left edge and ends at its right.
+  const io::PlotLayout layout;
+  char start[32], end[32];
+  std::snprintf(start, sizeof(start), "points=\"%.2f,", layout.margin_left);
+  std::snprintf(end, sizeof(end), " %.2f,", layout.margin_left + layout.plot_width());
+  CHECK_THAT(svg, Catch::Contains(start) && Catch::Contains(end));
+}
+
 TEST_CASE("SVG plot errors name the series and leave existing output alone", "[io][svg]") {
   TemporaryDirectory directory;
   const std::string path = directory.file("plot.svg");

@@ -84,8 +84,11 @@ inline AxisTicks nice_ticks(double minimum, double maximum, int target_intervals
     }
   // The small tolerance keeps a bound that is a multiple of the step (up to
   // rounding) from gaining a whole extra interval.
-  const double lower = std::floor(minimum / step + 1e-9) * step;
-  const double upper = std::ceil(maximum / step - 1e-9) * step;
+  double lower = std::floor(minimum / step + 1e-9) * step;
+  double upper = std::ceil(maximum / step - 1e-9) * step;
+  // Rounding out can pass the largest double; the data bound then serves.
+  if (!std::isfinite(lower)) lower = minimum;
+  if (!std::isfinite(upper)) upper = maximum;
   return {lower, upper, step};
 }
 
@@ -142,29 +145,44 @@ inline void write_panel(std::ostream& out, const PlotPanel& panel, const PlotLay
   const AxisTicks x_axis = nice_ticks(x_min, x_max);
   // Headroom above the data for the legend box, so that no point is hidden
   // behind it: the box is 18 px per series plus 14 px tall.
+  // Differences of halves throughout: a range over most of the doubles must
+  // not overflow.
   if (!panel.series.empty() && y_max > y_min) {
     const double legend_fraction = (18.0 * double(panel.series.size()) + 14.0) / layout.plot_height();
-    if (legend_fraction < 0.5) y_max += (y_max - y_min) * legend_fraction / (1.0 - legend_fraction);
+    if (legend_fraction < 0.5) {
+      const double raised = y_max + 2.0 * (0.5 * y_max - 0.5 * y_min) * legend_fraction / (1.0 - legend_fraction);
+      y_max = std::isfinite(raised) ? raised : std::numeric_limits<double>::max();
+    }
   }
   const AxisTicks y_axis = nice_ticks(y_min, y_max);
   const double left = offset_x + layout.margin_left, top = layout.margin_top;
   const double width = layout.plot_width(), height = layout.plot_height();
-  auto to_x = [&](double x) { return left + (x - x_axis.lower) / (x_axis.upper - x_axis.lower) * width; };
-  auto to_y = [&](double y) { return top + (y_axis.upper - y) / (y_axis.upper - y_axis.lower) * height; };
+  auto fraction = [](double value, const AxisTicks& axis) {
+    return (0.5 * value - 0.5 * axis.lower) / (0.5 * axis.upper - 0.5 * axis.lower);
+  };
+  auto to_x = [&](double x) { return left + fraction(x, x_axis) * width; };
+  auto to_y = [&](double y) { return top + (1.0 - fraction(y, y_axis)) * height; };
+  // Ticks inside the axis range (its bounds are whole steps unless rounding
+  // them out would have overflowed).
+  auto tick_count = [](const AxisTicks& axis) {
+    return int(std::floor((0.5 * axis.upper - 0.5 * axis.lower) / (0.5 * axis.step) + 1e-9));
+  };
+  // lower + k·step, in halves (scaling by 2 is exact).
+  auto tick_value = [](const AxisTicks& axis, int k) { return 2.0 * (0.5 * axis.lower + k * (0.5 * axis.step)); };
 
   out << "<text x=\"" << pixel(left + width / 2) << "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">"
       << xml_escape(panel.title) << "</text>\n";
-  const int x_intervals = int(std::lround((x_axis.upper - x_axis.lower) / x_axis.step));
+  const int x_intervals = tick_count(x_axis);
   for (int k = 0; k <= x_intervals; ++k) {
-    const double value = x_axis.lower + k * x_axis.step, px = to_x(value);
+    const double value = tick_value(x_axis, k), px = to_x(value);
     out << "<line x1=\"" << pixel(px) << "\" y1=\"" << pixel(top) << "\" x2=\"" << pixel(px) << "\" y2=\""
         << pixel(top + height) << "\" stroke=\"#dddddd\"/>\n"
         << "<text x=\"" << pixel(px) << "\" y=\"" << pixel(top + height + 18)
         << "\" text-anchor=\"middle\" font-size=\"12\">" << tick_label(value, x_axis.step) << "</text>\n";
   }
-  const int y_intervals = int(std::lround((y_axis.upper - y_axis.lower) / y_axis.step));
+  const int y_intervals = tick_count(y_axis);
   for (int k = 0; k <= y_intervals; ++k) {
-    const double value = y_axis.lower + k * y_axis.step, py = to_y(value);
+    const double value = tick_value(y_axis, k), py = to_y(value);
     out << "<line x1=\"" << pixel(left) << "\" y1=\"" << pixel(py) << "\" x2=\"" << pixel(left + width)
         << "\" y2=\"" << pixel(py) << "\" stroke=\"#dddddd\"/>\n"
         << "<text x=\"" << pixel(left - 6) << "\" y=\"" << pixel(py + 4)
