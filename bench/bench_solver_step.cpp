@@ -14,7 +14,6 @@
 
 #include <chrono>
 #include <memory>
-#include <stdexcept>
 
 using namespace sphshell;
 
@@ -83,8 +82,10 @@ void fracture_cost_ratio(benchmark::State& state) {
     const auto cracked_solver = plate_at_crack_onset<crack::LineSegments>();
     FracturePlateSolver<crack::None>& intact = *intact_solver;
     FracturePlateSolver<crack::LineSegments>& cracked = *cracked_solver;
-    if (intact.time_step() != cracked.time_step())
-      throw std::logic_error("fracture_cost_ratio: the two solvers step with different time steps");
+    if (intact.time_step() != cracked.time_step()) {
+      state.SkipWithError("the two solvers step with different time steps");
+      break;
+    }
     const int chunk = 10;
     double intact_seconds = 0.0, cracked_seconds = 0.0;
     long steps = 0;
