@@ -82,8 +82,8 @@
 // 2.5 mm; at the crossover itself the 2.5 mm run went unstable). This
 // slows only the short-wavelength rotational (thickness-shear) modes. The
 // default run (1.5 mm: 80 × 610 ≈ 49 000 particles, 400 µs, 3 368 steps) takes
-// about 70 s with two threads; --spacing 2.5e-3 about 17 s, --spacing 1e-3
-// (109 000 particles, 5 025 steps) about 4 minutes (236 s measured alone).
+// about 65 s with two threads; --spacing 2.5e-3 about 15 s, --spacing 1e-3
+// (109 000 particles, 5 025 steps) about 4 minutes.
 //
 // The CSV also holds the circumferential half-extent of the notch crack
 // (largest arc distance of its points from the notch line): the crack turning
@@ -95,35 +95,37 @@
 // axial coordinate. The path growth rate of an end is the rate at which the
 // notch crack's length on that side of the notch centre grows, along its
 // segments: while the tip has neither turned nor branched it is the tip's
-// speed along its path, after that the sum over the branches. The program
-// prints the path speed's peak before the first turn or branch (the first
-// sample whose path rate exceeds 1.5 × the axial speed) and the peak path rate.
+// speed along its path, after that the sum over the branches (and any other
+// crack that has joined the notch crack). An end has turned round the tube
+// once its crack points reach more than two spacings from the notch line (the
+// CSV holds each end's circumferential half-extent); the program prints that
+// time and the speeds' peaks before it.
 //
 // Results, resolution study (400 µs, rotary scale automatic, particle share
 // 0.02; 2 threads):
 //   spacing                           2.5 mm     1.5 mm     1.0 mm
 //   growth starts at                  242 µs     236 µs     220 µs
-//   peak axial speed rear / front     250/250    321/301    350/350 m/s
+//   turns round the tube, rear/front  308/304    316/308    314/308 µs
+//   peak axial speed before the turn  250/250    301/301    300/300 m/s
+//   peak axial speed, whole run       250/250    321/301    350/350 m/s
 //   mean axial speed rear / front     148/119    251/210    251/274 m/s
 //   axial growth by 400 µs rear/front  23/18      41/33      45/47  mm
-//   first turn or branch rear / front 270/266    298/290    304/294 µs
 //   total length growth rate          849        1022       1101   m/s
 //   circumferential half-extent       24 mm      25 mm      25 mm
-//   run time                          17 s       68 s       470 s (machine shared)
-// (--notch-offset 0 at 1.5 mm: peaks 321/301 m/s, turns at 296/286 µs.)
+//   run time                          13 s       63 s       252 s
+// (--notch-offset 0 at 1.5 mm: peaks 321/301 m/s, both ends turn at 322 µs.)
 // No growth while the wave travels to the notch; the tips start soon after it
-// arrives, run axially at up to 300–350 m/s, and then turn round the tube, the
-// front end first (at 1.5 and 1.0 mm). That is what the paper shows: speeds
-// up to ≈ 300 m/s before bifurcation (Fig. 32), a crack running axially first
-// and turning circumferentially at the front end from ≈ 300 µs (Fig. 30). The
-// 2.5 mm grid is too coarse for it (speeds come in steps of one spacing per
-// 20 µs window, 125 m/s there).
+// arrives, run axially at up to 300 m/s, and then turn round the tube, the
+// front end 4–8 µs before the rear. That is what the paper shows: speeds up to
+// ≈ 300 m/s before bifurcation (Fig. 32), a crack running axially first and
+// turning circumferentially at the front end from ≈ 300 µs (Fig. 30). At
+// 2.5 mm speeds come in steps of one spacing per 20 µs window (125 m/s).
 //
 // The particle share decides it. With the library's default 0.5
-// (--particle-share 0.5) the crack turns or branches at its first or second
-// step of growth (2.5 / 1.5 / 1.0 mm: at 254/258, 228/232, 222/228 µs), the
-// axial speeds peak at 125, 156 and 200 m/s, and the axial growth by 400 µs is
-// 11/11 mm at 2.5 mm. The reason: only stress points can become crack points,
+// (--particle-share 0.5) the crack forms a T at its first or second step of
+// growth and turns round the tube early (one end past two spacings at 290,
+// 262 and 250 µs at 2.5 / 1.5 / 1.0 mm), the axial speeds peak at 125, 156 and
+// 200 m/s, and the axial growth by 400 µs is 11/11 mm at 2.5 mm. The reason: only stress points can become crack points,
 // and a particle whose integral points all fail just drops out of the
 // integration. With half the membrane and bending work on the particles, the
 // two particles flanking a tip fail first (in the 2.5 mm run, 18 particle
@@ -309,7 +311,7 @@ int run(const Arguments& a) {
             << ", end " << a.end_time * 1e6 << " µs\n";
 
   struct Sample {
-    double t, rear, front, rear_path, front_path, length, radial, arc;
+    double t, rear, front, rear_path, front_path, length, radial, arc, rear_arc, front_arc;
     std::size_t damaged;
     int cracks;
   };
@@ -347,17 +349,20 @@ int run(const Arguments& a) {
     }
     return std::make_pair(rear, front);
   };
-  // Largest arc distance of the notch crack's points from the notch line.
-  auto arc_extent = [&](const TubeSolver& s) {
-    double arc = 0.0;
+  // Largest arc distance of the notch crack's points from the notch line, of
+  // those behind and ahead of the notch centre.
+  auto arc_extents = [&](const TubeSolver& s) {
+    double rear = 0.0, front = 0.0;
     const auto& points = s.crack().points();
     const auto& id = s.crack().crack_of_point();
     for (std::size_t k = 0; k < points.size(); ++k)
       if (id[k] == 0) {
         const double angle = std::atan2(points[k].y(), points[k].x()) - theta;
-        arc = std::max(arc, a.radius * std::abs(std::remainder(angle, 2 * kPi)));
+        const double arc = a.radius * std::abs(std::remainder(angle, 2 * kPi));
+        double& side = points[k].z() < notch_centre ? rear : front;
+        side = std::max(side, arc);
       }
-    return arc;
+    return std::make_pair(rear, front);
   };
   const int notch_particle = model.nearest_particle(a.radius * radial + Vector3(0, 0, notch_centre));
   const auto start = std::chrono::steady_clock::now();
@@ -367,7 +372,9 @@ int run(const Arguments& a) {
       const auto [rear, front] = tips(s);
       const auto [rear_path, front_path] = path_lengths(s);
       const double radial_displacement = s.displacement(notch_particle).dot(model.particle_normal[notch_particle]);
-      samples.push_back({s.time(), rear, front, rear_path, front_path, s.crack().total_length(), radial_displacement, arc_extent(s),
+      const auto [rear_arc, front_arc] = arc_extents(s);
+      samples.push_back({s.time(), rear, front, rear_path, front_path, s.crack().total_length(), radial_displacement,
+                         std::max(rear_arc, front_arc), rear_arc, front_arc,
                          s.damaged_stress_point_count(), s.crack().crack_count()});
       next_sample += sample_interval;
     }
@@ -387,6 +394,7 @@ int run(const Arguments& a) {
   const std::size_t half = 5;
   io::CsvProbe history(csv, {"t [s]", "rear_tip_z [m]", "front_tip_z [m]", "rear_speed [m/s]",
                              "front_speed [m/s]", "rear_path_speed [m/s]", "front_path_speed [m/s]", "crack_total_length [m]", "notch_radial_displacement [m]", "crack_arc_half_extent [m]",
+                             "rear_arc_half_extent [m]", "front_arc_half_extent [m]",
                              "damaged_stress_points", "cracks"});
   std::vector<double> rear_speed(samples.size(), 0.0), front_speed(samples.size(), 0.0);
   std::vector<double> rear_path_speed(samples.size(), 0.0), front_path_speed(samples.size(), 0.0);
@@ -400,7 +408,7 @@ int run(const Arguments& a) {
       front_path_speed[k] = (samples[hi].front_path - samples[lo].front_path) / dt;
     }
     const Sample& s = samples[k];
-    history.write_row({s.t, s.rear, s.front, rear_speed[k], front_speed[k], rear_path_speed[k], front_path_speed[k], s.length, s.radial, s.arc,
+    history.write_row({s.t, s.rear, s.front, rear_speed[k], front_speed[k], rear_path_speed[k], front_path_speed[k], s.length, s.radial, s.arc, s.rear_arc, s.front_arc,
                        double(s.damaged), double(s.cracks)});
   }
   std::printf("\n   t [µs]  rear tip z [mm]  front tip z [mm]  rear speed [m/s]  front speed [m/s]  crack length [mm]  arc half-extent [mm]\n");
@@ -424,25 +432,31 @@ int run(const Arguments& a) {
   const double mean_rear = mean_speed([](const Sample& s) { return s.rear; }, notch_centre - 0.5 * notch_length(), -1.0);
   const double mean_front = mean_speed([](const Sample& s) { return s.front; }, notch_centre + 0.5 * notch_length(), 1.0);
   std::printf("\npeak axial tip speeds (±10 µs differences): rear %.0f m/s, front %.0f m/s\n", max_rear, max_front);
-  // The first time an end's path grows faster than its tip moves axially by
-  // more than half: the tip has turned or branched there.
-  auto peak_before_branching = [&](const std::vector<double>& path_speed, const std::vector<double>& axial_speed,
-                                   const char* end) {
-    double peak = 0.0;
-    std::size_t k = 0;
-    for (; k < samples.size(); ++k) {
-      if (path_speed[k] > 20.0 && path_speed[k] > 1.5 * axial_speed[k]) break;
-      peak = std::max(peak, path_speed[k]);
+  // An end has turned round the tube at the first sample at which its crack
+  // points reach more than two grid spacings from the notch line (raw sample
+  // values; a zigzag along the line stays within one). The pre-turn peaks use
+  // only speed windows that close before that sample.
+  const double grid_spacing = std::min(2 * kPi * a.radius / n_circ, a.length / (n_axial - 1));
+  auto peak_before_branching = [&](auto side_arc, const std::vector<double>& path_speed,
+                                   const std::vector<double>& axial_speed, const char* end) {
+    std::size_t turn = 0;
+    while (turn < samples.size() && side_arc(samples[turn]) <= 2.0 * grid_spacing) ++turn;
+    double path_peak = 0.0, axial_peak = 0.0;
+    for (std::size_t k = 0; k + half < turn; ++k) {
+      path_peak = std::max(path_peak, path_speed[k]);
+      axial_peak = std::max(axial_peak, axial_speed[k]);
     }
-    if (k < samples.size())
-      std::printf("%s end: path speed peaks at %.0f m/s before it turns or branches at %.0f µs; peak path growth rate "
-                  "(branches included) %.0f m/s\n",
-                  end, peak, samples[k].t * 1e6, *std::max_element(path_speed.begin(), path_speed.end()));
+    if (turn < samples.size())
+      std::printf("%s end: turns round the tube at %.0f µs; before that the speed peaks at %.0f m/s axially, "
+                  "%.0f m/s along the crack\n",
+                  end, samples[turn].t * 1e6, axial_peak, path_peak);
     else
-      std::printf("%s end: path speed peaks at %.0f m/s, no turning or branching\n", end, peak);
+      std::printf("%s end: does not turn round the tube; the speed peaks at %.0f m/s axially, %.0f m/s along the "
+                  "crack\n",
+                  end, axial_peak, path_peak);
   };
-  peak_before_branching(rear_path_speed, rear_speed, "rear");
-  peak_before_branching(front_path_speed, front_speed, "front");
+  peak_before_branching([](const Sample& s) { return s.rear_arc; }, rear_path_speed, rear_speed, "rear");
+  peak_before_branching([](const Sample& s) { return s.front_arc; }, front_path_speed, front_speed, "front");
   std::printf("mean axial tip speeds from the first growth to the end: rear %.0f m/s, front %.0f m/s\n", mean_rear,
               mean_front);
   if (!samples.empty()) {
@@ -465,7 +479,9 @@ int run(const Arguments& a) {
               solver.fragment_count());
   std::printf("energy: kinetic %.4g J, plastic dissipation %.4g J, external work %.4g J, balance %.3g J\n",
               e.kinetic, e.plastic_dissipation, e.external_work, e.balance());
-  io::PlotSeries rear{"rear tip, axial", {}, {}}, front{"front tip, axial", {}, {}}, arc{"circumferential half-extent", {}, {}, io::PlotStyle::dashed};
+  io::PlotSeries rear{"rear tip, axial", {}, {}}, front{"front tip, axial", {}, {}};
+  io::PlotSeries rear_arc{"rear end, circumferential half-extent", {}, {}, io::PlotStyle::dashed},
+      front_arc{"front end, circumferential half-extent", {}, {}, io::PlotStyle::dashed};
   io::PlotSeries rear_path{"rear end, along the crack", {}, {}, io::PlotStyle::dashed},
       front_path{"front end, along the crack", {}, {}, io::PlotStyle::dashed};
   io::PlotSeries rear_position{"rear tip (distance behind the notch)", {}, {}}, front_position{"front tip (distance ahead)", {}, {}};
@@ -483,13 +499,15 @@ int run(const Arguments& a) {
     rear_position.y.push_back((notch_centre - 0.5 * notch_length() - samples[k].rear) * 1e3);
     front_position.x.push_back(microseconds);
     front_position.y.push_back((samples[k].front - notch_centre - 0.5 * notch_length()) * 1e3);
-    arc.x.push_back(microseconds);
-    arc.y.push_back(samples[k].arc * 1e3);
+    rear_arc.x.push_back(microseconds);
+    rear_arc.y.push_back(samples[k].rear_arc * 1e3);
+    front_arc.x.push_back(microseconds);
+    front_arc.y.push_back(samples[k].front_arc * 1e3);
   }
   const std::string plot = std::filesystem::path(csv).replace_extension(".svg").string();
   io::write_svg_plot(plot, {{"Crack speeds (paper Fig. 32)", "t [µs]", "speed [m/s]", {rear, front, rear_path, front_path}},
                             {"Crack growth beyond the notch", "t [µs]", "extent [mm]",
-                             {rear_position, front_position, arc}}});
+                             {rear_position, front_position, rear_arc, front_arc}}});
   std::printf("%ld steps in %.1f s; history in %s, plot in %s\n", solver.steps(), seconds, csv.c_str(), plot.c_str());
   return 0;
 }
