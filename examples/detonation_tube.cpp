@@ -203,7 +203,7 @@ Arguments parse(int argc, char** argv) {
     else if (flag == "--pressure-direction") a.pressure_direction = value();
     else if (flag == "--notch-offset") a.notch_offset = example::parse_number(flag, value());
     else if (flag == "--notch-ligament") a.notch_ligament = example::parse_number(flag, value());
-    else if (flag == "--particle-share") a.particle_share = example::parse_number(flag, value());
+    else if (flag == "--particle-share") a.particle_share = example::parse_particle_share(flag, value());
     else if (flag == "--output") a.output = value();
     else if (flag == "--csv") a.csv = value();
     else throw Error("unknown option " + flag + " (see the comment at the top of detonation_tube.cpp)");
@@ -221,8 +221,6 @@ Arguments parse(int argc, char** argv) {
       detail::invalid_parameter("--notch-offset", a.notch_offset, "a surface notch runs along the stress-point row");
     a.notch_offset = 0.0;
   }
-  if (!(a.particle_share >= 0.0 && a.particle_share < 1.0))
-    detail::invalid_parameter("--particle-share", a.particle_share, "must lie in [0, 1)");
   if (a.pressure_direction != "follower" && a.pressure_direction != "fixed")
     throw Error("--pressure-direction is '" + a.pressure_direction + "'; use follower or fixed");
   if (!(a.length > notch_length() + 4 * a.spacing))
@@ -263,6 +261,7 @@ int run(const Arguments& a) {
   options.output_directory = a.output;
   options.output_interval = a.output.empty() ? 0.0 : 1e-5;
   const double notch_centre = 0.5 * a.length;
+  const double notch_rear_end = notch_centre - 0.5 * notch_length(), notch_front_end = notch_centre + 0.5 * notch_length();
   ShellModel tube = ShellModel::cylindrical_panel(a.radius, a.length, 2 * kPi, n_circ, n_axial, thickness);
   if (a.notch_ligament > 0.0)
     // A surface notch: the wall thins to the ligament over the notch length,
@@ -295,8 +294,8 @@ int run(const Arguments& a) {
   const Vector3 radial(std::cos(theta), std::sin(theta), 0.0);
   const Vector3 notch_line = a.notch_offset == 0.0 ? Vector3(row.x(), row.y(), 0.0) : notch_radius * radial;
   if (a.notch_ligament == 0.0)
-    solver.add_precrack({notch_line + Vector3(0, 0, notch_centre - 0.5 * notch_length()),
-                         notch_line + Vector3(0, 0, notch_centre + 0.5 * notch_length())});
+    solver.add_precrack({notch_line + Vector3(0, 0, notch_rear_end),
+                         notch_line + Vector3(0, 0, notch_front_end)});
 
   const std::string csv = a.output.empty() ? a.csv : a.output + "/crack_tips.csv";
   if (!a.output.empty()) std::filesystem::create_directories(a.output);
@@ -305,7 +304,7 @@ int run(const Arguments& a) {
             << a.length << " m, d = " << thickness << " m, " << n_circ << " x " << n_axial << " = "
             << model.particle_count() << " particles, " << model.stress_point_count() << " stress points\n"
             << "  notch 50.8 mm centred at z = " << notch_centre << " m (wave arrives at its rear end at "
-            << (notch_centre - 0.5 * notch_length()) / v_cj * 1e6 << " µs), dt = " << solver.time_step()
+            << notch_rear_end / v_cj * 1e6 << " µs), dt = " << solver.time_step()
             << " s (stable " << solver.stable_time_step() << " s), rotary-inertia scale " << rotary_scale
             << ", particle share " << a.particle_share
             << ", end " << a.end_time * 1e6 << " µs\n";
@@ -319,7 +318,7 @@ int run(const Arguments& a) {
   const double sample_interval = 2e-6;
   double next_sample = 0.0;
   auto tips = [&](const TubeSolver& s) {
-    double rear = notch_centre - 0.5 * notch_length(), front = notch_centre + 0.5 * notch_length();
+    double rear = notch_rear_end, front = notch_front_end;
     const auto& points = s.crack().points();
     const auto& id = s.crack().crack_of_point();
     for (std::size_t k = 0; k < points.size(); ++k)
@@ -429,16 +428,16 @@ int run(const Arguments& a) {
       }
     return 0.0;
   };
-  const double mean_rear = mean_speed([](const Sample& s) { return s.rear; }, notch_centre - 0.5 * notch_length(), -1.0);
-  const double mean_front = mean_speed([](const Sample& s) { return s.front; }, notch_centre + 0.5 * notch_length(), 1.0);
+  const double mean_rear = mean_speed([](const Sample& s) { return s.rear; }, notch_rear_end, -1.0);
+  const double mean_front = mean_speed([](const Sample& s) { return s.front; }, notch_front_end, 1.0);
   std::printf("\npeak axial tip speeds (±10 µs differences): rear %.0f m/s, front %.0f m/s\n", max_rear, max_front);
   // An end has turned round the tube at the first sample at which its crack
   // points reach more than two grid spacings from the notch line (raw sample
   // values; a zigzag along the line stays within one). The pre-turn peaks use
   // only speed windows that close before that sample.
   const double grid_spacing = std::min(2 * kPi * a.radius / n_circ, a.length / (n_axial - 1));
-  auto peak_before_branching = [&](auto side_arc, const std::vector<double>& path_speed,
-                                   const std::vector<double>& axial_speed, const char* end) {
+  auto report_turn = [&](auto side_arc, const std::vector<double>& path_speed,
+                         const std::vector<double>& axial_speed, const char* end) {
     std::size_t turn = 0;
     while (turn < samples.size() && side_arc(samples[turn]) <= 2.0 * grid_spacing) ++turn;
     double path_peak = 0.0, axial_peak = 0.0;
@@ -455,13 +454,13 @@ int run(const Arguments& a) {
                   "crack\n",
                   end, axial_peak, path_peak);
   };
-  peak_before_branching([](const Sample& s) { return s.rear_arc; }, rear_path_speed, rear_speed, "rear");
-  peak_before_branching([](const Sample& s) { return s.front_arc; }, front_path_speed, front_speed, "front");
+  report_turn([](const Sample& s) { return s.rear_arc; }, rear_path_speed, rear_speed, "rear");
+  report_turn([](const Sample& s) { return s.front_arc; }, front_path_speed, front_speed, "front");
   std::printf("mean axial tip speeds from the first growth to the end: rear %.0f m/s, front %.0f m/s\n", mean_rear,
               mean_front);
   if (!samples.empty()) {
-    std::printf("rear end axial growth, mm: %.1f\n", (notch_centre - 0.5 * notch_length() - samples.back().rear) * 1e3);
-    std::printf("front end axial growth, mm: %.1f\n", (samples.back().front - notch_centre - 0.5 * notch_length()) * 1e3);
+    std::printf("rear end axial growth, mm: %.1f\n", (notch_rear_end - samples.back().rear) * 1e3);
+    std::printf("front end axial growth, mm: %.1f\n", (samples.back().front - notch_front_end) * 1e3);
   }
   // Growth along the crack path, branches included: the total length's rate.
   double growth_start = samples.empty() ? 0.0 : samples.back().t;
@@ -496,9 +495,9 @@ int run(const Arguments& a) {
     front_path.x.push_back(microseconds);
     front_path.y.push_back(front_path_speed[k]);
     rear_position.x.push_back(microseconds);
-    rear_position.y.push_back((notch_centre - 0.5 * notch_length() - samples[k].rear) * 1e3);
+    rear_position.y.push_back((notch_rear_end - samples[k].rear) * 1e3);
     front_position.x.push_back(microseconds);
-    front_position.y.push_back((samples[k].front - notch_centre - 0.5 * notch_length()) * 1e3);
+    front_position.y.push_back((samples[k].front - notch_front_end) * 1e3);
     rear_arc.x.push_back(microseconds);
     rear_arc.y.push_back(samples[k].rear_arc * 1e3);
     front_arc.x.push_back(microseconds);

@@ -38,4 +38,12 @@ inline int parse_integer(const std::string& option, const std::string& text) {
   return static_cast<int>(value);
 }
 
+// SolverOptions::particle_integration_share from the command line, checked
+// here so that the error names the option rather than the solver field.
+inline double parse_particle_share(const std::string& option, const std::string& text) {
+  const double share = parse_number(option, text);
+  if (!(share >= 0.0 && share < 1.0)) detail::invalid_parameter(option, share, "must lie in [0, 1)");
+  return share;
+}
+
 }  // namespace sphshell::example

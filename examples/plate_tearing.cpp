@@ -160,7 +160,7 @@ Arguments parse(int argc, char** argv) {
     else if (flag == "--end-displacement") a.end_displacement = example::parse_number(flag, value());
     else if (flag == "--precrack") a.precrack = example::parse_number(flag, value());
     else if (flag == "--rotary-scale") a.rotary_scale = example::parse_number(flag, value());
-    else if (flag == "--particle-share") a.particle_share = example::parse_number(flag, value());
+    else if (flag == "--particle-share") a.particle_share = example::parse_particle_share(flag, value());
     else if (flag == "--arm-length") a.arm_length = example::parse_number(flag, value());
     else if (flag == "--stroke-per-arm") a.stroke_per_arm = example::parse_number(flag, value());
     else if (flag == "--output") a.output = value();
@@ -171,8 +171,6 @@ Arguments parse(int argc, char** argv) {
   detail::require_positive("--speed", a.speed);
   detail::require_positive("--end-displacement", a.end_displacement);
   detail::require_positive("--rotary-scale", a.rotary_scale);
-  if (!(a.particle_share >= 0.0 && a.particle_share < 1.0))
-    detail::invalid_parameter("--particle-share", a.particle_share, "must lie in [0, 1)");
   if (!(a.arm_length > width + pin_offset_x))
     detail::invalid_parameter("--arm-length", a.arm_length, "must reach past the plate's left edge (> 0.7 m)");
   if (!(a.stroke_per_arm > 0.0 && a.stroke_per_arm <= 1.0))

@@ -59,15 +59,13 @@ Arguments parse(int argc, char** argv) {
     else if (flag == "--n") a.n = example::parse_integer(flag, value());
     else if (flag == "--pressure") a.pressure = example::parse_number(flag, value());
     else if (flag == "--end-time") a.end_time = example::parse_number(flag, value());
-    else if (flag == "--particle-share") a.particle_share = example::parse_number(flag, value());
+    else if (flag == "--particle-share") a.particle_share = example::parse_particle_share(flag, value());
     else if (flag == "--output") a.output = value();
     else throw Error("square_plate: unknown option " + flag + " (see the comment at the top of square_plate.cpp)");
   }
   if (a.n < 3) detail::invalid_parameter("--n", a.n, "must be at least 3");
   detail::require_positive("--end-time", a.end_time);
   if (a.pressure != 0.0) detail::require_positive("--pressure", a.pressure);
-  if (!(a.particle_share >= 0.0 && a.particle_share < 1.0))
-    detail::invalid_parameter("--particle-share", a.particle_share, "must lie in [0, 1)");
   return a;
 }
 
@@ -137,6 +135,7 @@ int run(const Arguments& a, const typename Material::Parameters& parameters) {
       peak_time = s.time();
     }
     if (s.steps() % 5 != 0) return;
+    const double longest = longest_crack_length(s);
     std::vector<double> row{s.time(), w};
     for (int k = 0; k < points; ++k) row.push_back(s.equivalent_stress(stress_point_a, k));
     for (int k = 0; k < points; ++k) row.push_back(s.equivalent_plastic_strain(stress_point_a, k));
@@ -144,7 +143,7 @@ int run(const Arguments& a, const typename Material::Parameters& parameters) {
     for (int k = 0; k < points; ++k) row.push_back(s.equivalent_plastic_strain(stress_point_b, k));
     for (int k = 0; k < points; ++k) row.push_back(s.damage(stress_point_b, k));
     if constexpr (Crack::enabled)
-      row.insert(row.end(), {s.crack().total_length(), longest_crack_length(s), double(s.crack().crack_count()),
+      row.insert(row.end(), {s.crack().total_length(), longest, double(s.crack().crack_count()),
                              double(s.damaged_stress_point_count()), double(s.fragment_count())});
     history.write_row(row);
     deflection.x.push_back(s.time() * 1e3);
@@ -153,7 +152,7 @@ int run(const Arguments& a, const typename Material::Parameters& parameters) {
       crack_length.x.push_back(s.time() * 1e3);
       crack_length.y.push_back(s.crack().total_length());
       longest_crack.x.push_back(s.time() * 1e3);
-      longest_crack.y.push_back(longest_crack_length(s));
+      longest_crack.y.push_back(longest);
     }
   });
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
