@@ -161,6 +161,7 @@ struct Elastic {
   const Parameters& parameters() const { return parameters_; }
   double youngs_modulus() const { return parameters_.E; }
   double poisson_ratio() const { return parameters_.nu; }
+  double shear_modulus() const { return elasticity_.shear_modulus(); }
   const PlaneStressElasticity& elasticity() const { return elasticity_; }
   Matrix3 elasticity_matrix() const { return elasticity_.matrix(); }
 

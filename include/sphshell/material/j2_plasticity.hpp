@@ -5,6 +5,7 @@
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/material/elastic.hpp>
+#include <sphshell/material/material.hpp>
 #include <sphshell/material/return_map.hpp>
 
 #include <cmath>
@@ -73,6 +74,8 @@ struct J2Plasticity {
   const Parameters& parameters() const { return parameters_; }
   double youngs_modulus() const { return parameters_.E; }
   double poisson_ratio() const { return parameters_.nu; }
+  double shear_modulus() const { return elasticity_.shear_modulus(); }
+  HardeningParameters hardening() const { return {parameters_.sigma_y0, parameters_.Ep}; }
   const PlaneStressElasticity& elasticity() const { return elasticity_; }
   Matrix3 elasticity_matrix() const { return elasticity_.matrix(); }
 

@@ -6,7 +6,7 @@
 // - Strain equivalence: σ = (1−D)Γεe, so the effective stress σ̃ = σ/(1−D)
 //   is what yields (eq. 2.42: σ̄/(1−D) = σs), and the flow is associative in
 //   σ̃: Δεp = (Δε̄p/σs)Ξσ̃. Then ε̄p is the von Mises equivalent of εp — the
-//   same consistency argument as the scaling note of design.md, which rules
+//   same consistency argument as the consistent scaling of docs/method.md §5, which rules
 //   out the paper's Δεp ∝ Ξσ (with it a damaged uniaxial bar would accumulate
 //   (1−D)Δε̄p of axial plastic strain per Δε̄p).
 // - Implicit in D: writing the step with D_{n+1} everywhere,
@@ -136,6 +136,9 @@ struct LemaitreDamage {
   const Parameters& parameters() const { return parameters_; }
   double youngs_modulus() const { return parameters_.E; }
   double poisson_ratio() const { return parameters_.nu; }
+  double shear_modulus() const { return elasticity_.shear_modulus(); }
+  HardeningParameters hardening() const { return {parameters_.sigma_y0, parameters_.Ep}; }
+  DamageParameters damage_parameters() const { return {parameters_.eps_s, parameters_.eps_c, parameters_.Dc}; }
   const PlaneStressElasticity& elasticity() const { return elasticity_; }
   // The undamaged Γ; the current stiffness of a point is (1−D)Γ.
   Matrix3 elasticity_matrix() const { return elasticity_.matrix(); }

@@ -9,12 +9,17 @@
 //              UpdateResult update(State&, const StrainVoigt& d_eps) const;
 //              const Parameters& parameters() const;
 //              double youngs_modulus() const; double poisson_ratio() const;
+//              double shear_modulus() const;                  (G = E / (2(1 + ν)))
 //              Matrix3 elasticity_matrix() const;             (plane-stress Γ, eq. 2.24)
 //              double equivalent_stress(const State&) const;   (σ̄ = √(σᵀΞσ))
 //              double equivalent_plastic_strain(const State&) const;
 //              double damage(const State&) const;
 //              bool failed(const State&) const;
 //              double elastic_energy_density(const State&) const;
+//   plastic    HardeningParameters hardening() const;     (when has_plasticity)
+//   damage     DamageParameters damage_parameters() const; (when has_damage)
+// What generic code needs of a law's constants goes through these members,
+// never through the fields of Parameters (which each law names as it likes).
 // is_material_law<Law> checks all of it; each has_* trait checks one member, and
 // check_material_law<Law>() static_asserts them one by one so a compile error
 // names the missing member.
@@ -26,10 +31,24 @@
 
 namespace sphshell::material {
 
+// Initial yield stress σs0 and plastic modulus Ep = E Et / (E − Et) of a
+// linearly hardening law (eq. 2.34–2.35).
+struct HardeningParameters {
+  double initial_yield_stress = 0.0;
+  double plastic_modulus = 0.0;
+};
+
+// Damage threshold ε̄sp, critical equivalent plastic strain ε̄cp and critical
+// damage Dc of a Lemaitre-type law (eq. 2.40–2.41).
+struct DamageParameters {
+  double threshold_strain = 0.0;
+  double critical_strain = 0.0;
+  double critical_damage = 0.0;
+};
+
 namespace detail {
 
-template <class...>
-using void_t = void;
+using std::void_t;
 
 template <class Default, class AlwaysVoid, template <class...> class Op, class... Args>
 struct detector : std::false_type {};
@@ -61,6 +80,12 @@ template <class Law>
 using youngs_modulus_t = decltype(std::declval<const Law&>().youngs_modulus());
 template <class Law>
 using poisson_ratio_t = decltype(std::declval<const Law&>().poisson_ratio());
+template <class Law>
+using shear_modulus_t = decltype(std::declval<const Law&>().shear_modulus());
+template <class Law>
+using hardening_t = decltype(std::declval<const Law&>().hardening());
+template <class Law>
+using damage_parameters_t = decltype(std::declval<const Law&>().damage_parameters());
 template <class Law>
 using elasticity_matrix_t = decltype(std::declval<const Law&>().elasticity_matrix());
 template <class Law>
@@ -125,7 +150,24 @@ struct has_youngs_modulus : detail::yields<double, detail::youngs_modulus_t, Law
 template <class Law>
 struct has_poisson_ratio : detail::yields<double, detail::poisson_ratio_t, Law> {};
 template <class Law>
+struct has_shear_modulus : detail::yields<double, detail::shear_modulus_t, Law> {};
+template <class Law>
+struct has_hardening : detail::yields<HardeningParameters, detail::hardening_t, Law> {};
+template <class Law>
+struct has_damage_parameters : detail::yields<DamageParameters, detail::damage_parameters_t, Law> {};
+template <class Law>
 struct has_elasticity_matrix : detail::yields<Matrix3, detail::elasticity_matrix_t, Law> {};
+
+namespace detail {
+// A plastic law must give its hardening and a damage law its damage
+// parameters; flags that are missing are reported by their own checks.
+template <class Law, class = void>
+struct has_parameters_its_flags_need : std::false_type {};
+template <class Law>
+struct has_parameters_its_flags_need<Law, void_t<has_plasticity_t<Law>, has_damage_t<Law>>>
+    : std::bool_constant<(!Law::has_plasticity || has_hardening<Law>::value) &&
+                         (!Law::has_damage || has_damage_parameters<Law>::value)> {};
+}  // namespace detail
 template <class Law>
 struct has_plasticity_flag : detail::is_detected<detail::has_plasticity_t, Law> {};
 template <class Law>
@@ -150,7 +192,8 @@ struct is_material_law
     : std::conjunction<has_parameters_type<Law>, has_state_type<Law>, has_update_result_type<Law>,
                        has_parameter_constructor<Law>, has_initial_state<Law>, has_update<Law>,
                        has_parameters_accessor<Law>, has_youngs_modulus<Law>,
-                       has_poisson_ratio<Law>, has_elasticity_matrix<Law>, has_plasticity_flag<Law>,
+                       has_poisson_ratio<Law>, has_shear_modulus<Law>, has_elasticity_matrix<Law>,
+                       has_plasticity_flag<Law>, detail::has_parameters_its_flags_need<Law>,
                        has_damage_flag<Law>, has_name<Law>, has_equivalent_stress<Law>,
                        has_equivalent_plastic_strain<Law>, has_damage_accessor<Law>,
                        has_failed<Law>, has_elastic_energy_density<Law>> {};
@@ -161,37 +204,49 @@ inline constexpr bool is_material_law_v = is_material_law<Law>::value;
 // static_assert(check_material_law<Law>()) reports the first missing member by name.
 template <class Law>
 constexpr bool check_material_law() {
-  static_assert(has_parameters_type<Law>::value, "material law: missing nested type Parameters");
-  static_assert(has_state_type<Law>::value, "material law: missing nested type State");
+  static_assert(has_parameters_type<Law>::value, "material law: missing nested type Parameters; add `struct Parameters { ... };` holding the law's constants");
+  static_assert(has_state_type<Law>::value, "material law: missing nested type State; add `struct State { StressVoigt stress; ... };` (one integral point)");
   static_assert(has_update_result_type<Law>::value,
-                "material law: missing UpdateResult { bool plastic; int iterations; }");
+                "material law: missing nested type UpdateResult; add `struct UpdateResult { bool plastic; int iterations; };`");
   static_assert(has_parameter_constructor<Law>::value,
-                "material law: missing constructor Law(const Parameters&)");
-  static_assert(has_initial_state<Law>::value, "material law: missing State initial_state() const");
+                "material law: missing constructor; add `explicit Law(const Parameters&)` (validating, throwing sphshell::Error)");
+  static_assert(has_initial_state<Law>::value, "material law: missing initial state; add `State initial_state() const`");
   static_assert(has_update<Law>::value,
-                "material law: missing UpdateResult update(State&, const StrainVoigt&) const");
+                "material law: missing update; add `UpdateResult update(State&, const StrainVoigt& d_eps) const`");
   static_assert(has_parameters_accessor<Law>::value,
-                "material law: missing const Parameters& parameters() const");
+                "material law: missing parameters accessor; add `const Parameters& parameters() const`");
   static_assert(has_youngs_modulus<Law>::value,
-                "material law: missing double youngs_modulus() const");
+                "material law: missing Young's modulus; add `double youngs_modulus() const`");
   static_assert(has_poisson_ratio<Law>::value,
-                "material law: missing double poisson_ratio() const");
+                "material law: missing Poisson's ratio; add `double poisson_ratio() const`");
+  static_assert(has_shear_modulus<Law>::value,
+                "material law: missing shear modulus; add `double shear_modulus() const` (G = E / (2(1 + nu)))");
   static_assert(has_elasticity_matrix<Law>::value,
-                "material law: missing Matrix3 elasticity_matrix() const");
+                "material law: missing plane-stress stiffness; add `Matrix3 elasticity_matrix() const` (eq. 2.24)");
   static_assert(has_plasticity_flag<Law>::value,
-                "material law: missing static constexpr bool has_plasticity");
+                "material law: missing plasticity flag; add `static constexpr bool has_plasticity`");
   static_assert(has_damage_flag<Law>::value,
-                "material law: missing static constexpr bool has_damage");
-  static_assert(has_name<Law>::value, "material law: missing static constexpr const char* name");
+                "material law: missing damage flag; add `static constexpr bool has_damage`");
+  if constexpr (has_plasticity_flag<Law>::value)
+    if constexpr (Law::has_plasticity)
+      static_assert(has_hardening<Law>::value,
+                    "material law: a law with has_plasticity needs its hardening; add `HardeningParameters "
+                    "hardening() const`");
+  if constexpr (has_damage_flag<Law>::value)
+    if constexpr (Law::has_damage)
+      static_assert(has_damage_parameters<Law>::value,
+                    "material law: a law with has_damage needs its damage constants; add `DamageParameters "
+                    "damage_parameters() const`");
+  static_assert(has_name<Law>::value, "material law: missing name; add `static constexpr const char* name`");
   static_assert(has_equivalent_stress<Law>::value,
-                "material law: missing double equivalent_stress(const State&) const");
+                "material law: missing equivalent stress; add `double equivalent_stress(const State&) const`");
   static_assert(has_equivalent_plastic_strain<Law>::value,
-                "material law: missing double equivalent_plastic_strain(const State&) const");
+                "material law: missing equivalent plastic strain; add `double equivalent_plastic_strain(const State&) const`");
   static_assert(has_damage_accessor<Law>::value,
-                "material law: missing double damage(const State&) const");
-  static_assert(has_failed<Law>::value, "material law: missing bool failed(const State&) const");
+                "material law: missing damage accessor; add `double damage(const State&) const`");
+  static_assert(has_failed<Law>::value, "material law: missing failure flag; add `bool failed(const State&) const`");
   static_assert(has_elastic_energy_density<Law>::value,
-                "material law: missing double elastic_energy_density(const State&) const");
+                "material law: missing stored energy; add `double elastic_energy_density(const State&) const`");
   return is_material_law<Law>::value;
 }
 

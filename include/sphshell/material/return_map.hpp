@@ -8,7 +8,7 @@
 // c uses the consistent scaling Δεp = (Δε̄p/σs)Ξσ rather than the paper's
 // printed 3Δε̄p/σs: with the factor 3 a uniaxial return produces three times the
 // von Mises equivalent plastic strain, so hardening would be applied to the
-// wrong strain (design.md, scaling note). Appendix A's derivative and
+// wrong strain (docs/method.md, "The consistent scaling"). Appendix A's derivative and
 // Appendix B's K are rederived for the same scaling.
 //
 // Two implementations of the same equations:

@@ -16,7 +16,7 @@
 // so σ̄_I = √(xᵀÂ_s x) is a generalized equivalent stress (σ̄_I = σ in uniform tension).
 // Associated flow Δε_gp = Δλ Âx/σ̄_I with Δλ = d Δε̄p makes the plastic work per area
 // d σs Δε̄p, so ε̄p is the thickness-averaged equivalent plastic strain and the
-// hardening σs = σs,n + Ep Δε̄p is the law's. Closest point, like design §2.4:
+// hardening σs = σs,n + Ep Δε̄p is the law's. Closest point, like the J2 map of docs/method.md §5:
 //   x = (I + (d Δε̄p/σs) D Â_s)⁻¹ x*,  D = diag(dΓ, d³/12 Γ),  g(Δε̄p) = xᵀÂ_s x − σs² = 0,
 // a scalar Newton safeguarded by bisection. |Q_tm| makes a ridge at Q_tm = 0 (which pure
 // bending and pure tension sit on); when the return with s = ±1 leaves its own side,
@@ -25,7 +25,7 @@
 // on Q_tm(s) = 0.
 //
 // Damage (LemaitreDamage), the project's reduction to resultants: the damage law of
-// design §2.5 driven by the generalized ε̄p with the triaxiality fixed at T = 1/3
+// docs/method.md §6 (eq. 2.41) driven by the generalized ε̄p with the triaxiality fixed at T = 1/3
 // (uniaxial tension, so the factor ⅔(1+ν) + 3(1−2ν)T² is exactly 1): D grows by
 // Dc/(ε̄cp − ε̄sp) Δε̄p once ε̄p >= ε̄sp. A membrane-based triaxiality is undefined in pure
 // bending, which is the dominant shell loading; T = 1/3 is the fibre state there.
@@ -35,6 +35,7 @@
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/types.hpp>
+#include <sphshell/material/material.hpp>
 #include <sphshell/thickness/section.hpp>
 #include <sphshell/thickness/thickness.hpp>
 
@@ -75,6 +76,17 @@ class Section<Global, Law> {
   static constexpr int output_points = 1;
   using State = ResultantState;
 
+  // Iteration caps of the ridge search and of the Newton solve on the plastic
+  // multiplier; both converge in a few iterations, so reaching one is an error.
+  static constexpr int max_ridge_iterations = 200;
+  static constexpr int max_newton_iterations = 200;
+  // A coupling term below this fraction of σs² is on the ridge (s = 0).
+  static constexpr double ridge_tolerance = 1e-12;
+  // |g| below this fraction of σs² is converged; brackets and the ridge
+  // parameter narrower than this relative width stop the search.
+  static constexpr double residual_tolerance = 1e-13;
+  static constexpr double bracket_tolerance = 1e-15;
+
   Section(const Law& law, double thickness) : law_(law), thickness_(thickness) {
     sphshell::detail::require_positive("thickness", thickness);
     const double d = thickness;
@@ -96,7 +108,7 @@ class Section<Global, Law> {
     coupling_metric_.template topRightCorner<3, 3>() = 2.0 * xi / (std::sqrt(3.0) * d * d * d);
     coupling_metric_.template bottomLeftCorner<3, 3>() = 2.0 * xi / (std::sqrt(3.0) * d * d * d);
 
-    // Γ and Ξ share the eigenvectors q_i (design §2.4), so the 6×6 return decouples
+    // Γ and Ξ share the eigenvectors q_i (docs/method.md §5), so the 6×6 return decouples
     // into three 2×2 systems in (N·q_i, M·q_i); ΓΞ q_i = λ_i q_i.
     modal_basis_ << 1.0 / std::sqrt(2.0), 1.0 / std::sqrt(2.0), 0.0,
                     1.0 / std::sqrt(2.0), -1.0 / std::sqrt(2.0), 0.0,
@@ -112,13 +124,15 @@ class Section<Global, Law> {
                               2.0 / (std::sqrt(3.0) * d * d * d), 0.0;
 
     if constexpr (Law::has_plasticity) {
-      initial_yield_stress_ = law.parameters().sigma_y0;
-      hardening_modulus_ = law.parameters().Ep;
+      const material::HardeningParameters hardening = law.hardening();
+      initial_yield_stress_ = hardening.initial_yield_stress;
+      hardening_modulus_ = hardening.plastic_modulus;
     }
     if constexpr (Law::has_damage) {
-      damage_threshold_ = law.parameters().eps_s;
-      critical_damage_ = law.parameters().Dc;
-      damage_rate_ = law.parameters().Dc / (law.parameters().eps_c - law.parameters().eps_s);
+      const material::DamageParameters damage = law.damage_parameters();
+      damage_threshold_ = damage.threshold_strain;
+      critical_damage_ = damage.critical_damage;
+      damage_rate_ = damage.critical_damage / (damage.critical_strain - damage.threshold_strain);
     }
   }
 
@@ -226,7 +240,7 @@ class Section<Global, Law> {
   }
 
   ReturnResult plastic_return(const Vector6& trial, double sigma_y_n) const {
-    const double tolerance = 1e-12 * sigma_y_n * sigma_y_n;
+    const double tolerance = ridge_tolerance * sigma_y_n * sigma_y_n;
     // Pure bending or pure tension: the trial is on the ridge and s = 0 keeps it there.
     if (std::abs(coupling_term(trial)) <= tolerance) {
       const ReturnResult uncoupled = return_onto(trial, sigma_y_n, 0.0);
@@ -244,11 +258,11 @@ class Section<Global, Law> {
     double s_a = first_side, s_b = -first_side;
     double h_a = first_coupling, h_b = second_coupling;
     int retained = 0;
-    for (int iteration = 0; iteration < 200; ++iteration) {
+    for (int iteration = 0; iteration < max_ridge_iterations; ++iteration) {
       const double s = (s_a * h_b - s_b * h_a) / (h_b - h_a);
       const ReturnResult ridge = return_onto(trial, sigma_y_n, s);
       const double h = coupling_term(ridge.resultants);
-      if (std::abs(h) <= tolerance || std::abs(s_b - s_a) <= 1e-15) return ridge;
+      if (std::abs(h) <= tolerance || std::abs(s_b - s_a) <= bracket_tolerance) return ridge;
       if ((h > 0.0) == (h_a > 0.0)) {
         s_a = s;
         h_a = h;
@@ -307,12 +321,12 @@ class Section<Global, Law> {
     const double growth_step =
         std::sqrt(trial.dot((uncoupled_metric_ + s * coupling_metric_) * trial)) /
         law_.youngs_modulus();
-    for (int iteration = 0; iteration < 200; ++iteration) {
+    for (int iteration = 0; iteration < max_newton_iterations; ++iteration) {
       const double g = residual(d_eps_p, derivative);
       const double sigma_y = sigma_y_n + hardening * d_eps_p;
-      if (std::abs(g) <= 1e-13 * sigma_y * sigma_y) return {resultants_of(), d_eps_p};
+      if (std::abs(g) <= residual_tolerance * sigma_y * sigma_y) return {resultants_of(), d_eps_p};
       if (g > 0.0) lower = d_eps_p; else upper = d_eps_p;
-      if (upper >= 0.0 && upper - lower <= 1e-15 * upper) return {resultants_of(), d_eps_p};
+      if (upper >= 0.0 && upper - lower <= bracket_tolerance * upper) return {resultants_of(), d_eps_p};
       double next = derivative < 0.0 ? d_eps_p - g / derivative : -1.0;
       const bool outside = !(next > lower) || (upper >= 0.0 && !(next < upper));
       if (outside) next = upper >= 0.0 ? 0.5 * (lower + upper) : 2.0 * lower + growth_step;
