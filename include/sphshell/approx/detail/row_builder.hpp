@@ -6,6 +6,7 @@
 #include <sphshell/approx/neighbour_search.hpp>
 #include <sphshell/approx/shape_functions.hpp>
 #include <sphshell/core/error.hpp>
+#include <sphshell/core/parallel.hpp>
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/kernel/kernel.hpp>
@@ -18,14 +19,6 @@
 #include <string>
 #include <vector>
 
-#ifdef _OPENMP
-#include <omp.h>
-// Without OpenMP the directives vanish instead of raising -Wunknown-pragmas in
-// user code.
-#define SPHSHELL_APPROX_OMP(directive) _Pragma(directive)
-#else
-#define SPHSHELL_APPROX_OMP(directive)
-#endif
 
 namespace sphshell::approx::detail {
 
@@ -50,6 +43,8 @@ struct RowWorkspace {
 
 // Two points of one set closer than this (relative to h) are "coincident".
 inline constexpr double coincidence_tolerance_factor = 1e-9;
+// Neighbours per row reserved up front (a support of two spacings holds about 12).
+inline constexpr std::size_t expected_neighbours = 16;
 
 [[noreturn]] inline void throw_no_visible_neighbour(std::size_t eval_index) {
   std::ostringstream message;
@@ -202,11 +197,12 @@ ShapeFunctions build_all(const std::vector<Vector3>& particles,
     return static_cast<std::size_t>(block) * rows / static_cast<std::size_t>(block_count);
   };
   std::vector<std::vector<int>> gathered(static_cast<std::size_t>(block_count));
-  SPHSHELL_APPROX_OMP("omp parallel for schedule(static, 1)")
-  for (std::ptrdiff_t block = 0; block < block_count; ++block) {
+  // An allocation failure in a block is rethrown after the loop (the lowest
+  // block's), never inside the OpenMP region.
+  parallel::for_each(std::ptrdiff_t{0}, block_count, [&](std::ptrdiff_t block) {
     std::vector<int>& list = gathered[static_cast<std::size_t>(block)];
     const std::size_t last = block_first_row(block + 1);
-    list.reserve((last - block_first_row(block)) * 16);
+    list.reserve((last - block_first_row(block)) * expected_neighbours);
     for (std::size_t row = block_first_row(block); row < last; ++row) {
       const std::size_t first = list.size();
       particle_cells.for_each_within(eval_positions[row], support,
@@ -214,36 +210,35 @@ ShapeFunctions build_all(const std::vector<Vector3>& particles,
       std::sort(list.begin() + static_cast<std::ptrdiff_t>(first), list.end());
       sf.row_begin[row + 1] = list.size() - first;
     }
-  }
+  });
   for (std::size_t r = 0; r < rows; ++r) sf.row_begin[r + 1] += sf.row_begin[r];
   const std::size_t slots = sf.row_begin[rows];
   sf.neighbour.resize(slots);
   sf.phi.resize(slots);
   sf.dphi_d1.resize(slots);
   sf.dphi_d2.resize(slots);
-  SPHSHELL_APPROX_OMP("omp parallel for schedule(static, 1)")
-  for (std::ptrdiff_t block = 0; block < block_count; ++block) {
+  parallel::for_each(std::ptrdiff_t{0}, block_count, [&](std::ptrdiff_t block) noexcept {
     std::vector<int>& list = gathered[static_cast<std::size_t>(block)];
     std::copy(list.begin(), list.end(),
               sf.neighbour.begin() + static_cast<std::ptrdiff_t>(sf.row_begin[block_first_row(block)]));
     std::vector<int>().swap(list);
-  }
+  });
 
   // Exceptions may not leave an OpenMP region; the one of the lowest row is
   // kept so the message does not depend on the thread count.
   std::exception_ptr error;
   std::ptrdiff_t error_row = row_count;
-  SPHSHELL_APPROX_OMP("omp parallel")
+  SPHSHELL_OMP("omp parallel")
   {
     RowWorkspace ws;
-    SPHSHELL_APPROX_OMP("omp for schedule(static)")
+    SPHSHELL_OMP("omp for schedule(static)")
     for (std::ptrdiff_t i = 0; i < row_count; ++i) {
       const auto row = static_cast<std::size_t>(i);
       try {
         compute_row<Kernel, Method>(sf, row, particles, volumes, eval_positions[row],
                                     eval_frames[row], h, visible, ws);
       } catch (...) {
-        SPHSHELL_APPROX_OMP("omp critical(sphshell_approx_error)")
+        SPHSHELL_OMP("omp critical(sphshell_approx_error)")
         if (i < error_row) {
           error_row = i;
           error = std::current_exception();
@@ -285,4 +280,3 @@ void rebuild_one_row(ShapeFunctions& sf, std::size_t row, const std::vector<Vect
 
 }  // namespace sphshell::approx::detail
 
-#undef SPHSHELL_APPROX_OMP
