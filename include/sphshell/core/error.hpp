@@ -15,7 +15,23 @@ class Error : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Where a run is: the step count and the simulated time. Parts of the solver
+// that can detect an instability are handed it, so their error names both.
+struct StepTime {
+  long step = 0;
+  double time = 0.0;
+};
+
 namespace detail {
+
+// A run that went unstable stops with an Error naming the step, the time and
+// what failed (a particle or a point).
+[[noreturn]] inline void fail_unstable(const StepTime& at, const std::string& what) {
+  std::ostringstream message;
+  message.precision(6);
+  message << "sphshell: simulation unstable at step " << at.step << ", t = " << at.time << " s: " << what;
+  throw Error(message.str());
+}
 
 template <class Value>
 [[noreturn]] inline void invalid_parameter(const std::string& name, const Value& value,

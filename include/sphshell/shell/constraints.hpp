@@ -8,9 +8,11 @@
 // prescribed part. Constraint directions are fixed in space.
 
 #include <sphshell/core/error.hpp>
+#include <sphshell/core/parallel.hpp>
 #include <sphshell/core/types.hpp>
 
 #include <memory>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -62,6 +64,13 @@ struct ParticleConstraint {
 
 class Constraints {
  public:
+  // A free rotation subspace whose drilling component (along the director) is
+  // this small in squared length has none to remove.
+  static constexpr double negligible_drilling_squared = 1e-24;
+  // A constraint direction whose part in the free subspace is this short
+  // (relative) is already fixed.
+  static constexpr double already_fixed_length = 1e-8;
+
   void fix_translation(int particle, const Vector3& direction) {
     restrict(entry(particle).free_translation, direction, "translation direction");
   }
@@ -77,6 +86,35 @@ class Constraints {
   const PrescribedMotion* own(std::unique_ptr<Motion> motion) {
     owned_.push_back(std::move(motion));
     return owned_.back().get();
+  }
+
+  // Imposes the conditions on velocities just updated without them: the
+  // translation is projected onto its free subspace plus the prescribed part,
+  // the angular velocity onto the free rotations normal to the director.
+  // The position update always spans time_step (also on the half-step
+  // start-up of the velocities), so the imposed velocity does too.
+  void impose(const StepTime& at, const std::vector<Vector3>& reference_position, double time_step,
+              const std::vector<Vector3>& director, std::vector<Vector3>& velocity,
+              std::vector<Vector3>& angular_velocity) const {
+    parallel::for_each(std::size_t{0}, particles_.size(), [&](std::size_t k) {
+      const int i = particles_[k];
+      const ParticleConstraint& constraint = entries_[k];
+      Vector3 prescribed = Vector3::Zero();
+      for (const PrescribedMotion* motion : constraint.motions)
+        prescribed += motion->velocity(i, reference_position[i], at.time, time_step);
+      if (!prescribed.allFinite())
+        fail_unstable(at, "prescribed motion of particle " + std::to_string(i) + " is not finite");
+      velocity[i] = constraint.free_translation * velocity[i] +
+                    (Matrix3::Identity() - constraint.free_translation) * prescribed;
+      // Project onto the free rotations and the plane normal to the director at
+      // once: projecting one after the other would let the drilling removal
+      // reintroduce a fixed component when the director is tilted.
+      Matrix3 free = constraint.free_rotation;
+      const Vector3 drilling = free * director[i];
+      if (drilling.squaredNorm() > negligible_drilling_squared)
+        free -= drilling * drilling.transpose() / drilling.squaredNorm();
+      angular_velocity[i] = free * angular_velocity[i];
+    });
   }
 
   bool empty() const { return particles_.empty(); }
@@ -98,7 +136,7 @@ class Constraints {
       invalid_parameter(name, direction.transpose(), "must be finite and non-zero");
     const Vector3 projected = free * direction.normalized();
     const double length = projected.norm();
-    if (length < 1e-8) return;  // (numerically) already fixed
+    if (length < already_fixed_length) return;
     const Vector3 c = projected / length;
     free -= c * c.transpose();
   }

@@ -1,15 +1,18 @@
 #pragma once
 // External loads on particles: pressure (uniform or p(X, t), follower or fixed
-// direction), point forces, and ready-made time functions.
+// direction), point forces and moments, gravity, and ready-made time functions.
 //
 // Each load is type-erased once (one virtual call per load per step); its loop
 // over particles calls the user's callable inline.
 
 #include <sphshell/core/error.hpp>
+#include <sphshell/core/parallel.hpp>
 #include <sphshell/core/types.hpp>
 
 #include <cmath>
+#include <cstddef>
 #include <memory>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -40,18 +43,25 @@ enum class PressureDirection {
 
 namespace detail {
 
+// What a load sees and where it adds: per particle the reference position and
+// normal, the current director, the reference area and the mass; it adds to
+// the external force (N) and the external moment (N·m, about the particle;
+// only its part normal to the director acts, the director has no drilling
+// rotation).
 // Sign convention: a positive pressure acts on the face the normal points out
 // of and pushes the shell against its normal, f = −p A n (for a spherical cap
 // with outward normals, positive pressure is inward). A is the reference area
-// of the particle. A point force applies its full value to every particle of
-// its set.
+// of the particle. A point force or moment applies its full value to every
+// particle of its set.
 struct LoadContext {
   double time;
   const std::vector<Vector3>& reference_position;
   const std::vector<Vector3>& reference_normal;
   const std::vector<Vector3>& director;
   const std::vector<double>& area;
+  const std::vector<double>& mass;
   std::vector<Vector3>& force;
+  std::vector<Vector3>& moment;
 };
 
 class Load {
@@ -96,5 +106,63 @@ class PointForceLoad final : public Load {
   TimeFunction time_function_;
 };
 
+template <class TimeFunction>
+class PointMomentLoad final : public Load {
+ public:
+  PointMomentLoad(std::vector<int> particles, Vector3 moment, TimeFunction time_function)
+      : particles_(std::move(particles)), moment_(moment), time_function_(std::move(time_function)) {}
+  void apply(LoadContext& c) const override {
+    const Vector3 m = time_function_(c.time) * moment_;
+    for (int i : particles_) c.moment[i] += m;
+  }
+
+ private:
+  std::vector<int> particles_;
+  Vector3 moment_;
+  TimeFunction time_function_;
+};
+
+// Body force of an acceleration field g (m/s²) on each particle's mass.
+template <class TimeFunction>
+class GravityLoad final : public Load {
+ public:
+  GravityLoad(std::vector<int> particles, Vector3 acceleration, TimeFunction time_function)
+      : particles_(std::move(particles)), acceleration_(acceleration), time_function_(std::move(time_function)) {}
+  void apply(LoadContext& c) const override {
+    const Vector3 g = time_function_(c.time) * acceleration_;
+    for (int i : particles_) c.force[i] += c.mass[i] * g;
+  }
+
+ private:
+  std::vector<int> particles_;
+  Vector3 acceleration_;
+  TimeFunction time_function_;
+};
+
 }  // namespace detail
+
+// The loads of a run: each applied in turn into zeroed force and moment
+// arrays; a load that produces a non-finite value stops the run.
+class ExternalLoads {
+ public:
+  void add(std::unique_ptr<detail::Load> load) { loads_.push_back(std::move(load)); }
+  bool empty() const { return loads_.empty(); }
+
+  void apply(const StepTime& at, detail::LoadContext& context) const {
+    parallel::for_each(std::size_t{0}, context.force.size(), [&](std::size_t i) noexcept {
+      context.force[i].setZero();
+      context.moment[i].setZero();
+    });
+    for (const auto& load : loads_) load->apply(context);
+    parallel::for_each(std::size_t{0}, context.force.size(), [&](std::size_t i) {
+      if (!context.force[i].allFinite() || !context.moment[i].allFinite())
+        detail::fail_unstable(at, "non-finite external load at particle " + std::to_string(i) +
+                                      " (a pressure, force or moment function returned NaN or infinity)");
+    });
+  }
+
+ private:
+  std::vector<std::unique_ptr<detail::Load>> loads_;
+};
+
 }  // namespace sphshell

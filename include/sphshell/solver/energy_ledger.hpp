@@ -1,0 +1,163 @@
+#pragma once
+// The energy ledger (docs/method.md, "Energy accounting"): the work of the
+// external loads and prescribed motions, the work removed by damping, the
+// kinetic energy, the internal work done on the material, and their balance,
+// checked while the run goes; and the progress line.
+//
+// Every sum over particles or points is formed in index order from terms a
+// parallel loop wrote to an array, so the books are identical for any thread
+// count.
+
+#include <sphshell/core/error.hpp>
+#include <sphshell/core/parallel.hpp>
+#include <sphshell/core/types.hpp>
+#include <sphshell/solver/options.hpp>
+#include <sphshell/solver/particles.hpp>
+#include <sphshell/stepper/stepper.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <iostream>
+#include <ostream>
+#include <sstream>
+#include <vector>
+
+namespace sphshell {
+
+struct EnergyReport {
+  double kinetic = 0.0;
+  double internal = 0.0;             // work done on the shell's material (elastic + dissipated)
+  double elastic = 0.0;              // recoverable part of internal
+  double plastic_dissipation = 0.0;  // internal − elastic
+  double external_work = 0.0;        // loads and prescribed motions
+  double damping_work = 0.0;         // removed by mass-proportional damping
+  double released_by_fracture = 0.0; // elastic energy held by integration points when they were removed (part of plastic_dissipation)
+  // kinetic + internal + damping − external, zero up to the time-discretization
+  // error. The leapfrog velocities live at half steps, so the internal energy
+  // enters at the half step too (the mean of its two neighbouring values).
+  double balance() const { return balance_; }
+
+  double balance_ = 0.0;
+};
+
+namespace solver {
+
+class EnergyLedger {
+ public:
+  // The balance is checked every check_interval steps (the elastic energy
+  // costs a pass over all states), from step first_checked_step on (the
+  // start-up half step and the first steps carry no balance yet).
+  static constexpr long check_interval = 16;
+  static constexpr long first_checked_step = 21;
+  // Below the energy of this strain throughout the shell the sums are
+  // round-off (e.g. before a travelling load arrives) and carry no balance.
+  static constexpr double round_off_strain_squared = 1e-20;
+
+  // volume: Σ d_i A_i of the shell; youngs_modulus sets the round-off scale.
+  EnergyLedger(const MonitoringOptions& monitoring, double youngs_modulus, double volume)
+      : monitoring_(monitoring), round_off_energy_(youngs_modulus * volume * round_off_strain_squared) {}
+
+  // v^{n−½} and ω^{n−½}, before the stepper updates them.
+  void remember_velocities(const ParticleState& state) {
+    old_velocity_ = state.velocity;
+    old_angular_velocity_ = state.angular_velocity;
+  }
+  // The velocities the unconstrained update produced, before the kinematic
+  // conditions: their difference is the reactions' impulse.
+  void remember_free_velocities(const ParticleState& state) { free_velocity_ = state.velocity; }
+
+  // Work over the step of each force, f · Δt · (v^{n−½} + v^{n+½})/2, with the
+  // reactions m (v − v_free)/Δt counted as external; damping work c m |v̄|²Δt;
+  // the kinetic energy at n+½.
+  void book_step(const stepper::StepContext& context, const ParticleState& state, const Inertia& inertia,
+                 const ParticleForces& forces) {
+    const double dt = context.velocity_step;
+    const double c = context.damping;
+    const std::size_t n = state.size();
+    external_term_.resize(n);
+    damping_term_.resize(n);
+    kinetic_term_.resize(n);
+    parallel::for_each(state.ranges.owned_begin, state.ranges.owned_end, [&](std::size_t i) noexcept {
+      const Vector3 average = 0.5 * (old_velocity_[i] + state.velocity[i]);
+      const Vector3 average_angular = 0.5 * (old_angular_velocity_[i] + state.angular_velocity[i]);
+      const Vector3 reaction = inertia.mass[i] * (state.velocity[i] - free_velocity_[i]) / dt;
+      external_term_[i] = dt * (forces.external[i] + reaction).dot(average) +
+                          dt * forces.external_moment[i].dot(average_angular);
+      damping_term_[i] = dt * c * inertia.mass[i] * average.squaredNorm() +
+                         dt * c * inertia.rotary_inertia[i] * average_angular.squaredNorm();
+      kinetic_term_[i] = 0.5 * inertia.mass[i] * state.velocity[i].squaredNorm() +
+                         0.5 * inertia.rotary_inertia[i] * state.angular_velocity[i].squaredNorm();
+    });
+    double external = 0.0, damping = 0.0, kinetic = 0.0;
+    for (std::size_t i = state.ranges.owned_begin; i < state.ranges.owned_end; ++i) {
+      external += external_term_[i];
+      damping += damping_term_[i];
+      kinetic += kinetic_term_[i];
+    }
+    external_work_ += external;
+    damping_work_ += damping;
+    kinetic_energy_ = kinetic;
+  }
+
+  // The internal work of one force evaluation, per point in index order.
+  void book_internal_work(const std::vector<double>& work_increments) {
+    previous_internal_energy_ = internal_energy_;
+    for (double work : work_increments) internal_energy_ += work;
+  }
+
+  // The books, with the elastic energy now held and the energy the fracture released.
+  EnergyReport report(double elastic, double released_by_fracture) const {
+    EnergyReport report;
+    report.kinetic = kinetic_energy_;
+    report.internal = internal_energy_;
+    report.elastic = elastic;
+    report.plastic_dissipation = internal_energy_ - elastic;
+    report.external_work = external_work_;
+    report.damping_work = damping_work_;
+    report.released_by_fracture = released_by_fracture;
+    report.balance_ = kinetic_energy_ + 0.5 * (previous_internal_energy_ + internal_energy_) + damping_work_ -
+                      external_work_;
+    return report;
+  }
+
+  // Whether step n is one whose balance is checked.
+  static bool is_check_step(long step) { return step % check_interval == 0; }
+
+  // Stops the run when |balance| exceeds the tolerance times the largest energy in play.
+  void check_balance(const StepTime& at, const EnergyReport& e) const {
+    const double scale = std::max({std::abs(e.external_work), e.kinetic, std::abs(e.internal)});
+    if (at.step >= first_checked_step && scale > round_off_energy_ &&
+        std::abs(e.balance()) > monitoring_.energy_tolerance * scale) {
+      std::ostringstream message;
+      message << "energy balance lost (kinetic " << e.kinetic << " J, internal " << e.internal
+              << " J, external work " << e.external_work << " J, balance " << e.balance()
+              << " J); reduce the time step or check the loads";
+      detail::fail_unstable(at, message.str());
+    }
+  }
+
+  // Whether step n writes a progress line.
+  bool is_progress_step(long step) const {
+    return monitoring_.progress_interval > 0 && step % monitoring_.progress_interval == 0;
+  }
+  void write_progress(const StepTime& at, const EnergyReport& e) const {
+    std::ostringstream line;
+    line.precision(4);
+    line << "step " << at.step << "  t = " << at.time << " s  kinetic " << e.kinetic << " J  internal "
+         << e.internal << " J  external " << e.external_work << " J  balance " << e.balance() << " J\n";
+    std::ostream& out = monitoring_.progress_stream ? *monitoring_.progress_stream : std::cout;
+    out << line.str() << std::flush;
+  }
+
+ private:
+  MonitoringOptions monitoring_;
+  double round_off_energy_;
+  double previous_internal_energy_ = 0.0, internal_energy_ = 0.0;
+  double external_work_ = 0.0, damping_work_ = 0.0, kinetic_energy_ = 0.0;
+  std::vector<Vector3> old_velocity_, old_angular_velocity_, free_velocity_;
+  std::vector<double> external_term_, damping_term_, kinetic_term_;
+};
+
+}  // namespace solver
+}  // namespace sphshell

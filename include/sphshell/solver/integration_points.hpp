@@ -1,0 +1,193 @@
+#pragma once
+// The integration points of the shell and what is fixed about them: the two
+// groups (stress points and particles), their shape functions and tangent
+// frames, integration weights, reference surface gradients and the slot
+// transpose (which shape-function slots refer to each particle). Built once in
+// the reference configuration (total Lagrangian); only a crack changes rows,
+// through rebuild_row.
+//
+// Points are numbered across both groups: the stress points first, then the
+// particle points, so per-point arrays elsewhere (section states, work) use one
+// index p = offset(group) + row.
+
+#include <sphshell/approx/approx.hpp>
+#include <sphshell/core/error.hpp>
+#include <sphshell/core/frame.hpp>
+#include <sphshell/core/types.hpp>
+#include <sphshell/shell/kinematics.hpp>
+#include <sphshell/shell/model.hpp>
+#include <sphshell/solver/options.hpp>
+
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace sphshell::solver {
+
+// The two kinds of integration point (docs/method.md, "Particles, stress
+// points and integral points").
+enum class PointGroup { stress_points, particles };
+inline constexpr std::array<PointGroup, 2> point_groups{PointGroup::stress_points, PointGroup::particles};
+inline constexpr std::size_t index_of(PointGroup group) { return group == PointGroup::stress_points ? 0 : 1; }
+inline const char* name_of(PointGroup group) {
+  return group == PointGroup::stress_points ? "stress point" : "particle";
+}
+
+template <class Approx>
+class IntegrationPoints {
+ public:
+  // Shape functions at the stress points and, when the particles integrate
+  // (a share or a shear weight > 0), at the particles.
+  IntegrationPoints(const ShellModel& model, const PhysicsOptions& physics,
+                    const ParticleIntegrationOptions& particle_integration, double shear_modulus) {
+    const double spacing = model.maximum_spacing();
+    smoothing_length_ = physics.support_radius_factor * spacing / Approx::kernel_type::support_radius_factor;
+    for (const Vector3& normal : model.stress_point_normal) frames_[0].push_back(tangent_frame(normal));
+    for (const Vector3& normal : model.particle_normal) frames_[1].push_back(tangent_frame(normal));
+    shape_[0] = Approx::build(model.particle_position, model.particle_area, model.stress_point_position,
+                              frames_[0], smoothing_length_);
+    const bool particles_integrate = particle_integration.particle_integration_share > 0.0 ||
+                                     particle_integration.particle_shear_weight > 0.0;
+    if (particles_integrate)
+      shape_[1] = Approx::build(model.particle_position, model.particle_area, model.particle_position,
+                                frames_[1], smoothing_length_);
+
+    // A row that fell back to the constant approximation has no gradient: the
+    // support is too small for the spacing.
+    for (PointGroup group : point_groups)
+      for (std::size_t row = 0; row < count(group); ++row)
+        if (shape(group).shepard[row])
+          detail::invalid_parameter("support_radius_factor", physics.support_radius_factor,
+                                    std::string("too few neighbours (fewer than 3) at ") + name_of(group) + " " +
+                                        std::to_string(row));
+    const std::size_t stress_points = model.stress_point_count();
+    const std::size_t particle_points = particles_integrate ? model.particle_count() : 0;
+    offset_ = {0, stress_points};
+    compute_weights(model, physics, particle_integration, shear_modulus, stress_points, particle_points);
+    reference_.resize(size());
+    for (PointGroup group : point_groups)
+      for (std::size_t row = 0; row < count(group); ++row)
+        reference_[point(group, row)] = gather(group, row, model.particle_position, model.particle_normal);
+    build_slot_transpose(model.particle_count());
+  }
+
+  // Points of a group, all points, and the global index of a group's row.
+  std::size_t count(PointGroup group) const { return shape(group).rows(); }
+  std::size_t size() const { return count(PointGroup::stress_points) + count(PointGroup::particles); }
+  std::size_t point(PointGroup group, std::size_t row) const { return offset_[index_of(group)] + row; }
+  PointGroup group_of(std::size_t p) const {
+    return p < offset_[1] ? PointGroup::stress_points : PointGroup::particles;
+  }
+  std::size_t row_of(std::size_t p) const { return p - offset_[index_of(group_of(p))]; }
+
+  const approx::ShapeFunctions& shape(PointGroup group) const { return shape_[index_of(group)]; }
+  const TangentFrame& frame(PointGroup group, std::size_t row) const { return frames_[index_of(group)][row]; }
+  // Reference positions of a group's evaluation points.
+  static const std::vector<Vector3>& positions(const ShellModel& model, PointGroup group) {
+    return group == PointGroup::stress_points ? model.stress_point_position : model.particle_position;
+  }
+  double smoothing_length() const { return smoothing_length_; }
+  double support_radius() const { return smoothing_length_ * Approx::kernel_type::support_radius_factor; }
+
+  // Weights: the area share for membrane and bending; area × κs G d (softened
+  // at particles) for transverse shear.
+  double membrane_bending_weight(std::size_t p) const { return membrane_bending_weight_[p]; }
+  double shear_weight(std::size_t p) const { return shear_weight_[p]; }
+  const shell::SurfaceGradients& reference(std::size_t p) const { return reference_[p]; }
+
+  // Interpolated a1, a2, n, n1, n2 of one row from particle positions x and directors d.
+  shell::SurfaceGradients gather(PointGroup group, std::size_t row, const std::vector<Vector3>& x,
+                                 const std::vector<Vector3>& d) const {
+    const approx::ShapeFunctions& sf = shape(group);
+    shell::SurfaceGradients g;
+    const std::size_t end = sf.row_begin[row] + sf.row_size[row];
+    for (std::size_t s = sf.row_begin[row]; s < end; ++s) {
+      const int j = sf.neighbour[s];
+      g.a1 += sf.dphi_d1[s] * x[j];
+      g.a2 += sf.dphi_d2[s] * x[j];
+      g.n += sf.phi[s] * d[j];
+      g.n1 += sf.dphi_d1[s] * d[j];
+      g.n2 += sf.dphi_d2[s] * d[j];
+    }
+    return g;
+  }
+
+  // Recomputes one row with a visibility predicate visible(row, particle)
+  // (after a crack), and its reference gradients. Throws Error when nothing
+  // stays visible.
+  template <class Visible>
+  void rebuild_row(const ShellModel& model, PointGroup group, std::size_t row, Visible&& visible) {
+    Approx::rebuild_row(shape_[index_of(group)], row, model.particle_position, model.particle_area,
+                        positions(model, group)[row], frame(group, row), smoothing_length_, visible);
+    reference_[point(group, row)] = gather(group, row, model.particle_position, model.particle_normal);
+  }
+
+  // Slots: every (row, neighbour) entry of both groups, numbered across them.
+  std::size_t slot_count() const { return shape_[0].neighbour.size() + shape_[1].neighbour.size(); }
+  std::size_t slot(PointGroup group, std::size_t s) const { return slot_offset_[index_of(group)] + s; }
+  // The slots referring to particle i: particle_slots()[k] for k in
+  // [particle_slot_begin()[i], particle_slot_begin()[i + 1]).
+  const std::vector<std::size_t>& particle_slot_begin() const { return particle_slot_begin_; }
+  const std::vector<std::size_t>& particle_slots() const { return particle_slots_; }
+
+  // Maps every particle to the shape-function slots that reference it, so the
+  // force gather is a deterministic per-particle sum (no atomics, identical
+  // results for any thread count). Rows keep their capacity when cracks shrink
+  // them, so the slot numbering stays; only the map is rebuilt.
+  void build_slot_transpose(std::size_t particle_count) {
+    slot_offset_ = {0, shape_[0].neighbour.size()};
+    std::vector<std::size_t> count_of(particle_count + 1, 0);
+    auto for_each_slot = [&](auto&& visit) {
+      for (PointGroup group : point_groups) {
+        const approx::ShapeFunctions& sf = shape(group);
+        for (std::size_t row = 0; row < count(group); ++row)
+          for (std::size_t s = sf.row_begin[row]; s < sf.row_begin[row] + sf.row_size[row]; ++s)
+            visit(sf.neighbour[s], slot(group, s));
+      }
+    };
+    for_each_slot([&](int particle, std::size_t) { ++count_of[particle + 1]; });
+    for (std::size_t i = 1; i < count_of.size(); ++i) count_of[i] += count_of[i - 1];
+    particle_slot_begin_ = count_of;
+    particle_slots_.resize(count_of.back());
+    for_each_slot([&](int particle, std::size_t s) { particle_slots_[count_of[particle]++] = s; });
+  }
+
+ private:
+  void compute_weights(const ShellModel& model, const PhysicsOptions& physics,
+                       const ParticleIntegrationOptions& particle_integration, double shear_modulus,
+                       std::size_t stress_points, std::size_t particle_points) {
+    const double share = particle_integration.particle_integration_share;
+    membrane_bending_weight_.resize(stress_points + particle_points);
+    shear_weight_.resize(stress_points + particle_points);
+    for (std::size_t p = 0; p < stress_points; ++p) {
+      const double d = model.stress_point_thickness(p);
+      membrane_bending_weight_[p] = (1.0 - share) * model.stress_point_area[p];
+      shear_weight_[p] = model.stress_point_area[p] * physics.shear_correction * shear_modulus * d;
+    }
+    // The particles' shear term is softened by d² / (d² + s Δ²) with the local
+    // spacing Δ = √A (docs/method.md, "Quadrature and the particle share").
+    for (std::size_t i = 0; i < particle_points; ++i) {
+      const double d = model.particle_thickness(i);
+      const double shear_stiffness = physics.shear_correction * shear_modulus * d;
+      const double local_spacing = std::sqrt(model.particle_area[i]);
+      const double softening =
+          d * d / (d * d + particle_integration.particle_shear_softening * local_spacing * local_spacing);
+      membrane_bending_weight_[stress_points + i] = share * model.particle_area[i];
+      shear_weight_[stress_points + i] =
+          particle_integration.particle_shear_weight * model.particle_area[i] * shear_stiffness * softening;
+    }
+  }
+
+  double smoothing_length_ = 0.0;
+  std::array<approx::ShapeFunctions, 2> shape_;
+  std::array<std::vector<TangentFrame>, 2> frames_;  // evaluation frames, kept for rebuilds
+  std::array<std::size_t, 2> offset_{};
+  std::array<std::size_t, 2> slot_offset_{};
+  std::vector<double> membrane_bending_weight_, shear_weight_;
+  std::vector<shell::SurfaceGradients> reference_;
+  std::vector<std::size_t> particle_slot_begin_, particle_slots_;
+};
+
+}  // namespace sphshell::solver

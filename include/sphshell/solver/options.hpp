@@ -1,0 +1,93 @@
+#pragma once
+// SolverOptions, grouped by concern. Each group is a plain struct that the
+// part it concerns receives on its own (the stepper the time options, the
+// ledger the monitoring options, …); SolverOptions derives from all of them, so
+// a user still writes `options.density = 2700.0` and `options.damping = …`.
+// Units are SI. The method behind each option is in docs/method.md.
+
+#include <iosfwd>
+#include <string>
+
+namespace sphshell {
+
+// The shell's physics and its discretization.
+struct PhysicsOptions {
+  double density = 7850.0;  // ρ, kg/m³
+  // Geometrically nonlinear (Green strain, paper §3.2) or linear (§3.1) analysis.
+  bool nonlinear = true;
+  // Support radius of the approximation in units of the particle spacing.
+  double support_radius_factor = 2.0;
+  // Rotary inertia ρ d³/12 A is multiplied by this (≥ 1), as explicit FE shell
+  // codes do to lift the shear–rotation frequency limit on thin shells.
+  double rotary_inertia_scale = 1.0;
+  double shear_correction = 5.0 / 6.0;  // κs of the elastic transverse shear
+};
+
+// Particle integration (docs/method.md, "Quadrature and the particle share"):
+// the share of the membrane and bending work carried by the particles (the
+// stress points carry the rest), in [0, 1); the particles' transverse-shear
+// weight (a fraction of their area) and the softening d² / (d² + s Δ²) of its
+// stiffness. Any share > 0 removes the stress points' spurious zero-energy
+// modes. Fracture runs whose crack path matters want a small share such as
+// 0.02: only stress points become crack points (see the method document and
+// the README's measurements).
+struct ParticleIntegrationOptions {
+  double particle_integration_share = 0.5;
+  double particle_shear_weight = 0.01;
+  double particle_shear_softening = 0.01;
+};
+
+// Time integration.
+struct TimeOptions {
+  // The time step is safety_factor × the stable bound (see stable_time_step()).
+  double safety_factor = 0.8;
+  // A user time step (s); 0 selects safety_factor × the bound. A step above the
+  // bound is refused.
+  double time_step = 0.0;
+  // Mass-proportional damping coefficient c (1/s): M a = f − c M v. For
+  // quasi-static solutions by dynamic relaxation; 0 for dynamics.
+  double damping = 0.0;
+};
+
+// What the run reports while it goes.
+struct MonitoringOptions {
+  // Write a progress line every this many steps (0: quiet) to progress_stream
+  // (nullptr: std::clog).
+  long progress_interval = 0;
+  std::ostream* progress_stream = nullptr;
+  // A run stops with an error when |energy balance| exceeds this fraction of
+  // the largest energy in play (after the first steps).
+  double energy_tolerance = 0.5;
+};
+
+// Files.
+struct OutputOptions {
+  // ParaView output: every output_interval seconds of simulated time, one .vtu
+  // of the particles and one of the stress points, gathered in particles.pvd and
+  // stress_points.pvd inside output_directory (created if missing). An empty
+  // directory writes nothing.
+  std::string output_directory;
+  double output_interval = 0.0;
+  // Probes (add_particle_probe, add_stress_point_probe) write a CSV row every
+  // probe_interval seconds (0: every step).
+  double probe_interval = 0.0;
+};
+
+struct SolverOptions : PhysicsOptions,
+                       ParticleIntegrationOptions,
+                       TimeOptions,
+                       MonitoringOptions,
+                       OutputOptions {
+  PhysicsOptions& physics() { return *this; }
+  const PhysicsOptions& physics() const { return *this; }
+  ParticleIntegrationOptions& particle_integration() { return *this; }
+  const ParticleIntegrationOptions& particle_integration() const { return *this; }
+  TimeOptions& time() { return *this; }
+  const TimeOptions& time() const { return *this; }
+  MonitoringOptions& monitoring() { return *this; }
+  const MonitoringOptions& monitoring() const { return *this; }
+  OutputOptions& output() { return *this; }
+  const OutputOptions& output() const { return *this; }
+};
+
+}  // namespace sphshell

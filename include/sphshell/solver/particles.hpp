@@ -1,0 +1,64 @@
+#pragma once
+// The particles' state, inertia and forces, each a plain structure of arrays
+// indexed by particle.
+//
+// Owned and ghost particles: a process integrates the particles it owns,
+// [0, owned_count), and only mirrors the ghosts, [owned_count, size()), whose
+// state another process sends it (a distributed run). In a single process
+// every particle is owned and the ghost range is empty.
+
+#include <sphshell/core/types.hpp>
+
+#include <cstddef>
+#include <vector>
+
+namespace sphshell::solver {
+
+// Index ranges of the owned and the ghost particles.
+struct ParticleRanges {
+  std::size_t owned_begin = 0, owned_end = 0;
+  std::size_t ghost_begin = 0, ghost_end = 0;
+  std::size_t owned_count() const { return owned_end - owned_begin; }
+  std::size_t ghost_count() const { return ghost_end - ghost_begin; }
+};
+
+// Kinematic state: mid-surface position x, unit director d, velocity v and
+// angular velocity ω (normal to d: the director has no drilling rotation).
+struct ParticleState {
+  std::vector<Vector3> position, director, velocity, angular_velocity;
+  ParticleRanges ranges;
+
+  // At rest in the reference configuration, every particle owned.
+  static ParticleState at_rest(const std::vector<Vector3>& reference_position,
+                               const std::vector<Vector3>& reference_normal) {
+    ParticleState state;
+    state.position = reference_position;
+    state.director = reference_normal;
+    state.velocity.assign(reference_position.size(), Vector3::Zero());
+    state.angular_velocity.assign(reference_position.size(), Vector3::Zero());
+    state.ranges = {0, reference_position.size(), reference_position.size(), reference_position.size()};
+    return state;
+  }
+  std::size_t size() const { return position.size(); }
+  std::size_t owned_count() const { return ranges.owned_count(); }
+};
+
+// Lumped translational mass m (kg) and rotary inertia I (kg·m²) per particle.
+struct Inertia {
+  std::vector<double> mass, rotary_inertia;
+};
+
+// Forces on the particles. The internal ones are ∂Π/∂x_j and ∂Π/∂d_j (the
+// generalized force on the director; its moment is −d × g). The external
+// ones are what the loads apply: a force and a moment about the particle.
+struct ParticleForces {
+  std::vector<Vector3> internal, internal_director, external, external_moment;
+
+  explicit ParticleForces(std::size_t particles = 0)
+      : internal(particles, Vector3::Zero()),
+        internal_director(particles, Vector3::Zero()),
+        external(particles, Vector3::Zero()),
+        external_moment(particles, Vector3::Zero()) {}
+};
+
+}  // namespace sphshell::solver

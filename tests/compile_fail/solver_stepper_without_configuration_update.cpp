@@ -1,0 +1,15 @@
+// Must not compile: a stepper without advance_configuration as the fifth parameter.
+#include <sphshell/sphshell.hpp>
+
+struct HalfAStepper {
+  double velocity_step(long, double time_step) const { return time_step; }
+  void advance_velocities(const sphshell::stepper::StepContext&, sphshell::solver::ParticleState&,
+                          const sphshell::solver::Inertia&, const sphshell::solver::ParticleForces&) {}
+};
+
+int main() {
+  using namespace sphshell;
+  Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<3>, material::Elastic, crack::None, HalfAStepper> solver(
+      ShellModel::rectangular_plate(0.1, 0.1, 5, 5, 0.01), {210e9, 0.3});
+  solver.step();
+}

@@ -1,0 +1,191 @@
+// The solver's seams: a user stepper as the fifth template parameter, the
+// load context's mass and moment channels (gravity, applied moments) against
+// closed forms, the parallel loop's deterministic error rule, and the grouped
+// options.
+#include <sphshell/sphshell.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+using namespace sphshell;
+
+namespace {
+
+// Counts its calls and otherwise steps exactly as the central difference.
+struct CountingStepper : stepper::CentralDifference {
+  long velocity_updates = 0;
+  long configuration_updates = 0;
+  void advance_velocities(const stepper::StepContext& context, solver::ParticleState& state,
+                          const solver::Inertia& inertia, const solver::ParticleForces& forces) {
+    ++velocity_updates;
+    CentralDifference::advance_velocities(context, state, inertia, forces);
+  }
+  void advance_configuration(const stepper::StepContext& context, solver::ParticleState& state) {
+    ++configuration_updates;
+    CentralDifference::advance_configuration(context, state);
+  }
+};
+
+// Never moves anything: a solver that uses it must stay in the reference configuration.
+struct FrozenStepper {
+  double velocity_step(long, double time_step) const { return time_step; }
+  void advance_velocities(const stepper::StepContext&, solver::ParticleState&, const solver::Inertia&,
+                          const solver::ParticleForces&) {}
+  void advance_configuration(const stepper::StepContext&, solver::ParticleState&) {}
+};
+
+struct NotAStepper {
+  void advance_velocities() {}
+};
+
+static_assert(stepper::is_stepper_v<stepper::CentralDifference>);
+static_assert(stepper::is_stepper_v<CountingStepper> && stepper::is_stepper_v<FrozenStepper>);
+static_assert(!stepper::is_stepper_v<NotAStepper> && !stepper::is_stepper_v<int>);
+
+template <class Stepper>
+using PlateSolver = Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<3>, material::Elastic, crack::None,
+                           Stepper>;
+
+template <class Stepper>
+PlateSolver<Stepper> loaded_plate() {
+  PlateSolver<Stepper> solver(ShellModel::rectangular_plate(0.2, 0.2, 9, 9, 0.01), {210e9, 0.3});
+  solver.clamp(solver.model().set("boundary"));
+  solver.add_uniform_pressure(solver.model().all_particles(), 1e6);
+  return solver;
+}
+
+}  // namespace
+
+TEST_CASE("A user stepper passed as the fifth parameter advances the solver", "[solver][stepper]") {
+  auto counted = loaded_plate<CountingStepper>();
+  auto reference = loaded_plate<stepper::CentralDifference>();
+  const long steps = 37;
+  for (long n = 0; n < steps; ++n) {
+    counted.step();
+    reference.step();
+  }
+  CHECK(counted.integrator().velocity_updates == steps);
+  CHECK(counted.integrator().configuration_updates == steps);
+  // The counting stepper steps as the default one: the same state, bit for bit.
+  const int centre = counted.model().nearest_particle(Vector3(0.1, 0.1, 0.0));
+  CHECK(counted.displacement(centre).z() != 0.0);
+  for (std::size_t i = 0; i < counted.particle_count(); ++i) {
+    CHECK(counted.positions()[i] == reference.positions()[i]);
+    CHECK(counted.directors()[i] == reference.directors()[i]);
+  }
+
+  auto frozen = loaded_plate<FrozenStepper>();
+  frozen.run_until(20 * frozen.time_step());
+  for (std::size_t i = 0; i < frozen.particle_count(); ++i)
+    CHECK(frozen.displacement(static_cast<int>(i)).norm() == 0.0);
+}
+
+TEST_CASE("Gravity acts on each particle's mass: a free plate falls as x = g t²/2", "[solver][loads]") {
+  Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<3>, material::Elastic> solver(
+      ShellModel::rectangular_plate(0.2, 0.1, 9, 5, 0.01), {210e9, 0.3});
+  const Vector3 g(0.0, 0.0, -9.81);
+  solver.add_gravity(solver.model().all_particles(), g);
+  solver.run_until(200 * solver.time_step());
+  const double t = solver.time();
+  // The central difference integrates a constant acceleration exactly, and a
+  // rigid translation strains nothing.
+  for (std::size_t i = 0; i < solver.particle_count(); ++i)
+    CHECK(solver.displacement(static_cast<int>(i)).z() == Approx(0.5 * g.z() * t * t).epsilon(1e-12));
+  const EnergyReport energy = solver.energy();
+  double mass = 0.0;
+  for (double m : solver.masses()) mass += m;
+  // The ledger books the work up to the half step where the leapfrog's
+  // velocities live: m |g|² (t − Δt/2)²/2, exactly for a constant force.
+  const double half_step_back = t - 0.5 * solver.time_step();
+  CHECK(energy.external_work == Approx(mass * 0.5 * g.squaredNorm() * half_step_back * half_step_back).epsilon(1e-9));
+  CHECK(energy.kinetic == Approx(energy.external_work).epsilon(1e-9));
+  CHECK(std::abs(energy.balance()) < 1e-9 * energy.external_work);
+}
+
+TEST_CASE("An end moment bends a cantilever strip uniformly: tip rotation ML/EI", "[solver][loads]") {
+  // Linear, ν = 0 (the strip bends like a beam), static by dynamic relaxation.
+  const double L = 0.5, width = 0.1, d = 0.02, E = 210e9, rho = 7850;
+  const double EI = E * width * d * d * d / 12.0;
+  const double omega = 3.516 * std::sqrt(EI / (rho * width * d)) / (L * L);
+  SolverOptions options;
+  options.nonlinear = false;
+  options.density = rho;
+  options.damping = 1.5 * omega;
+  options.rotary_inertia_scale = 4.0;
+  Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<3>, material::Elastic> solver(
+      ShellModel::rectangular_plate(L, width, 21, 5, d), {E, 0.0}, options);
+  const ShellModel& model = solver.model();
+  solver.clamp(model.set("x_min"));
+  const ParticleSet& tip = model.set("x_max");
+  // A moment about +y turns the x-directed strip's director from +z toward
+  // +x, so the tip deflects downward (−z), w = −ML²/(2EI).
+  const double M = 0.05 * EI / L;  // tip rotation 0.05 rad
+  solver.add_point_moment(tip, Vector3(0.0, M / tip.size(), 0.0));
+  solver.run_until(12 * 2 * M_PI / omega);
+  double rotation = 0.0, deflection = 0.0;
+  for (int i : tip) {
+    rotation += solver.rotation(i).y() / tip.size();
+    deflection += solver.displacement(i).z() / tip.size();
+  }
+  INFO("tip rotation " << rotation << " rad (ML/EI = " << M * L / EI << "), deflection " << deflection
+                       << " m (-ML^2/2EI = " << -M * L * L / (2 * EI) << ")");
+  CHECK(rotation == Approx(M * L / EI).epsilon(0.02));
+  CHECK(deflection == Approx(-M * L * L / (2.0 * EI)).epsilon(0.02));
+}
+
+TEST_CASE("parallel::for_each rethrows the lowest failing index's error for any thread count", "[core][parallel]") {
+  for (int threads : {1, 2, 4}) {
+#ifdef _OPENMP
+    omp_set_num_threads(threads);
+#endif
+    INFO(threads << " threads");
+    std::vector<int> visited(1000, 0);
+    std::string caught;
+    std::size_t failing = 0;
+    try {
+      parallel::for_each(
+          std::size_t{0}, visited.size(),
+          [&](std::size_t i) {
+            visited[i] = 1;
+            if (i % 97 == 13) throw std::runtime_error("index " + std::to_string(i));
+          },
+          [&](std::size_t i, const std::exception_ptr& error) {
+            failing = i;
+            caught = parallel::what(error);
+          });
+    } catch (const std::runtime_error& error) {
+      CHECK(std::string(error.what()) == "index 13");
+    }
+    CHECK(failing == 13);
+    CHECK(caught == "index 13");
+    // Every index still ran: a failure does not leave the region early.
+    int count = 0;
+    for (int v : visited) count += v;
+    CHECK(count == 1000);
+    // A noexcept body runs without the bookkeeping and visits every index once.
+    std::vector<double> squares(1000);
+    parallel::for_each(std::size_t{0}, squares.size(), [&](std::size_t i) noexcept { squares[i] = double(i) * i; });
+    CHECK(squares[999] == 998001.0);
+  }
+#ifdef _OPENMP
+  omp_set_num_threads(1);
+#endif
+}
+
+TEST_CASE("Options are grouped by concern and still read as flat fields", "[solver][options]") {
+  SolverOptions options;
+  options.density = 2700.0;
+  options.damping = 12.0;
+  options.output_directory = "frames";
+  CHECK(options.physics().density == 2700.0);
+  CHECK(options.time().damping == 12.0);
+  CHECK(options.output().output_directory == "frames");
+  options.particle_integration().particle_integration_share = 0.02;
+  CHECK(options.particle_integration_share == 0.02);
+  options.monitoring().progress_interval = 5;
+  CHECK(options.progress_interval == 5);
+}
