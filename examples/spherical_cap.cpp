@@ -1,6 +1,6 @@
 // The clamped spherical cap under an inward step pressure — the classic
 // nonlinear shell dynamics benchmark the paper checks its SPH shell against
-// (Fig. 6–7; design.md §4): R = 22.27 in = 0.5657 m, d = 0.41 in = 0.010414 m,
+// (Fig. 6–7): R = 22.27 in = 0.5657 m, d = 0.41 in = 0.010414 m,
 // half angle 26.67°, E = 72.4 GPa, ν = 0.3, ρ = 2618 kg/m³, p = 600 psi.
 //
 //   spherical_cap [--plastic] [--n 25] [--end-time 1e-3] [--output DIR]

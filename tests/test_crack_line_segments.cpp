@@ -163,7 +163,7 @@ TEST_CASE("diagonal neighbours link, points two spacings apart do not", "[crack]
   // whichever way the rounded coordinates put that point.
   CHECK_FALSE(visible_on_plate(crack, node(3, 4), node(4, 3)));
   // A diagonal segment runs through the grid node between its stress points;
-  // a particle on a crack's line is never cut off by it (design.md §2.6).
+  // a particle on a crack's line is never cut off by it (docs/method.md §6).
   CHECK(visible_on_plate(crack, node(3, 3), node(4, 2)));
   CHECK(visible_on_plate(crack, node(3, 3), node(2, 4)));
 

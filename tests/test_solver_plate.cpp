@@ -1,5 +1,5 @@
 // Square plates under uniform static pressure, solved by dynamic relaxation
-// (mass-proportional damping), against the Mindlin plate values of design.md §4.
+// (mass-proportional damping), against Mindlin plate values.
 #include <sphshell/approx/mls.hpp>
 #include <sphshell/kernel/cubic_spline.hpp>
 #include <sphshell/material/elastic.hpp>

@@ -59,7 +59,7 @@ TEST_CASE("Large deflection of a cantilever follows the elastica", "[solver][non
 
 TEST_CASE("Clamped spherical cap under step pressure: apex response of the classic benchmark",
           "[solver][shell][validation]") {
-  // Paper Fig. 7 (and design.md §4): the apex moves inward to u/d ≈ 0.15 in the
+  // Paper Fig. 7: the apex moves inward to u/d ≈ 0.15 in the
   // first swing (≈ 0.2 ms) and reaches u/d ≈ 0.2–0.25 within 1 ms.
   const double thickness = 0.010414;
   SolverOptions options;

@@ -220,7 +220,7 @@ TEST_CASE("thickness Global membrane plasticity equals the integral model", "[th
       const Resultants a = global.update(global_state, direction, StrainVoigt::Zero());
       const Resultants b = integral.update(integral_state, direction, StrainVoigt::Zero());
       // Loose enough for any converged return map, far below the 3× error of an
-      // inconsistently scaled flow (design §2.4).
+      // inconsistently scaled flow (docs/method.md §5).
       REQUIRE((a.membrane - b.membrane).norm() <= 1e-7 * b.membrane.norm());
     }
   }

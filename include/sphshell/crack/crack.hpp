@@ -2,7 +2,7 @@
 // The crack family. A crack policy states at compile time whether it is
 // enabled (`static constexpr bool enabled`) and gives a `name`; an enabled
 // policy also decides which particle pairs stay visible to each other and which
-// stress points are removed (design.md §2.6). The solver calls, of an enabled
+// stress points are removed (docs/method.md §6). The solver calls, of an enabled
 // policy (crack::LineSegments): initialize(positions, normals, spacing,
 // support_radius); add_precrack(polyline), returning the stress points it takes
 // over as crack points; add_damaged_stress_points(points), returning the new

@@ -1,6 +1,6 @@
 #pragma once
 // crack::LineSegments: cracks as multiple line segments between damaged stress
-// points (Ming, Zhang & Wang 2015, section 2.4 and Fig. 3; design.md §2.6).
+// points (Ming, Zhang & Wang 2015, section 2.4 and Fig. 3; docs/method.md §6).
 // Everything lives in the reference configuration (total Lagrangian): the
 // topology only grows, and visibility is judged on reference positions.
 //
@@ -261,7 +261,7 @@ class LineSegments {
     return created;
   }
 
-  // Visibility of neighbour b from evaluation point a (design.md §2.6 item 4),
+  // Visibility of neighbour b from evaluation point a (docs/method.md §6, item 4),
   // judged in the tangent plane of frame at a. Only crack segments within
   // reach = max(support_radius, |a − b|) of a (3-D point-to-segment distance)
   // are tested: a segment crossing the pair comes closer to a than b does, and

@@ -1,5 +1,5 @@
 #pragma once
-// Segment-crossing predicate of the visibility criterion (design.md §2.6 item 4):
+// Segment-crossing predicate of the visibility criterion (docs/method.md §6, item 4):
 // a particle pair (a, b) is cut by a crack segment (c1, c2) when
 //   s(a; c1,c2) · s(b; c1,c2) < 0   and   s(c1; a,b) · s(c2; a,b) <= 0,
 // with s(P; A,B) the signed side of P relative to the line AB. Only the signs

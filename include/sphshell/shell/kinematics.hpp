@@ -1,6 +1,6 @@
 #pragma once
 // Mindlin–Reissner shell kinematics at one integration point (stress point or
-// particle), total Lagrangian (design.md §2.2).
+// particle), total Lagrangian (docs/method.md §3; the paper's eq. 2.1–2.5).
 //
 // A fibre at height ζ along the director sits at x(ζ) = x_m + ζ n. With the
 // in-plane base vectors a_α = ∂x_m/∂X_α (X_α the reference tangent coordinates

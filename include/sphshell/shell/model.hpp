@@ -1,6 +1,6 @@
 #pragma once
 // The shell's geometry in the reference configuration: particles on the
-// mid-surface and the stress points staggered between them (design.md §2.1),
+// mid-surface and the stress points staggered between them (docs/method.md §1),
 // in structure-of-arrays storage, with builders for the usual shapes.
 
 #include <sphshell/core/error.hpp>
