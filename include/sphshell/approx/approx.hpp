@@ -69,13 +69,13 @@ struct is_approximation : std::bool_constant<is_approximation_v<A>> {};
 template <class A>
 constexpr bool check_approximation() {
   static_assert(detail::has_kernel_type<A>::value,
-                "sphshell approximation: missing 'using kernel_type = <a kernel>' (see kernel/kernel.hpp)");
+                "sphshell approximation: missing its kernel; add `using kernel_type = <a kernel>` (see kernel/kernel.hpp)");
   static_assert(detail::has_build<A>::value,
-                "sphshell approximation: missing 'static ShapeFunctions build(particles, particle_volumes, "
-                "eval_positions, eval_frames, h, visible)'");
+                "sphshell approximation: missing the build; add `static ShapeFunctions build(particles, "
+                "particle_volumes, eval_positions, eval_frames, h, visible)`");
   static_assert(detail::has_rebuild_row<A>::value,
-                "sphshell approximation: missing 'static void rebuild_row(ShapeFunctions&, row, particles, "
-                "particle_volumes, eval_position, eval_frame, h, visible)'");
+                "sphshell approximation: missing the row rebuild; add `static void rebuild_row(ShapeFunctions&, "
+                "row, particles, particle_volumes, eval_position, eval_frame, h, visible)`");
   return true;
 }
 

@@ -38,6 +38,8 @@ struct has_name<Policy, std::void_t<decltype(Policy::name)>> : std::true_type {}
 template <class Policy>
 struct is_crack_policy
     : std::bool_constant<has_enabled_flag<Policy>::value && has_name<Policy>::value> {};
+template <class Policy>
+inline constexpr bool is_crack_policy_v = is_crack_policy<Policy>::value;
 
 template <class Policy, class = void>
 struct is_enabled : std::false_type {};
@@ -127,30 +129,35 @@ struct has_precrack_distance<
 template <class Policy>
 constexpr bool check_crack_policy() {
   static_assert(has_enabled_flag<Policy>::value,
-                "a crack policy needs `static constexpr bool enabled`");
-  static_assert(has_name<Policy>::value, "a crack policy needs `static constexpr const char* name`");
+                "crack policy: missing its flag; add `static constexpr bool enabled`");
+  static_assert(has_name<Policy>::value, "crack policy: missing its name; add `static constexpr const char* name`");
   if constexpr (is_enabled<Policy>::value) {
     static_assert(std::is_default_constructible_v<Policy>,
-                  "an enabled crack policy must be default-constructible (the solver holds one and initializes it)");
+                  "an enabled crack policy must be default-constructible (the solver holds one and initializes "
+                  "it); add a default constructor");
     static_assert(detail::has_initialize<Policy>::value,
-                  "an enabled crack policy needs initialize(positions, normals, spacing, support_radius)");
+                  "an enabled crack policy needs its set-up; add `void initialize(positions, normals, spacing, "
+                  "support_radius)`");
     static_assert(detail::has_add_precrack<Policy>::value,
-                  "an enabled crack policy needs add_precrack(polyline) returning the absorbed stress points "
-                  "(std::vector<int>)");
+                  "an enabled crack policy needs pre-cracks; add `std::vector<int> add_precrack(polyline)` "
+                  "returning the absorbed stress points");
     static_assert(detail::has_add_damaged_stress_points<Policy>::value,
-                  "an enabled crack policy needs add_damaged_stress_points(stress_points) returning the new segments");
+                  "an enabled crack policy needs crack growth; add `add_damaged_stress_points(stress_points)` "
+                  "returning the new segments");
     static_assert(detail::has_visible<Policy>::value,
-                  "an enabled crack policy needs `bool visible(a, b, frame) const`");
+                  "an enabled crack policy needs `bool visible(a, b, frame) const`; add it (a, b positions, frame at a)");
     static_assert(detail::has_affected_points<Policy>::value,
-                  "an enabled crack policy needs `affected_points(positions, segments) const` taking the "
-                  "segments add_damaged_stress_points returns and segments() holds, returning std::vector<std::size_t>");
-    static_assert(detail::has_spacing<Policy>::value, "an enabled crack policy needs `double spacing() const`");
+                  "an enabled crack policy needs the rows a crack touches; add `std::vector<std::size_t> "
+                  "affected_points(positions, segments) const` taking the segments add_damaged_stress_points "
+                  "returns and segments() holds");
+    static_assert(detail::has_spacing<Policy>::value, "an enabled crack policy needs its spacing; add `double spacing() const`");
     static_assert(detail::has_output_members<Policy>::value,
-                  "an enabled crack policy needs `const std::vector<Vector3>& points() const`, segments() with int "
-                  "start_point, end_point and crack_id, and `int crack_point_of_stress_point(p) const` for output");
+                  "an enabled crack policy needs output members; add `const std::vector<Vector3>& points() const`, "
+                  "segments() with int start_point, end_point and crack_id, and `int "
+                  "crack_point_of_stress_point(p) const`");
     static_assert(detail::has_precrack_distance<Policy>::value,
-                  "an enabled crack policy needs `static constexpr double on_precrack_in_spacings` and "
-                  "`static double distance_to_precrack_piece(point, start, end)`");
+                  "an enabled crack policy needs the pre-crack distance; add `static constexpr double "
+                  "on_precrack_in_spacings` and `static double distance_to_precrack_piece(point, start, end)`");
   }
   return is_crack_policy<Policy>::value;
 }

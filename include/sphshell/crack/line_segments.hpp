@@ -69,6 +69,9 @@ class LineSegments {
   static constexpr double linking_distance_in_spacings = 1.5;
   // Pre-crack pieces shorter than this fraction of the spacing count as zero-length.
   static constexpr double zero_length_in_spacings = 1e-9;
+  // Cell lists are built this much wider than the radius they serve, so the
+  // exact distance test after the cell search decides at the boundary.
+  static constexpr double cell_margin = 1.01;
   // A point closer than this fraction of the spacing to a pre-crack lies on it.
   static constexpr double on_precrack_in_spacings = 1e-6;
   static double distance_to_precrack_piece(const Vector3& point, const Vector3& start, const Vector3& end) {
@@ -304,7 +307,7 @@ class LineSegments {
     std::vector<std::size_t> affected;
     if (new_segments.empty() || eval_positions.empty()) return affected;
     // Slightly wider than needed: the exact distance test below decides.
-    const approx::CellList eval_index(eval_positions, 1.01 * (support_radius_ + max_half_length));
+    const approx::CellList eval_index(eval_positions, cell_margin * (support_radius_ + max_half_length));
     std::vector<char> is_affected(eval_positions.size(), 0);
     for (const Segment& segment : new_segments) {
       const Vector3& start = points_[static_cast<std::size_t>(segment.start_point)];
@@ -431,7 +434,7 @@ class LineSegments {
       }
       // A little wider than the linking distance: the cell list excludes its
       // boundary, the linking test includes it.
-      indexed_points_.emplace(owner_.points_, 1.01 * owner_.linking_distance_);
+      indexed_points_.emplace(owner_.points_, cell_margin * owner_.linking_distance_);
     }
 
     const LineSegments& owner_;
@@ -496,7 +499,7 @@ class LineSegments {
     for (const Segment& segment : segments_)
       midpoints.push_back(0.5 * (points_[static_cast<std::size_t>(segment.start_point)] +
                                  points_[static_cast<std::size_t>(segment.end_point)]));
-    segment_index_.emplace(midpoints, 1.01 * (support_radius_ + 0.5 * max_segment_length_));
+    segment_index_.emplace(midpoints, cell_margin * (support_radius_ + 0.5 * max_segment_length_));
   }
 
   bool initialized_ = false;

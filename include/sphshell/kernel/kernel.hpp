@@ -50,11 +50,11 @@ struct is_kernel : std::bool_constant<is_kernel_v<K>> {};
 template <class K>
 constexpr bool check_kernel() {
   static_assert(detail::has_support_radius_factor<K>::value,
-                "sphshell kernel: missing 'static constexpr double support_radius_factor'");
+                "sphshell kernel: missing its support; add `static constexpr double support_radius_factor` (W = 0 for r >= factor * h)");
   static_assert(detail::has_value<K>::value,
-                "sphshell kernel: missing 'static double value(double r, double h)'");
+                "sphshell kernel: missing its value; add `static double value(double r, double h)` (normalized in 2-D)");
   static_assert(detail::has_derivative<K>::value,
-                "sphshell kernel: missing 'static double derivative(double r, double h)'");
+                "sphshell kernel: missing its derivative; add `static double derivative(double r, double h)` (dW/dr)");
   return true;
 }
 

@@ -93,7 +93,8 @@ struct GaussLegendreTable<7> {
 template <int N>
 struct Gauss : detail::ScaledPoints<Gauss<N>> {
   static_assert(N >= 1 && N <= 7,
-                "sphshell::thickness::Gauss<N> is tabulated for N = 1..7 points only");
+                "sphshell::thickness::Gauss<N> is tabulated for N = 1..7 points only; use N <= 7, or Simpson<N> for "
+                "more points");
   static constexpr int num_points = N;
   static constexpr std::array<double, std::size_t(N)> reference_points =
       detail::GaussLegendreTable<N>::points;

@@ -21,7 +21,7 @@ class Section {
   static_assert(check_thickness_rule<Rule>());
   static_assert(Rule::num_points >= 1,
                 "sphshell::thickness::Section: a rule with num_points = 0 needs its own "
-                "Section specialization (as Global has)");
+                "Section; add `template <class Law> class Section<YourRule, Law>` as global.hpp does");
 
  public:
   static constexpr int num_points = Rule::num_points;

@@ -35,7 +35,7 @@ constexpr std::array<double, std::size_t(N)> simpson_weights() {
 template <int N>
 struct Simpson : detail::ScaledPoints<Simpson<N>> {
   static_assert(N >= 3 && N % 2 == 1,
-                "sphshell::thickness::Simpson<N> needs an odd number of points N >= 3");
+                "sphshell::thickness::Simpson<N> needs an odd number of points N >= 3; use N = 3, 5, 7, ...");
   static constexpr int num_points = N;
   static constexpr std::array<double, std::size_t(N)> reference_points =
       detail::simpson_points<N>();

@@ -67,24 +67,28 @@ struct has_name<Rule, std::void_t<decltype(static_cast<const char*>(Rule::name))
 }  // namespace traits
 
 template <class Rule>
-inline constexpr bool is_thickness_rule =
+inline constexpr bool is_thickness_rule_v =
     traits::has_num_points<Rule>::value && traits::has_reference_points<Rule>::value &&
     traits::has_reference_weights<Rule>::value && traits::has_name<Rule>::value;
+// The earlier spelling of is_thickness_rule_v.
+template <class Rule>
+inline constexpr bool is_thickness_rule = is_thickness_rule_v<Rule>;
 
 // Call inside a template that takes a rule: each missing member gets its own message.
 template <class Rule>
 constexpr bool check_thickness_rule() {
   static_assert(traits::has_num_points<Rule>::value,
-                "sphshell::thickness rule is missing `static constexpr int num_points`");
+                "sphshell::thickness rule is missing its point count; add `static constexpr int num_points` (0 for a "
+                "resultant model with its own Section)");
   static_assert(traits::has_reference_points<Rule>::value,
-                "sphshell::thickness rule is missing `static constexpr std::array<double, "
-                "num_points> reference_points` (points on [-1, 1])");
+                "sphshell::thickness rule is missing its points; add `static constexpr std::array<double, "
+                "num_points> reference_points` (on [-1, 1])");
   static_assert(traits::has_reference_weights<Rule>::value,
-                "sphshell::thickness rule is missing `static constexpr std::array<double, "
-                "num_points> reference_weights` (weights summing to 2)");
+                "sphshell::thickness rule is missing its weights; add `static constexpr std::array<double, "
+                "num_points> reference_weights` (summing to 2)");
   static_assert(traits::has_name<Rule>::value,
-                "sphshell::thickness rule is missing `static constexpr const char* name`");
-  return is_thickness_rule<Rule>;
+                "sphshell::thickness rule is missing its name; add `static constexpr const char* name`");
+  return is_thickness_rule_v<Rule>;
 }
 
 namespace detail {
