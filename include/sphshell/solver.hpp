@@ -86,14 +86,14 @@ class Solver {
   Solver(ShellModel model, const MaterialParameters& parameters, SolverOptions options = {})
       : model_(std::move(model)),
         law_(parameters),
-        options_(validated(std::move(options))),
+        options_((validate(options), std::move(options))),
         particles_(solver::ParticleState::at_rest(model_.particle_position, model_.particle_normal)),
-        inertia_(inertia_of(model_, options_)),
+        inertia_(solver::Inertia::lumped(model_, options_.density, options_.rotary_inertia_scale)),
         forces_(model_.particle_count()),
         points_(model_, options_.physics(), options_.particle_integration(), law_.shear_modulus()),
         states_(model_, law_, points_.count(solver::PointGroup::particles)),
         assembler_(options_.nonlinear, points_),
-        ledger_(options_.monitoring(), law_.youngs_modulus(), volume_of(model_)),
+        ledger_(options_.monitoring(), law_.youngs_modulus(), solver::shell_volume(model_)),
         output_(options_.output()) {
     fracture_.initialize(model_, points_);
     stable_time_step_ = solver::stable_time_step(model_, law_, options_.physics(), points_, states_);
@@ -107,39 +107,24 @@ class Solver {
     }
   }
 
-  // Boundary conditions on particle sets.
-  void clamp(const ParticleSet& set) {
-    for (int i : checked(set)) {
-      constraints_.fix_all_translations(i);
-      constraints_.fix_all_rotations(i);
-    }
-  }
+  // Boundary conditions on particle sets (shell/constraints.hpp).
+  void clamp(const ParticleSet& set) { constraints_.clamp(checked(set)); }
   // Translations fixed, rotations free ("soft" simple support).
-  void simply_support(const ParticleSet& set) {
-    for (int i : checked(set)) constraints_.fix_all_translations(i);
-  }
+  void simply_support(const ParticleSet& set) { constraints_.simply_support(checked(set)); }
   // Translations fixed and the director kept from tilting along the edge
   // ("hard" simple support of Mindlin plates): fixes rotation about n × t.
   void simply_support_hard(const ParticleSet& set, const Vector3& edge_tangent) {
-    for (int i : checked(set)) {
-      constraints_.fix_all_translations(i);
-      constraints_.fix_rotation(i, model_.particle_normal[i].cross(edge_tangent));
-    }
+    constraints_.simply_support_hard(checked(set), model_.particle_normal, edge_tangent);
   }
   // Mirror symmetry about a plane (given by its normal) through the particles:
   // no translation across the plane and no rotation tilting the director out of it.
   void symmetry_plane(const ParticleSet& set, const Vector3& plane_normal) {
-    for (int i : checked(set)) {
-      constraints_.fix_translation(i, plane_normal);
-      constraints_.fix_rotation(i, model_.particle_normal[i].cross(plane_normal));
-    }
+    constraints_.symmetry_plane(checked(set), model_.particle_normal, plane_normal);
   }
   void fix_translation(const ParticleSet& set, const Vector3& direction) {
-    for (int i : checked(set)) constraints_.fix_translation(i, direction);
+    constraints_.fix_translation(checked(set), direction);
   }
-  void fix_rotation(const ParticleSet& set, const Vector3& axis) {
-    for (int i : checked(set)) constraints_.fix_rotation(i, axis);
-  }
+  void fix_rotation(const ParticleSet& set, const Vector3& axis) { constraints_.fix_rotation(checked(set), axis); }
   // Prescribed displacement u(X, t) (a Vector3 from the reference position and
   // time) imposed on all three translations of the set.
   template <class DisplacementFunction>
@@ -389,46 +374,6 @@ class Solver {
   // Below this the reference and current directors are parallel (no rotation).
   static constexpr double negligible_rotation_sine = 1e-300;
 
-  static SolverOptions validated(SolverOptions options) {
-    detail::require_positive("density", options.density);
-    detail::require_half_open_interval("safety_factor", options.safety_factor, 0.0, 1.0);
-    detail::require_nonnegative("time_step", options.time_step);
-    detail::require_nonnegative("damping", options.damping);
-    detail::require_positive("support_radius_factor", options.support_radius_factor);
-    if (!(options.rotary_inertia_scale >= 1.0) || !std::isfinite(options.rotary_inertia_scale))
-      detail::invalid_parameter("rotary_inertia_scale", options.rotary_inertia_scale, "must be finite and >= 1");
-    detail::require_half_open_interval("shear_correction", options.shear_correction, 0.0, 1.0);
-    if (!(options.particle_integration_share >= 0.0 && options.particle_integration_share < 1.0))
-      detail::invalid_parameter("particle_integration_share", options.particle_integration_share,
-                                "must lie in [0, 1)");
-    detail::require_nonnegative("particle_shear_weight", options.particle_shear_weight);
-    detail::require_nonnegative("particle_shear_softening", options.particle_shear_softening);
-    detail::require_positive("energy_tolerance", options.energy_tolerance);
-    detail::require_nonnegative("output_interval", options.output_interval);
-    detail::require_nonnegative("probe_interval", options.probe_interval);
-    return options;
-  }
-
-  // Lumped mass ρ d A and rotary inertia s_I ρ d³/12 A of each particle.
-  static solver::Inertia inertia_of(const ShellModel& model, const SolverOptions& options) {
-    solver::Inertia inertia;
-    const std::size_t n = model.particle_count();
-    inertia.mass.resize(n);
-    inertia.rotary_inertia.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const double d = model.particle_thickness(i);
-      inertia.mass[i] = options.density * d * model.particle_area[i];
-      inertia.rotary_inertia[i] =
-          options.rotary_inertia_scale * options.density * d * d * d / 12.0 * model.particle_area[i];
-    }
-    return inertia;
-  }
-  static double volume_of(const ShellModel& model) {
-    double volume = 0.0;
-    for (std::size_t i = 0; i < model.particle_count(); ++i) volume += model.particle_thickness(i) * model.particle_area[i];
-    return volume;
-  }
-
   StepTime now() const { return {steps_, time_}; }
   Parts fracture_parts() { return Parts{model_, particles_, points_, states_, assembler_, forces_}; }
 
@@ -451,17 +396,7 @@ class Solver {
 
   template <class Motion>
   void add_motion(const ParticleSet& set, std::unique_ptr<Motion> motion) {
-    const ParticleSet particles = checked(set);
-    for (int i : particles) {
-      const Vector3 v = motion->velocity(i, model_.particle_position[i], time_, time_step_);
-      if (!v.allFinite())
-        detail::invalid_parameter("prescribed motion at particle " + std::to_string(i), v.transpose(), "must be finite");
-    }
-    const detail::PrescribedMotion* owned = constraints_.own(std::move(motion));
-    for (int i : particles) {
-      constraints_.fix_all_translations(i);
-      constraints_.add_motion(i, owned);
-    }
+    constraints_.add_motion(checked(set), std::move(motion), model_.particle_position, time_, time_step_);
   }
 
   static std::string to_string(double value) {

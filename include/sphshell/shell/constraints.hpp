@@ -71,6 +71,54 @@ class Constraints {
   // (relative) is already fixed.
   static constexpr double already_fixed_length = 1e-8;
 
+  // On every particle of a set (indices already checked).
+  void clamp(const std::vector<int>& set) {
+    for (int i : set) {
+      fix_all_translations(i);
+      fix_all_rotations(i);
+    }
+  }
+  void simply_support(const std::vector<int>& set) {
+    for (int i : set) fix_all_translations(i);
+  }
+  // Translations fixed and no rotation about n × t (the director does not tilt along the edge).
+  void simply_support_hard(const std::vector<int>& set, const std::vector<Vector3>& normal,
+                           const Vector3& edge_tangent) {
+    for (int i : set) {
+      fix_all_translations(i);
+      fix_rotation(i, normal[i].cross(edge_tangent));
+    }
+  }
+  // No translation across the plane and no rotation tilting the director out of it.
+  void symmetry_plane(const std::vector<int>& set, const std::vector<Vector3>& normal, const Vector3& plane_normal) {
+    for (int i : set) {
+      fix_translation(i, plane_normal);
+      fix_rotation(i, normal[i].cross(plane_normal));
+    }
+  }
+  void fix_translation(const std::vector<int>& set, const Vector3& direction) {
+    for (int i : set) fix_translation(i, direction);
+  }
+  void fix_rotation(const std::vector<int>& set, const Vector3& axis) {
+    for (int i : set) fix_rotation(i, axis);
+  }
+  // A prescribed motion on all three translations of a set; its velocity
+  // over the coming step must be finite at every particle.
+  template <class Motion>
+  void add_motion(const std::vector<int>& set, std::unique_ptr<Motion> motion,
+                  const std::vector<Vector3>& reference_position, double time, double time_step) {
+    for (int i : set) {
+      const Vector3 v = motion->velocity(i, reference_position[i], time, time_step);
+      if (!v.allFinite())
+        invalid_parameter("prescribed motion at particle " + std::to_string(i), v.transpose(), "must be finite");
+    }
+    const PrescribedMotion* owned = own(std::move(motion));
+    for (int i : set) {
+      fix_all_translations(i);
+      add_motion(i, owned);
+    }
+  }
+
   void fix_translation(int particle, const Vector3& direction) {
     restrict(entry(particle).free_translation, direction, "translation direction");
   }

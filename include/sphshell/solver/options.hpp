@@ -5,6 +5,9 @@
 // a user still writes `options.density = 2700.0` and `options.damping = …`.
 // Units are SI. The method behind each option is in docs/method.md.
 
+#include <sphshell/core/error.hpp>
+
+#include <cmath>
 #include <iosfwd>
 #include <string>
 
@@ -89,5 +92,24 @@ struct SolverOptions : PhysicsOptions,
   OutputOptions& output() { return *this; }
   const OutputOptions& output() const { return *this; }
 };
+
+// Every option in its allowed range, or an Error naming it.
+inline void validate(const SolverOptions& options) {
+  detail::require_positive("density", options.density);
+  detail::require_half_open_interval("safety_factor", options.safety_factor, 0.0, 1.0);
+  detail::require_nonnegative("time_step", options.time_step);
+  detail::require_nonnegative("damping", options.damping);
+  detail::require_positive("support_radius_factor", options.support_radius_factor);
+  if (!(options.rotary_inertia_scale >= 1.0) || !std::isfinite(options.rotary_inertia_scale))
+    detail::invalid_parameter("rotary_inertia_scale", options.rotary_inertia_scale, "must be finite and >= 1");
+  detail::require_half_open_interval("shear_correction", options.shear_correction, 0.0, 1.0);
+  if (!(options.particle_integration_share >= 0.0 && options.particle_integration_share < 1.0))
+    detail::invalid_parameter("particle_integration_share", options.particle_integration_share, "must lie in [0, 1)");
+  detail::require_nonnegative("particle_shear_weight", options.particle_shear_weight);
+  detail::require_nonnegative("particle_shear_softening", options.particle_shear_softening);
+  detail::require_positive("energy_tolerance", options.energy_tolerance);
+  detail::require_nonnegative("output_interval", options.output_interval);
+  detail::require_nonnegative("probe_interval", options.probe_interval);
+}
 
 }  // namespace sphshell

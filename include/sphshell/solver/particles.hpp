@@ -8,6 +8,7 @@
 // every particle is owned and the ghost range is empty.
 
 #include <sphshell/core/types.hpp>
+#include <sphshell/shell/model.hpp>
 
 #include <cstddef>
 #include <vector>
@@ -46,7 +47,29 @@ struct ParticleState {
 // Lumped translational mass m (kg) and rotary inertia I (kg·m²) per particle.
 struct Inertia {
   std::vector<double> mass, rotary_inertia;
+
+  // m = ρ d A and I = s_I ρ d³/12 A with each particle's own thickness d and
+  // the rotary-inertia scale s_I (docs/method.md §1, §7).
+  static Inertia lumped(const ShellModel& model, double density, double rotary_inertia_scale) {
+    Inertia inertia;
+    const std::size_t n = model.particle_count();
+    inertia.mass.resize(n);
+    inertia.rotary_inertia.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const double d = model.particle_thickness(i);
+      inertia.mass[i] = density * d * model.particle_area[i];
+      inertia.rotary_inertia[i] = rotary_inertia_scale * density * d * d * d / 12.0 * model.particle_area[i];
+    }
+    return inertia;
+  }
 };
+
+// Σ d_i A_i over the particles: the shell's volume.
+inline double shell_volume(const ShellModel& model) {
+  double volume = 0.0;
+  for (std::size_t i = 0; i < model.particle_count(); ++i) volume += model.particle_thickness(i) * model.particle_area[i];
+  return volume;
+}
 
 // Forces on the particles. The internal ones are ∂Π/∂x_j and ∂Π/∂d_j (the
 // generalized force on the director; its moment is −d × g). The external
