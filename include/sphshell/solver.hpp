@@ -240,8 +240,8 @@ class Solver {
                         particles_.angular_velocity);
     ledger_.book_step(context, particles_, inertia_, forces_);
     stepper_.advance_configuration(context, particles_);
-    time_ += time_step_;
     ++steps_;
+    time_ = start_time_ + static_cast<double>(steps_) * time_step_;  // t = t0 + n Δt, never summed
     forces_current_ = false;
     check_configuration();
     compute_internal_forces();
@@ -446,6 +446,7 @@ class Solver {
   ExternalLoads loads_;
   double stable_time_step_ = 0.0;
   double time_step_ = 0.0;
+  double start_time_ = 0.0;  // t0
   double time_ = 0.0;
   long steps_ = 0;
   bool forces_current_ = false;
