@@ -7,6 +7,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -188,4 +189,39 @@ TEST_CASE("Options are grouped by concern and still read as flat fields", "[solv
   CHECK(options.particle_integration_share == 0.02);
   options.monitoring().progress_interval = 5;
   CHECK(options.progress_interval == 5);
+}
+
+TEST_CASE("The progress line goes to the stream the user chose, with the end time, share done and ETA",
+          "[solver][monitoring]") {
+  std::ostringstream progress;
+  SolverOptions options;
+  options.progress_interval = 10;
+  options.progress_stream = &progress;
+  Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<3>, material::Elastic> solver(
+      ShellModel::rectangular_plate(0.2, 0.2, 9, 9, 0.01), {210e9, 0.3}, options);
+  solver.clamp(solver.model().set("boundary"));
+  solver.add_uniform_pressure(solver.model().all_particles(), 1e6);
+  const double end = 40.25 * solver.time_step();
+  solver.run_until(end);
+  const std::string text = progress.str();
+  INFO(text);
+  // Steps 10, 20, 30 and 40: the run stops at 40 Δt, within half a step of its end.
+  std::size_t lines = 0;
+  for (char c : text) lines += c == '\n';
+  CHECK(lines == 4);
+  std::ostringstream end_text;
+  end_text.precision(4);
+  end_text << " of " << end << " s (";
+  CHECK(text.find(end_text.str()) != std::string::npos);
+  CHECK(text.find("step 20  t = ") != std::string::npos);
+  // Step 20 of a run to 40.25 Δt: t = 20 Δt is 49.7 % of the way.
+  CHECK(text.find("(49.7 %)") != std::string::npos);
+  CHECK(text.find("steps/s") != std::string::npos);
+  CHECK(text.find("ETA ") != std::string::npos);
+  CHECK(text.find("balance") != std::string::npos);
+  // A step outside run_until has no end time to report.
+  std::ostringstream().swap(progress);
+  for (int n = 0; n < 10; ++n) solver.step();
+  CHECK(progress.str().find("step 50  t = ") == 0);
+  CHECK(progress.str().find(" of ") == std::string::npos);
 }

@@ -34,6 +34,7 @@
 #include <sphshell/solver/options.hpp>
 #include <sphshell/solver/output.hpp>
 #include <sphshell/solver/particles.hpp>
+#include <sphshell/solver/progress.hpp>
 #include <sphshell/solver/section_states.hpp>
 #include <sphshell/solver/stable_time_step.hpp>
 #include <sphshell/stepper/central_difference.hpp>
@@ -94,6 +95,7 @@ class Solver {
         states_(model_, law_, points_.count(solver::PointGroup::particles)),
         assembler_(options_.nonlinear, points_),
         ledger_(options_.monitoring(), law_.youngs_modulus(), solver::shell_volume(model_)),
+        progress_(options_.monitoring()),
         output_(options_.output()) {
     fracture_.initialize(model_, points_);
     stable_time_step_ = solver::stable_time_step(model_, law_, options_.physics(), points_, states_);
@@ -247,18 +249,21 @@ class Solver {
     compute_internal_forces();
     if constexpr (Crack::enabled) fracture_.update(fracture_parts());
     if (solver::EnergyLedger::is_check_step(steps_)) ledger_.check_balance(now(), energy());
-    if (ledger_.is_progress_step(steps_)) ledger_.write_progress(now(), energy());
+    if (progress_.is_due(steps_)) progress_.write(now(), energy());
     output_.write_scheduled(*this);
   }
 
   // Steps until time t_end, calling observer(*this) after every step.
+  // The progress line (MonitoringOptions) then reports the share done and the time left.
   template <class Observer>
   void run_until(double t_end, Observer&& observer) {
     detail::require_finite("t_end", t_end);
+    progress_.start_run(now(), t_end);
     while (time_ < t_end - 0.5 * time_step_) {
       step();
       observer(*this);
     }
+    progress_.end_run();
   }
   void run_until(double t_end) {
     run_until(t_end, [](const Solver&) {});
@@ -440,6 +445,7 @@ class Solver {
   solver::InternalForceAssembler assembler_;
   solver::FractureManager<Crack> fracture_;
   solver::EnergyLedger ledger_;
+  solver::ProgressReporter progress_;
   Output output_;
   Stepper stepper_;
   detail::Constraints constraints_;

@@ -2,7 +2,7 @@
 // The energy ledger (docs/method.md, "Energy accounting"): the work of the
 // external loads and prescribed motions, the work removed by damping, the
 // kinetic energy, the internal work done on the material, and their balance,
-// checked while the run goes; and the progress line.
+// checked while the run goes.
 //
 // Every sum over particles or points is formed in index order from terms a
 // parallel loop wrote to an array, so the books are identical for any thread
@@ -18,7 +18,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
-#include <iostream>
 #include <ostream>
 #include <sstream>
 #include <vector>
@@ -135,19 +134,6 @@ class EnergyLedger {
               << " J); reduce the time step or check the loads";
       detail::fail_unstable(at, message.str());
     }
-  }
-
-  // Whether step n writes a progress line.
-  bool is_progress_step(long step) const {
-    return monitoring_.progress_interval > 0 && step % monitoring_.progress_interval == 0;
-  }
-  void write_progress(const StepTime& at, const EnergyReport& e) const {
-    std::ostringstream line;
-    line.precision(4);
-    line << "step " << at.step << "  t = " << at.time << " s  kinetic " << e.kinetic << " J  internal "
-         << e.internal << " J  external " << e.external_work << " J  balance " << e.balance() << " J\n";
-    std::ostream& out = monitoring_.progress_stream ? *monitoring_.progress_stream : std::cout;
-    out << line.str() << std::flush;
   }
 
  private:
