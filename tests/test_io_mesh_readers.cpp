@@ -66,9 +66,9 @@ test_support::AbaqusMesh abaqus_plate(const ShellModel& plate) {
   return mesh;
 }
 
-fs::path write_gmsh(const std::string& directory, const std::string& name, const test_support::GmshMesh& mesh,
-                    bool binary) {
-  const fs::path path = test_support::scratch_directory(directory) / name;
+fs::path write_gmsh(const test_support::ScratchDirectory& directory, const std::string& name,
+                    const test_support::GmshMesh& mesh, bool binary) {
+  const fs::path path = directory / name;
   test_support::write_text(path, test_support::gmsh_text(mesh, binary));
   return path;
 }
@@ -173,19 +173,21 @@ TEST_CASE("The paper plate read from Gmsh ASCII, Gmsh binary and Abaqus files is
   const std::vector<Vector3> reference = short_run(plate);
 
   SECTION("Gmsh 4.1 ASCII") {
-    const fs::path path = write_gmsh("plate_ascii", "plate.msh", gmsh_plate(plate), false);
+    const test_support::ScratchDirectory directory("plate_ascii");
+    const fs::path path = write_gmsh(directory, "plate.msh", gmsh_plate(plate), false);
     const ShellModel read = io::read_gmsh(path.string(), kThickness);
     check_same_as_builder(read, plate);
     check_same_run(short_run(read), reference);
   }
   SECTION("Gmsh 4.1 binary") {
-    const fs::path path = write_gmsh("plate_binary", "plate.msh", gmsh_plate(plate), true);
+    const test_support::ScratchDirectory directory("plate_binary");
+    const fs::path path = write_gmsh(directory, "plate.msh", gmsh_plate(plate), true);
     const ShellModel read = io::read_gmsh(path.string(), kThickness);
     check_same_as_builder(read, plate);
     check_same_run(short_run(read), reference);
   }
   SECTION("Abaqus, nodes in an included file in a subfolder") {
-    const fs::path directory = test_support::scratch_directory("plate_inp");
+    const test_support::ScratchDirectory directory("plate_inp");
     fs::create_directories(directory / "mesh");
     const test_support::AbaqusFiles files = test_support::abaqus_text(abaqus_plate(plate), "mesh/nodes.inp");
     test_support::write_text(directory / "plate.inp", files.deck);
@@ -214,7 +216,7 @@ TEST_CASE("A mixed mesh of quads and triangles keeps its cells and leaves quads(
     }
   mesh.sections.push_back({"ALL_QUADS", 0.004});
   mesh.sections.push_back({"ALL_TRIANGLES", 0.004});
-  const fs::path directory = test_support::scratch_directory("mixed");
+  const test_support::ScratchDirectory directory("mixed");
   test_support::write_text(directory / "mixed.inp", test_support::abaqus_text(mesh).deck);
   const ShellModel model = io::read_abaqus((directory / "mixed.inp").string());
   REQUIRE(model.stress_point_count() == 4 + 8);
@@ -253,7 +255,8 @@ TEST_CASE("Particle normals are the area-weighted mean of their elements' normal
   mesh.nodes = {Vector3(-1, 0, 0), Vector3(0, 0, 1), Vector3(0, 1, 1), Vector3(2, 0, 0)};
   mesh.cells = {Cell(0, 1, 2), Cell(1, 3, 2)};
   mesh.entities.push_back({2, {}, {0, 1}, {}});
-  const fs::path path = write_gmsh("roof", "roof.msh", mesh, false);
+  const test_support::ScratchDirectory directory("roof");
+  const fs::path path = write_gmsh(directory, "roof.msh", mesh, false);
   const ShellModel model = io::read_gmsh(path.string(), 0.01);
   // Independent: each triangle's area and unit normal by hand.
   const Vector3 left_normal = Vector3(-1, 0, 1).normalized(), right_normal = Vector3(1, 0, 2).normalized();
@@ -267,7 +270,7 @@ TEST_CASE("Particle normals are the area-weighted mean of their elements' normal
 }
 
 TEST_CASE("Abaqus sets, generated sets, includes, sections and continuation lines", "[io][mesh]") {
-  const fs::path directory = test_support::scratch_directory("inp_features");
+  const test_support::ScratchDirectory directory("inp_features");
   fs::create_directories(directory / "parts");
   // 3 × 1 quads; a second section makes the right quad thicker.
   test_support::write_text(directory / "parts" / "nodes.inp",
@@ -350,7 +353,7 @@ TEST_CASE("Gmsh physical groups of points, curves and surfaces become node sets"
       "2 1 3 1\n1 1 2 5 4\n"
       "2 2 3 1\n2 2 3 6 5\n"
       "$EndElements\n";
-  const fs::path directory = test_support::scratch_directory("gmsh_groups");
+  const test_support::ScratchDirectory directory("gmsh_groups");
   test_support::write_text(directory / "groups.msh", text);
   const ShellModel model = io::read_gmsh((directory / "groups.msh").string(), 0.001);
   CHECK(model.set("corner") == ParticleSet{0});
@@ -361,7 +364,7 @@ TEST_CASE("Gmsh physical groups of points, curves and surfaces become node sets"
 }
 
 TEST_CASE("Elements whose orientations flip are an Error naming both", "[io][mesh][errors]") {
-  const fs::path directory = test_support::scratch_directory("flip");
+  const test_support::ScratchDirectory directory("flip");
   test_support::write_text(directory / "flip.msh",
                            gmsh_strip("$Elements\n1 2 1 2\n2 1 3 2\n1 1 2 5 4\n2 2 5 6 3\n$EndElements\n"));
   check_message(error_of([&] { io::read_gmsh((directory / "flip.msh").string(), 0.01); }),
@@ -379,7 +382,7 @@ TEST_CASE("Elements whose orientations flip are an Error naming both", "[io][mes
 }
 
 TEST_CASE("Malformed Gmsh files are Errors naming the file, the place and the problem", "[io][mesh][errors]") {
-  const fs::path directory = test_support::scratch_directory("gmsh_errors");
+  const test_support::ScratchDirectory directory("gmsh_errors");
   auto read = [&](const std::string& name, const std::string& text) {
     test_support::write_text(directory / name, text);
     return error_of([&] { io::read_gmsh((directory / name).string(), 0.01); });
@@ -424,6 +427,21 @@ TEST_CASE("Malformed Gmsh files are Errors naming the file, the place and the pr
     big[marker] = 0, big[marker + 3] = 1;
     check_message(read("big_endian.msh", big), {"big_endian.msh", "big-endian"});
   }
+  SECTION("every truncation of a valid file is an Error, never a crash or a wrong mesh") {
+    for (const bool binary : {false, true}) {
+      test_support::GmshMesh strip{{Vector3(0, 0, 0), Vector3(1, 0, 0), Vector3(1, 1, 0), Vector3(0, 1, 0)},
+                                   {Cell(0, 1, 2), Cell(0, 2, 3)},
+                                   {{1, {{0, 1}}, {}, {"edge"}}, {2, {}, {0, 1}, {"square"}}}};
+      const std::string good = test_support::gmsh_text(strip, binary);
+      const std::size_t complete = good.rfind("$EndElements") + std::string("$EndElements").size();
+      int errors = 0;
+      for (std::size_t length = 0; length < complete; ++length) {
+        INFO((binary ? "binary" : "ASCII") << " file cut after " << length << " of " << good.size() << " bytes");
+        errors += !read("cut.msh", good.substr(0, length)).empty();
+      }
+      CHECK(errors == static_cast<int>(complete));
+    }
+  }
   SECTION("physical groups") {
     const std::string names = gmsh_header + "$PhysicalNames\n1\n2 5 \"ghost\"\n$EndPhysicalNames\n";
     check_message(read("names_only.msh", names + strip_nodes + strip_elements),
@@ -438,7 +456,7 @@ TEST_CASE("Malformed Gmsh files are Errors naming the file, the place and the pr
 }
 
 TEST_CASE("Malformed Abaqus files are Errors naming the file, the line and the problem", "[io][mesh][errors]") {
-  const fs::path directory = test_support::scratch_directory("inp_errors");
+  const test_support::ScratchDirectory directory("inp_errors");
   auto read = [&](const std::string& name, const std::string& text) {
     test_support::write_text(directory / name, text);
     return error_of([&] { io::read_abaqus((directory / name).string()); });

@@ -13,19 +13,39 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <stdexcept>
+#include <system_error>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include <unistd.h>
+
 namespace sphshell::test_support {
 
-// A fresh directory under the system's temporary directory (never the source tree).
-inline std::filesystem::path scratch_directory(const std::string& name) {
-  const std::filesystem::path directory = std::filesystem::temp_directory_path() / ("sphshell_mesh_tests_" + name);
-  std::filesystem::remove_all(directory);
-  std::filesystem::create_directories(directory);
-  return directory;
-}
+// A fresh directory under the system's temporary directory (never the source
+// tree), named after the test and the process (ctest runs test cases in
+// parallel processes), removed when it goes out of scope.
+class ScratchDirectory {
+ public:
+  explicit ScratchDirectory(const std::string& name)
+      : path_(std::filesystem::temp_directory_path() /
+              ("sphshell_mesh_tests_" + name + "_" + std::to_string(::getpid()))) {
+    std::filesystem::remove_all(path_);
+    std::filesystem::create_directories(path_);
+  }
+  ScratchDirectory(const ScratchDirectory&) = delete;
+  ScratchDirectory& operator=(const ScratchDirectory&) = delete;
+  ~ScratchDirectory() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  const std::filesystem::path& path() const { return path_; }
+  std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+
+ private:
+  std::filesystem::path path_;
+};
 
 inline void write_text(const std::filesystem::path& path, const std::string& text) {
   std::ofstream stream(path, std::ios::binary);
