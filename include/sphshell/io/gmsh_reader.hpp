@@ -122,10 +122,11 @@ class GmshParser {
   [[noreturn]] void fail(const std::string& problem) const { fail_at(token_start_, problem); }
 
   // --- low-level reading ----------------------------------------------------
+  static bool is_space(char character) {
+    return character == ' ' || character == '\t' || character == '\r' || character == '\n';
+  }
   void skip_space() {
-    while (position_ < data_.size() && std::strchr(" \t\r\n", data_[position_]) != nullptr &&
-           data_[position_] != '\0')
-      ++position_;
+    while (position_ < data_.size() && is_space(data_[position_])) ++position_;
   }
   std::string rest_of_line() {
     const std::size_t end = std::min(data_.find('\n', position_), data_.size());
@@ -136,7 +137,7 @@ class GmshParser {
   std::string token(const std::string& what) {
     skip_space();
     token_start_ = position_;
-    while (position_ < data_.size() && std::strchr(" \t\r\n", data_[position_]) == nullptr) ++position_;
+    while (position_ < data_.size() && !is_space(data_[position_])) ++position_;
     if (position_ == token_start_)
       fail("the file ends inside $" + current_ + " where " + what + " should follow (truncated?)");
     return data_.substr(token_start_, position_ - token_start_);

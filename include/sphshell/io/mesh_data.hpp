@@ -13,6 +13,7 @@
 //   write) are kept once when they hold the same particles, else an Error.
 // - A particle shared by elements of different thickness takes their
 //   area-weighted mean (its mass then equals the shares of its elements').
+//   The model's thickness() is that of the element with the lowest label.
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/types.hpp>
@@ -205,7 +206,7 @@ inline ShellModel build_shell_model(MeshData& mesh, const std::string& file, dou
     if (d != model.thickness()) model.set_particle_thickness(i, d);
   }
 
-  std::map<std::string, std::pair<ParticleSet, std::string>> added;  // name: members, where defined
+  std::map<std::string, std::pair<ParticleSet, MeshOrigin>> added;  // name: members, where defined
   for (const MeshSet& set : mesh.sets) {
     ParticleSet members;
     for (const auto& [node, origin] : set.nodes) {
@@ -227,12 +228,13 @@ inline ShellModel build_shell_model(MeshData& mesh, const std::string& file, dou
     const auto previous = added.find(set.name);
     if (previous != added.end()) {
       if (previous->second.first == members) continue;
-      mesh_error(mesh.describe(set.origin), "set name " + set.name + " is also used at " + previous->second.second +
+      mesh_error(mesh.describe(set.origin), "set name " + set.name + " is also used at " +
+                                                mesh.describe(previous->second.second) +
                                                 " for different nodes; both would become the particle set " +
                                                 set.name);
     }
     model.add_set(set.name, members);
-    added.emplace(set.name, std::make_pair(std::move(members), mesh.describe(set.origin)));
+    added.emplace(set.name, std::make_pair(std::move(members), set.origin));
   }
   return model;
 }
