@@ -11,7 +11,9 @@
 #include <sphshell/material/all.hpp>
 #include <sphshell/thickness/all.hpp>
 
+#include <sphshell/io/abaqus_reader.hpp>
 #include <sphshell/io/csv_probe.hpp>
+#include <sphshell/io/gmsh_reader.hpp>
 #include <sphshell/io/pvd_collection.hpp>
 #include <sphshell/io/svg_plot.hpp>
 #include <sphshell/io/vtu_writer.hpp>

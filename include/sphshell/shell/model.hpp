@@ -10,9 +10,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -23,6 +26,37 @@ using ParticleSet = std::vector<int>;
 // Four particle indices of a quadrilateral cell, counter-clockwise seen from the
 // side the normals point to; a stress point sits at each cell's centre.
 using Quad = std::array<int, 4>;
+
+// Corner particle indices of a triangular (3) or quadrilateral (4) cell, in
+// counter-clockwise order seen from the side the normals point to; the cell's
+// stress point sits at its centre.
+class Cell {
+ public:
+  Cell(int a, int b, int c) : corners_{a, b, c, -1}, size_(3) {}
+  Cell(int a, int b, int c, int d) : corners_{a, b, c, d}, size_(4) {}
+  explicit Cell(const Quad& quad) : corners_(quad), size_(4) {}
+  std::size_t size() const { return size_; }
+  bool is_triangle() const { return size_ == 3; }
+  int operator[](std::size_t k) const { return corners_[k]; }
+  const int* begin() const { return corners_.data(); }
+  const int* end() const { return corners_.data() + size_; }
+
+ private:
+  std::array<int, 4> corners_;
+  std::size_t size_;
+};
+
+// Two cells that share an edge and run along it in the same direction (their
+// normals flip across it), or a third cell on an edge (a junction, which one
+// director per particle cannot represent).
+struct CellEdgeProblem {
+  enum class Kind { flipped, junction };
+  Kind kind;
+  int first_cell;
+  int second_cell;
+  int edge_start;  // particle indices of the shared edge
+  int edge_end;
+};
 
 class ShellModel {
  public:
@@ -102,7 +136,106 @@ class ShellModel {
                      std::move(stress_positions), std::move(stress_normals),
                      std::move(stress_areas), thickness);
     model.quads_ = quads;
+    for (const Quad& quad : quads) model.cells_.emplace_back(quad);
     return model;
+  }
+
+  // Particles at the nodes of a triangle, quadrilateral or mixed mesh, one
+  // stress point per cell at its centre (the mean of its corners). A triangle's
+  // area goes to its stress point and a third of it to each corner particle; a
+  // quad's area (from its diagonals) and a quarter of it to each corner, as in
+  // from_quads. A stress point's normal is its cell's (the cross product of a
+  // triangle's edges, of a quad's diagonals); a particle's normal is the
+  // area-weighted mean of the normals of the cells around it. Cells that share
+  // an edge must run along it in opposite directions (consistent orientation);
+  // a flip, an edge of three or more cells, a degenerate cell or a particle of
+  // no cell is an Error. quads() is filled only when every cell is a quad.
+  static ShellModel from_cells(std::vector<Vector3> positions, const std::vector<Cell>& cells,
+                               double thickness) {
+    if (cells.empty()) detail::invalid_parameter("cell count", 0, "a shell needs cells");
+    for (std::size_t c = 0; c < cells.size(); ++c) check_cell(cells[c], c, positions.size());
+    if (const std::optional<CellEdgeProblem> problem = find_cell_edge_problem(cells))
+      detail::invalid_parameter(
+          "cells", std::to_string(problem->first_cell) + " and " + std::to_string(problem->second_cell),
+          describe_edge_problem(*problem, "particles"));
+    std::vector<Vector3> normals(positions.size(), Vector3::Zero());
+    std::vector<double> areas(positions.size(), 0.0);
+    std::vector<Vector3> centres, cell_normals;
+    std::vector<double> cell_areas;
+    centres.reserve(cells.size());
+    cell_normals.reserve(cells.size());
+    cell_areas.reserve(cells.size());
+    for (std::size_t c = 0; c < cells.size(); ++c) {
+      const Cell& cell = cells[c];
+      const double corners = static_cast<double>(cell.size());
+      // Twice the area times the unit normal, for a planar cell exactly.
+      const Vector3 doubled_area =
+          cell.is_triangle() ? Vector3((positions[cell[1]] - positions[cell[0]])
+                                           .cross(positions[cell[2]] - positions[cell[0]]))
+                             : Vector3((positions[cell[2]] - positions[cell[0]])
+                                           .cross(positions[cell[3]] - positions[cell[1]]));
+      const double area = 0.5 * doubled_area.norm();
+      if (!(area > 0.0))
+        detail::invalid_parameter("cell " + std::to_string(c) + " area", area, "must be > 0 (degenerate cell)");
+      Vector3 centre = Vector3::Zero();
+      for (int corner : cell) {
+        centre += positions[corner] / corners;
+        areas[corner] += area / corners;
+        normals[corner] += doubled_area;
+      }
+      centres.push_back(centre);
+      cell_normals.push_back(doubled_area);
+      cell_areas.push_back(area);
+    }
+    for (std::size_t i = 0; i < positions.size(); ++i)
+      if (!(areas[i] > 0.0))
+        detail::invalid_parameter("particle " + std::to_string(i), positions[i].transpose(), "belongs to no cell");
+    ShellModel model(std::move(positions), std::move(normals), std::move(areas), std::move(centres),
+                     std::move(cell_normals), std::move(cell_areas), thickness);
+    model.cells_ = cells;
+    if (std::none_of(cells.begin(), cells.end(), [](const Cell& cell) { return cell.is_triangle(); }))
+      for (const Cell& cell : cells) model.quads_.push_back({cell[0], cell[1], cell[2], cell[3]});
+    return model;
+  }
+
+  // The first orientation flip or junction among cells in the order given, or
+  // none. Cells' corners must be valid and distinct (from_cells checks them).
+  static std::optional<CellEdgeProblem> find_cell_edge_problem(const std::vector<Cell>& cells) {
+    struct EdgeUse {
+      int cell;
+      bool ascending;  // the first cell runs from the lower to the higher index
+      int count;
+    };
+    std::unordered_map<std::uint64_t, EdgeUse> uses;
+    for (std::size_t c = 0; c < cells.size(); ++c) {
+      const Cell& cell = cells[c];
+      for (std::size_t k = 0; k < cell.size(); ++k) {
+        const int from = cell[k], to = cell[(k + 1) % cell.size()];
+        const int low = std::min(from, to), high = std::max(from, to);
+        const std::uint64_t key = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(low)) << 32) |
+                                  static_cast<std::uint32_t>(high);
+        const EdgeUse use{static_cast<int>(c), from < to, 1};
+        auto [found, inserted] = uses.try_emplace(key, use);
+        if (inserted) continue;
+        if (found->second.count >= 2)
+          return CellEdgeProblem{CellEdgeProblem::Kind::junction, found->second.cell, use.cell, from, to};
+        if (found->second.ascending == use.ascending)
+          return CellEdgeProblem{CellEdgeProblem::Kind::flipped, found->second.cell, use.cell, from, to};
+        ++found->second.count;
+      }
+    }
+    return std::nullopt;
+  }
+
+  // What went wrong, for a message; `corner_names` says what the edge's ends are
+  // ("particles", "nodes").
+  static std::string describe_edge_problem(const CellEdgeProblem& problem, const std::string& corner_names) {
+    const std::string edge = "the edge between " + corner_names + " " + std::to_string(problem.edge_start) +
+                             " and " + std::to_string(problem.edge_end);
+    if (problem.kind == CellEdgeProblem::Kind::flipped)
+      return "they run along " + edge +
+             " in the same direction, so their normals flip there; reverse the corner order of one side";
+    return "a third cell meets at " + edge + "; a junction of three or more cells is not supported";
   }
 
   // Flat rectangular plate in the xy-plane, corner at the origin, normals +z:
@@ -226,19 +359,40 @@ class ShellModel {
       detail::invalid_parameter("set_thickness region", d, "holds no particle and no stress point");
     return count;
   }
+  // The wall thickness of one particle or one stress point (m), e.g. from a
+  // mesh file's shell sections; the mid-surface stays where it is.
+  void set_particle_thickness(std::size_t i, double d) {
+    check_index("particle", i, particle_count());
+    detail::require_positive("particle " + std::to_string(i) + " thickness", d);
+    particle_thickness_[i] = d;
+  }
+  void set_stress_point_thickness(std::size_t p, double d) {
+    check_index("stress point", p, stress_point_count());
+    detail::require_positive("stress point " + std::to_string(p) + " thickness", d);
+    stress_point_thickness_[p] = d;
+  }
   std::size_t particle_count() const { return particle_position.size(); }
   std::size_t stress_point_count() const { return stress_point_position.size(); }
+  // The corners of stress point q's quad, for models built from quads only
+  // (empty for a model with triangles or without cells).
   const std::vector<Quad>& quads() const { return quads_; }
+  // The corners of stress point q's cell, for models built from cells or quads
+  // (empty for the general constructor).
+  const std::vector<Cell>& cells() const { return cells_; }
 
   // Characteristic particle spacing: the smallest distance between a stress
   // point's neighbouring particles is not known without a search, so use the
-  // square root of the smallest stress-point area (the cell size of a sheet).
+  // square root of the smallest area per particle around a stress point (the
+  // cell size of a sheet): a quad's area, twice a triangle's (a triangulation
+  // has about two triangles per node, a quad mesh one quad).
   double minimum_spacing() const {
-    double smallest = *std::min_element(stress_point_area.begin(), stress_point_area.end());
+    double smallest = area_per_particle(0);
+    for (std::size_t p = 1; p < stress_point_count(); ++p) smallest = std::min(smallest, area_per_particle(p));
     return std::sqrt(smallest);
   }
   double maximum_spacing() const {
-    double largest = *std::max_element(stress_point_area.begin(), stress_point_area.end());
+    double largest = area_per_particle(0);
+    for (std::size_t p = 1; p < stress_point_count(); ++p) largest = std::max(largest, area_per_particle(p));
     return std::sqrt(largest);
   }
 
@@ -256,6 +410,22 @@ class ShellModel {
     auto found = sets_.find(name);
     if (found == sets_.end()) detail::invalid_parameter("particle set name", name, "no such set");
     return found->second;
+  }
+  // A named set from particle indices (e.g. a mesh file's node set). A name in
+  // use, an empty set, an index out of range or one listed twice is an Error
+  // naming it.
+  const ParticleSet& add_set(const std::string& name, ParticleSet members) {
+    if (has_set(name)) detail::invalid_parameter("particle set name", name, "a set of that name exists");
+    if (members.empty()) detail::invalid_parameter("particle set " + name, "(empty)", "a set needs members");
+    std::vector<char> listed(particle_count(), 0);
+    for (int member : members) {
+      if (member < 0 || static_cast<std::size_t>(member) >= particle_count())
+        detail::invalid_parameter("particle set " + name + " member", member,
+                                  "must lie in [0, " + std::to_string(particle_count()) + ")");
+      if (listed[member]) detail::invalid_parameter("particle set " + name + " member", member, "listed twice");
+      listed[member] = 1;
+    }
+    return sets_[name] = std::move(members);
   }
   bool has_set(const std::string& name) const { return sets_.count(name) != 0; }
   std::vector<std::string> set_names() const {
@@ -317,6 +487,24 @@ class ShellModel {
       detail::invalid_parameter("normal count", normals.size(),
                                 "must equal the particle count (" + std::to_string(positions.size()) + ")");
   }
+  static void check_cell(const Cell& cell, std::size_t index, std::size_t particle_count) {
+    const std::string name = "cell " + std::to_string(index) + " corner index";
+    for (std::size_t k = 0; k < cell.size(); ++k) {
+      if (cell[k] < 0 || static_cast<std::size_t>(cell[k]) >= particle_count)
+        detail::invalid_parameter(name, cell[k], "must lie in [0, " + std::to_string(particle_count) + ")");
+      for (std::size_t l = 0; l < k; ++l)
+        if (cell[l] == cell[k]) detail::invalid_parameter(name, cell[k], "listed twice (a degenerate cell)");
+    }
+  }
+  static void check_index(const char* what, std::size_t index, std::size_t count) {
+    if (index >= count)
+      detail::invalid_parameter(std::string(what) + " index", index,
+                                "must be below the count (" + std::to_string(count) + ")");
+  }
+  double area_per_particle(std::size_t p) const {
+    const bool triangle = !cells_.empty() && cells_[p].is_triangle();
+    return triangle ? 2.0 * stress_point_area[p] : stress_point_area[p];
+  }
   static void check_quad(const Quad& quad, std::size_t particle_count) {
     for (int corner : quad)
       if (corner < 0 || static_cast<std::size_t>(corner) >= particle_count)
@@ -368,6 +556,7 @@ class ShellModel {
   std::vector<double> particle_thickness_;
   std::vector<double> stress_point_thickness_;
   std::vector<Quad> quads_;
+  std::vector<Cell> cells_;
   std::map<std::string, ParticleSet> sets_;
 };
 
