@@ -64,12 +64,13 @@ class FractureManager<Crack, true> {
     crack_.initialize(model.stress_point_position, model.stress_point_normal, model.maximum_spacing(),
                       points.support_radius());
     fragment_.assign(model.particle_count(), 0);
-    // The particles around each stress point: the corners of its cell, or, for
-    // a model without cells, the particles within one spacing; and the inverse.
+    // The particles around each stress point: the corners of its cell (quad
+    // or triangle), or, for a model without cells, the particles within one
+    // spacing; and the inverse.
     particles_of_stress_point_.assign(model.stress_point_count(), {});
-    if (!model.quads().empty()) {
-      for (std::size_t q = 0; q < model.quads().size(); ++q)
-        particles_of_stress_point_[q].assign(model.quads()[q].begin(), model.quads()[q].end());
+    if (!model.cells().empty()) {
+      for (std::size_t q = 0; q < model.cells().size(); ++q)
+        particles_of_stress_point_[q].assign(model.cells()[q].begin(), model.cells()[q].end());
     } else {
       const double reach = model.maximum_spacing();
       const approx::CellList cells(model.particle_position, reach);
