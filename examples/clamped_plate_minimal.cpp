@@ -1,5 +1,6 @@
-// The README's complete program: the paper's clamped plate (§3, Table 3),
-// elastoplastic, centre deflection after 2 ms (Fig. 15).
+// The README's complete program ("A complete program") with a command line
+// around it: the paper's clamped plate (§3, Table 3), elastoplastic, centre
+// deflection after 2 ms (Fig. 15).
 // `clamped_plate_minimal --help` lists the option and the files written.
 #include <sphshell/sphshell.hpp>
 #include <iostream>
