@@ -1,13 +1,25 @@
 #pragma once
-// Command-line numbers for the examples: a malformed value ("abc", "1e-3x",
-// "nan") is an Error naming the option, never a silently truncated number.
+// Command lines of the examples. Each option is declared once, bound to the
+// variable it sets, with its unit and meaning; the variable's value at
+// declaration is the default. --help is printed from that same table, so the
+// help cannot drift from what is parsed. A malformed value ("abc", "1e-3x",
+// "nan"), a missing value, an unknown option or a stray argument is an Error
+// naming it, never silently ignored or truncated.
 
 #include <sphshell/core/error.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <iostream>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace sphshell::example {
 
@@ -45,5 +57,201 @@ inline double parse_particle_share(const std::string& option, const std::string&
   if (!(share >= 0.0 && share < 1.0)) detail::invalid_parameter(option, share, "must lie in [0, 1)");
   return share;
 }
+
+// The shortest decimal that reads back as the same double, with a compact
+// exponent ("0.004", "1e6", "5e-5"): defaults shown as a user would type them.
+inline std::string format_number(double value) {
+  constexpr int max_significant_digits = std::numeric_limits<double>::max_digits10;
+  char buffer[64];
+  int digits = 1;
+  for (; digits <= max_significant_digits; ++digits) {
+    std::snprintf(buffer, sizeof buffer, "%.*g", digits, value);
+    if (std::strtod(buffer, nullptr) == value) break;
+  }
+  // 400, not 4e2: below a million, keep every digit of the integer part.
+  constexpr double fixed_below = 1e6;
+  if (std::abs(value) >= 1.0 && std::abs(value) < fixed_below) {
+    const int integer_digits = static_cast<int>(std::floor(std::log10(std::abs(value)))) + 1;
+    std::snprintf(buffer, sizeof buffer, "%.*g", std::max(digits, integer_digits), value);
+  }
+  std::string text = buffer;
+  const std::size_t e = text.find('e');
+  if (e == std::string::npos) return text;
+  const std::string exponent = text.substr(e + 1);
+  const bool negative = exponent.front() == '-';
+  std::size_t first = exponent.front() == '-' || exponent.front() == '+' ? 1 : 0;
+  while (first + 1 < exponent.size() && exponent[first] == '0') ++first;
+  return text.substr(0, e) + "e" + (negative ? "-" : "") + exponent.substr(first);
+}
+
+// The options of one example, its --help text and the parse.
+class CommandLine {
+ public:
+  CommandLine(std::string program, std::string summary)
+      : program_(std::move(program)), summary_(std::move(summary)) {}
+
+  // A real number. unit: "s", "m", "Pa", ...; "-" for a dimensionless one.
+  void number(const std::string& name, double& target, const std::string& unit, const std::string& description) {
+    add({name, "X", unit, format_number(target), description,
+         [&target, name](const std::string& text) { target = parse_number(name, text); }});
+  }
+  void integer(const std::string& name, int& target, const std::string& description) {
+    add({name, "N", "", std::to_string(target), description,
+         [&target, name](const std::string& text) { target = parse_integer(name, text); }});
+  }
+  // One of a fixed list of words; anything else is an Error listing them.
+  void choice(const std::string& name, std::string& target, std::vector<std::string> choices,
+              const std::string& description) {
+    std::string list;
+    for (const std::string& choice : choices) list += (list.empty() ? "" : "|") + choice;
+    add({name, list, "", target, description, [&target, name, choices, list](const std::string& text) {
+           if (std::find(choices.begin(), choices.end(), text) == choices.end())
+             throw Error("unknown " + name + " " + text + " (one of " + list + ")");
+           target = text;
+         }});
+  }
+  // The folder every output file goes into (created if missing).
+  void output_folder(std::string& target) {
+    add({"--output", "DIR", "", target, "folder for every file the run writes, created if missing",
+         [&target](const std::string& text) {
+           if (text.empty()) throw Error("--output needs a folder name, not an empty string");
+           target = text;
+         }});
+  }
+  // On when given, off by default.
+  void flag(const std::string& name, bool& target, const std::string& description) {
+    Option option{name, "", "", target ? "on" : "off", description, {}};
+    option.flag = &target;
+    add(std::move(option));
+  }
+  // Anything else: the caller converts and checks the text, and says what the default is.
+  void custom(const std::string& name, const std::string& placeholder, const std::string& unit,
+              const std::string& default_text, const std::string& description,
+              std::function<void(const std::string&)> set) {
+    add({name, placeholder, unit, default_text, description, std::move(set)});
+  }
+  // A file the run writes, relative to the output folder.
+  void writes(const std::string& file, const std::string& description) { outputs_.push_back({file, description}); }
+  // A closing paragraph of the help.
+  void note(const std::string& paragraph) { notes_.push_back(paragraph); }
+
+  // Applies argv to the bound variables. Returns false when --help was asked
+  // for: the help is then on stdout and the program should exit with 0.
+  bool parse(int argc, char** argv) const {
+    for (int k = 1; k < argc; ++k) {
+      std::string name = argv[k];
+      if (name == "--help" || name == "-h") {
+        std::cout << help();
+        return false;
+      }
+      std::string value;
+      bool inline_value = false;
+      const std::size_t equals = name.find('=');
+      if (name.rfind("--", 0) == 0 && equals != std::string::npos) {
+        value = name.substr(equals + 1);
+        name = name.substr(0, equals);
+        inline_value = true;
+      }
+      const auto option = std::find_if(options_.begin(), options_.end(),
+                                        [&](const Option& candidate) { return candidate.name == name; });
+      if (option == options_.end()) {
+        if (name.rfind("-", 0) == 0)
+          throw Error("unknown option " + name + " (" + program_ + " --help lists the options)");
+        throw Error("unexpected argument '" + name + "' (" + program_ + " --help lists the options)");
+      }
+      if (option->flag) {
+        if (inline_value) throw Error(name + " takes no value");
+        *option->flag = true;
+        continue;
+      }
+      if (!inline_value) {
+        if (k + 1 >= argc) throw Error(name + " needs a value");
+        value = argv[++k];
+      }
+      option->set(value);
+    }
+    return true;
+  }
+
+  std::string help() const {
+    std::ostringstream out;
+    out << "Usage: " << program_ << (options_.empty() ? "" : " [options]") << "\n\n";
+    out << wrap(summary_, 0, 0) << '\n';
+    out << "Options:\n";
+    for (const Option& option : options_) {
+      const std::string label = option.name + (option.placeholder.empty() ? "" : " " + option.placeholder);
+      std::string text = option.description;
+      if (!option.unit.empty()) text += " [" + option.unit + "]";
+      out << entry(label, text, "(default: " + option.default_text + ")");
+    }
+    out << entry("-h, --help", "print this help and exit", "");
+    if (!outputs_.empty()) {
+      out << "\nWrites, into the --output folder:\n";
+      for (const auto& [file, description] : outputs_) out << entry(file, description, "");
+    }
+    for (const std::string& paragraph : notes_) out << '\n' << wrap(paragraph, 0, 0);
+    return out.str();
+  }
+
+ private:
+  struct Option {
+    std::string name, placeholder, unit, default_text, description;
+    std::function<void(const std::string&)> set;
+    bool* flag = nullptr;
+  };
+
+  static constexpr std::size_t line_width = 79;
+  static constexpr std::size_t label_indent = 2;
+  static constexpr std::size_t text_column = 28;
+
+  void add(Option option) {
+    for (const Option& existing : options_)
+      if (existing.name == option.name) throw Error(program_ + ": option " + option.name + " declared twice");
+    options_.push_back(std::move(option));
+  }
+
+  // Words of `text` filled into lines of line_width; the first line starts at
+  // column `first`, the others at `indent`. `last_word` is kept whole.
+  static std::string wrap(const std::string& text, std::size_t first, std::size_t indent,
+                          const std::string& last_word = "") {
+    std::vector<std::string> words;
+    std::istringstream stream(text);
+    for (std::string word; stream >> word;) words.push_back(word);
+    if (!last_word.empty()) words.push_back(last_word);
+    std::string result;
+    std::size_t column = first;
+    bool line_empty = true;
+    for (const std::string& word : words) {
+      if (!line_empty && column + 1 + word.size() > line_width) {
+        result += '\n' + std::string(indent, ' ');
+        column = indent;
+        line_empty = true;
+      }
+      if (!line_empty) {
+        result += ' ';
+        ++column;
+      }
+      result += word;
+      column += word.size();
+      line_empty = false;
+    }
+    return result + '\n';
+  }
+
+  static std::string entry(const std::string& label, const std::string& text, const std::string& last_word) {
+    std::string line = std::string(label_indent, ' ') + label;
+    if (line.size() + 1 < text_column) {
+      line += std::string(text_column - line.size(), ' ');
+    } else {
+      line += '\n' + std::string(text_column, ' ');
+    }
+    return line + wrap(text, text_column, text_column, last_word);
+  }
+
+  std::string program_, summary_;
+  std::vector<Option> options_;
+  std::vector<std::pair<std::string, std::string>> outputs_;
+  std::vector<std::string> notes_;
+};
 
 }  // namespace sphshell::example

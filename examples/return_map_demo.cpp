@@ -1,12 +1,15 @@
 // One integral point through a uniaxial tension → unloading → compression →
-// reloading loop, printed as a stress–strain table. σy = σxy = 0 is kept by
-// solving for the lateral strain each step, so the table is a uniaxial test of
-// the plane-stress return map.
+// reloading loop, printed as a stress–strain table: a uniaxial test of the
+// paper's plane-stress J2 return map (eq. 2.23-2.39).
+// `return_map_demo --help` says what it prints.
 
 #include <sphshell/material/all.hpp>
 
+#include "example_arguments.hpp"
+
 #include <cmath>
 #include <cstdio>
+#include <iostream>
 #include <vector>
 
 using namespace sphshell;
@@ -42,7 +45,24 @@ typename Law::UpdateResult uniaxial_step(const Law& law, typename Law::State& st
 
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
+  example::CommandLine command_line(
+      "return_map_demo",
+      "One integral point of J2 plasticity (E 210 GPa, ν 0.3, σs0 235 MPa, tangent modulus 2.1 GPa) through "
+      "a uniaxial loop: tension to 1 % strain, unloading to 0, compression to -1 %, reloading to 0.5 %, in "
+      "steps of 0.025 %. σy = σxy = 0 is kept by solving for the lateral strain each step, so the table is "
+      "a uniaxial test of the plane-stress return map.");
+  command_line.note("Prints the table as CSV on standard output (redirect it to keep it; no files are "
+                    "written): step, strains ε_x and ε_y, stresses σ_x and σ_y, equivalent stress, "
+                    "equivalent plastic strain, current yield stress, whether the step was plastic and its "
+                    "Newton iterations; then a closing line comparing σs0 + Ep ε̄p with the current yield "
+                    "stress (linear hardening, eq. 2.35).");
+  try {
+    if (!command_line.parse(argc, argv)) return 0;
+  } catch (const std::exception& error) {
+    std::cerr << "return_map_demo: " << error.what() << '\n';
+    return 1;
+  }
   const double E = 210e9, nu = 0.3, sigma_y0 = 235e6;
   const double tangent_modulus = 2.1e9;
   const double Ep = E * tangent_modulus / (E - tangent_modulus);  // eq. (2.35)

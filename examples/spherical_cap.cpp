@@ -1,13 +1,7 @@
-// The clamped spherical cap under an inward step pressure — the classic
+// The clamped spherical cap under an inward step pressure, the classic
 // nonlinear shell dynamics benchmark the paper checks its SPH shell against
-// (Fig. 6–7): R = 22.27 in = 0.5657 m, d = 0.41 in = 0.010414 m,
-// half angle 26.67°, E = 72.4 GPa, ν = 0.3, ρ = 2618 kg/m³, p = 600 psi.
-//
-//   spherical_cap [--plastic] [--n 25] [--end-time 1e-3] [--output DIR]
-//
-// Writes the apex displacement history u/d to spherical_cap_apex.csv (or
-// DIR/apex.csv) and prints its peak; --plastic uses the elastoplastic variant
-// (σs0 = 165.5 MPa, Et = 1.448 GPa).
+// (§3, Figs 6-7): apex displacement history.
+// `spherical_cap --help` lists the options, their defaults and the files written.
 
 #include <sphshell/sphshell.hpp>
 
@@ -17,6 +11,7 @@
 #include <filesystem>
 #include <cstdlib>
 #include <iostream>
+#include <optional>
 #include <string>
 
 using namespace sphshell;
@@ -27,23 +22,31 @@ struct Arguments {
   bool plastic = false;
   int n = 25;
   double end_time = 1e-3;
-  std::string output;
+  std::string output = "spherical_cap";
+  bool frames = false;
 };
 
-Arguments parse(int argc, char** argv) {
+// Nothing when --help was asked for.
+std::optional<Arguments> parse(int argc, char** argv) {
   Arguments arguments;
-  for (int k = 1; k < argc; ++k) {
-    const std::string flag = argv[k];
-    auto value = [&]() -> std::string {
-      if (k + 1 >= argc) throw Error("spherical_cap: " + flag + " needs a value");
-      return argv[++k];
-    };
-    if (flag == "--plastic") arguments.plastic = true;
-    else if (flag == "--n") arguments.n = example::parse_integer(flag, value());
-    else if (flag == "--end-time") arguments.end_time = example::parse_number(flag, value());
-    else if (flag == "--output") arguments.output = value();
-    else throw Error("spherical_cap: unknown option " + flag);
-  }
+  example::CommandLine command_line(
+      "spherical_cap",
+      "The clamped spherical cap of the paper's Figs 6-7: R = 22.27 in = 0.5657 m, d = 0.41 in = 0.010414 m, "
+      "half angle 26.67°, E = 72.4 GPa, ν = 0.3, ρ = 2618 kg/m³, inward step pressure 600 psi, geometrically "
+      "nonlinear, 5 Gauss points. Prints the apex displacement u/d while running and its peak at the end.");
+  command_line.flag("--plastic", arguments.plastic,
+                    "the elastoplastic variant (σs0 = 165.5 MPa, tangent modulus Et = 1.448 GPa) instead of "
+                    "the elastic cap");
+  command_line.integer("--n", arguments.n, "particles along each side of the square grid mapped onto the cap, "
+                                           "at least 3 (n × n particles)");
+  command_line.number("--end-time", arguments.end_time, "s", "simulated time");
+  command_line.output_folder(arguments.output);
+  command_line.flag("--frames", arguments.frames,
+                    "also write ParaView frames every 50 µs of simulated time (particles.pvd, stress_points.pvd)");
+  command_line.writes("apex.csv", "every step: t and the apex displacement along the inward normal, u/d");
+  command_line.writes("apex.svg", "chart of u/d over t (paper Fig. 7)");
+  command_line.writes("*.pvd, *.vtu", "with --frames: ParaView frames of particles and stress points");
+  if (!command_line.parse(argc, argv)) return std::nullopt;
   if (arguments.n < 3) detail::invalid_parameter("--n", arguments.n, "must be at least 3");
   detail::require_positive("--end-time", arguments.end_time);
   return arguments;
@@ -56,8 +59,8 @@ int run(const Arguments& arguments, const typename Material::Parameters& paramet
   SolverOptions options;
   options.density = 2618.0;
   options.nonlinear = true;
-  options.output_directory = arguments.output;
-  options.output_interval = arguments.output.empty() ? 0.0 : 5e-5;
+  options.output_directory = arguments.frames ? arguments.output : "";
+  options.output_interval = arguments.frames ? 5e-5 : 0.0;
   Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<5>, Material> solver(
       ShellModel::spherical_cap(radius, half_angle, arguments.n, thickness), parameters, options);
   const ShellModel& model = solver.model();
@@ -65,8 +68,8 @@ int run(const Arguments& arguments, const typename Material::Parameters& paramet
   const ParticleSet all = model.all_particles();
   solver.add_uniform_pressure(all, pressure);  // inward: normals point outward
   const int apex = model.set("apex")[0];
-  const std::string csv = arguments.output.empty() ? "spherical_cap_apex.csv" : arguments.output + "/apex.csv";
-  if (!arguments.output.empty()) std::filesystem::create_directories(arguments.output);
+  const std::string csv = arguments.output + "/apex.csv";
+  std::filesystem::create_directories(arguments.output);
   io::CsvProbe history(csv, {"t [s]", "u/d [-]"});
   double peak = 0.0, peak_time = 0.0;
   long next_report = 0;
@@ -98,7 +101,9 @@ int run(const Arguments& arguments, const typename Material::Parameters& paramet
 
 int main(int argc, char** argv) {
   try {
-    const Arguments arguments = parse(argc, argv);
+    const std::optional<Arguments> parsed = parse(argc, argv);
+    if (!parsed) return 0;
+    const Arguments& arguments = *parsed;
     const double E = 72.4e9, nu = 0.3;
     if (arguments.plastic) {
       const double Et = 1.448e9;
@@ -106,7 +111,7 @@ int main(int argc, char** argv) {
     }
     return run<material::Elastic>(arguments, {E, nu});
   } catch (const std::exception& error) {
-    std::cerr << error.what() << '\n';
+    std::cerr << "spherical_cap: " << error.what() << '\n';
     return 1;
   }
 }

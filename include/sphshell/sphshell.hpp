@@ -1,6 +1,14 @@
 #pragma once
 // Umbrella header: every policy of every family, the shell model and the solver.
 
+// SPHSHELL_VERSION_MAJOR/MINOR/PATCH/STRING: <sphshell/version.hpp> is generated
+// by CMake, so it exists in the build tree, for add_subdirectory users and in an
+// installation. A source tree used through -I<sphshell>/include alone has none;
+// the umbrella still compiles there, without the version macros.
+#if __has_include(<sphshell/version.hpp>)
+#include <sphshell/version.hpp>
+#endif
+
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>

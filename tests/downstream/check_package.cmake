@@ -1,5 +1,16 @@
-# cmake -P script: install sphshell into WORK_DIR/prefix, build the downstream
-# project against it and run it.
+# cmake -P script: builds and runs tests/downstream/main.cpp the way a user of
+# sphshell would, in WORK_DIR. CONSUMER says how:
+#   find_package    install into a scratch prefix, move it, find_package(sphshell)
+#   pkg-config      install and move likewise, compile with `pkg-config --cflags sphshell`
+#   add_subdirectory  vendor the source tree with add_subdirectory (no install)
+#   include-only    compile against -I<source>/include and Eigen alone (no CMake)
+#   cmake -DCONSUMER=<mode> -DSOURCE_DIR=<sphshell> -DWORK_DIR=<dir> -DGENERATOR=<gen>
+#         -DCXX_COMPILER=<c++> -DEXPECTED_VERSION=<x.y.z> [-DPKG_CONFIG=<pkg-config>]
+#         [-DEIGEN_INCLUDE_DIRS=<dirs>] -P check_package.cmake
+cmake_minimum_required(VERSION 3.16)
+if(NOT DEFINED CONSUMER)
+  set(CONSUMER find_package)
+endif()
 file(REMOVE_RECURSE ${WORK_DIR})
 file(MAKE_DIRECTORY ${WORK_DIR})
 
@@ -10,18 +21,80 @@ function(run_step)
   if(NOT result EQUAL 0)
     message(FATAL_ERROR "step failed (${result}): ${ARGN}")
   endif()
+  set(step_output "${output}" PARENT_SCOPE)
 endfunction()
 
-run_step(${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${WORK_DIR}/sphshell-build -G ${GENERATOR}
-         -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
-         -DSPHSHELL_BUILD_TESTS=OFF -DSPHSHELL_BUILD_EXAMPLES=OFF -DSPHSHELL_BUILD_BENCHMARKS=OFF
-         -DCMAKE_INSTALL_PREFIX=${WORK_DIR}/prefix)
-run_step(${CMAKE_COMMAND} --install ${WORK_DIR}/sphshell-build)
-# Relocatability: the consumer sees the prefix only through CMAKE_PREFIX_PATH,
-# after the installed tree has been moved.
-file(RENAME ${WORK_DIR}/prefix ${WORK_DIR}/moved-prefix)
-run_step(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/downstream -B ${WORK_DIR}/downstream-build
-         -G ${GENERATOR} -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
-         -DCMAKE_PREFIX_PATH=${WORK_DIR}/moved-prefix)
-run_step(${CMAKE_COMMAND} --build ${WORK_DIR}/downstream-build)
-run_step(${WORK_DIR}/downstream-build/downstream)
+set(compiler_flags "")
+if(CXX_COMPILER MATCHES "(g\\+\\+|clang\\+\\+)")
+  set(compiler_flags -Wall -Wextra -Wpedantic)
+endif()
+
+if(CONSUMER STREQUAL "find_package" OR CONSUMER STREQUAL "pkg-config")
+  run_step(${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${WORK_DIR}/sphshell-build -G ${GENERATOR}
+           -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
+           -DSPHSHELL_BUILD_TESTS=OFF -DSPHSHELL_BUILD_EXAMPLES=OFF -DSPHSHELL_BUILD_BENCHMARKS=OFF
+           -DCMAKE_INSTALL_PREFIX=${WORK_DIR}/prefix)
+  run_step(${CMAKE_COMMAND} --install ${WORK_DIR}/sphshell-build)
+  # Relocatability: the consumer sees the prefix only through CMAKE_PREFIX_PATH
+  # or PKG_CONFIG_PATH, after the installed tree has been moved.
+  file(RENAME ${WORK_DIR}/prefix ${WORK_DIR}/moved-prefix)
+endif()
+
+if(CONSUMER STREQUAL "find_package")
+  run_step(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/downstream -B ${WORK_DIR}/downstream-build
+           -G ${GENERATOR} -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
+           -DCMAKE_PREFIX_PATH=${WORK_DIR}/moved-prefix -DEXPECTED_VERSION=${EXPECTED_VERSION})
+  run_step(${CMAKE_COMMAND} --build ${WORK_DIR}/downstream-build)
+  run_step(${WORK_DIR}/downstream-build/downstream)
+elseif(CONSUMER STREQUAL "pkg-config")
+  if(NOT PKG_CONFIG)
+    message(FATAL_ERROR "pkg-config not found (scripts/install_dependencies.sh installs it)")
+  endif()
+  set(ENV{PKG_CONFIG_PATH} ${WORK_DIR}/moved-prefix/share/pkgconfig)
+  run_step(${PKG_CONFIG} --modversion sphshell)
+  string(STRIP "${step_output}" version)
+  if(NOT version STREQUAL EXPECTED_VERSION)
+    message(FATAL_ERROR "pkg-config --modversion sphshell gives '${version}', expected ${EXPECTED_VERSION}")
+  endif()
+  run_step(${PKG_CONFIG} --cflags sphshell)
+  string(STRIP "${step_output}" cflags)
+  # The include directory must be the moved prefix's, found from the .pc
+  # file's place, not the prefix it was installed to.
+  file(REAL_PATH ${WORK_DIR}/moved-prefix/include moved_include)
+  separate_arguments(cflag_list UNIX_COMMAND "${cflags}")
+  set(found_include OFF)
+  foreach(flag IN LISTS cflag_list)
+    if(flag MATCHES "^-I(.+)$")
+      set(directory "${CMAKE_MATCH_1}")
+      if(EXISTS "${directory}")
+        file(REAL_PATH "${directory}" directory)
+        if(directory STREQUAL moved_include)
+          set(found_include ON)
+        endif()
+      endif()
+    endif()
+  endforeach()
+  if(NOT found_include)
+    message(FATAL_ERROR "pkg-config --cflags sphshell ('${cflags}') does not name ${moved_include}")
+  endif()
+  run_step(${CXX_COMPILER} -std=c++17 ${compiler_flags} ${cflag_list}
+           "-DSPHSHELL_EXPECTED_VERSION=\"${EXPECTED_VERSION}\""
+           ${SOURCE_DIR}/tests/downstream/main.cpp -o ${WORK_DIR}/downstream)
+  run_step(${WORK_DIR}/downstream)
+elseif(CONSUMER STREQUAL "add_subdirectory")
+  run_step(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/downstream/subdirectory -B ${WORK_DIR}/downstream-build
+           -G ${GENERATOR} -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
+           -DSPHSHELL_SOURCE_DIR=${SOURCE_DIR} -DEXPECTED_VERSION=${EXPECTED_VERSION})
+  run_step(${CMAKE_COMMAND} --build ${WORK_DIR}/downstream-build)
+  run_step(${WORK_DIR}/downstream-build/downstream)
+elseif(CONSUMER STREQUAL "include-only")
+  set(include_flags -I${SOURCE_DIR}/include)
+  foreach(directory IN LISTS EIGEN_INCLUDE_DIRS)
+    list(APPEND include_flags -I${directory})
+  endforeach()
+  run_step(${CXX_COMPILER} -std=c++17 ${compiler_flags} ${include_flags} -DSPHSHELL_INCLUDE_ONLY
+           ${SOURCE_DIR}/tests/downstream/main.cpp -o ${WORK_DIR}/downstream)
+  run_step(${WORK_DIR}/downstream)
+else()
+  message(FATAL_ERROR "unknown CONSUMER ${CONSUMER}")
+endif()

@@ -1,11 +1,19 @@
 # Runs one example end to end in a scratch directory and checks that it exits
 # cleanly and writes its outputs: a CSV history with data rows, an SVG plot with
-# drawn curves, and the ParaView collections it announces.
-# With EXPECT_ERROR set, the run must instead fail with a message containing it.
+# drawn curves, and the ParaView collections it announces. Nothing may appear in
+# the working directory except the folders (or files) OUTPUTS names.
+# With EXPECT_ERROR set, the run must instead fail with a message containing it
+# (and write nothing).
 # EXPECT_AT_LEAST lists pairs "text|minimum": the output must hold a line
 # "text <number>" with number ≥ minimum.
+# EXPECT_OUTPUT lists texts that standard output must contain.
+# EXPECT_HELP lists the options --help must describe, as "--name" or
+# "--name=default": the help must list exactly these (besides -h, --help),
+# each with "(default: ...)", that default when given.
 #   cmake -DEXAMPLE=<exe> -DARGUMENTS="a|b|c" -DWORK_DIR=<dir> -DOUTPUTS="x.csv|y.svg"
-#         [-DEXPECT_ERROR=text] [-DEXPECT_AT_LEAST="text|minimum|..."] -P run_example.cmake
+#         [-DEXPECT_ERROR=text] [-DEXPECT_AT_LEAST="text|minimum|..."]
+#         [-DEXPECT_OUTPUT="text|..."] [-DEXPECT_HELP="--a=1|--b|..."] -P run_example.cmake
+cmake_minimum_required(VERSION 3.16)  # IN_LIST, and the policies of the project
 string(REPLACE "|" ";" arguments "${ARGUMENTS}")
 string(REPLACE "|" ";" outputs "${OUTPUTS}")
 file(REMOVE_RECURSE "${WORK_DIR}")
@@ -13,6 +21,22 @@ file(MAKE_DIRECTORY "${WORK_DIR}")
 execute_process(COMMAND "${EXAMPLE}" ${arguments}
                 WORKING_DIRECTORY "${WORK_DIR}"
                 RESULT_VARIABLE result OUTPUT_VARIABLE output ERROR_VARIABLE errors)
+
+# Only what OUTPUTS names may be in the working directory: outputs go into the
+# example's folder, not loose into the current directory.
+set(allowed_entries "")
+foreach(name IN LISTS outputs)
+  string(REGEX REPLACE "/.*" "" top "${name}")
+  list(APPEND allowed_entries "${top}")
+endforeach()
+file(GLOB written RELATIVE "${WORK_DIR}" "${WORK_DIR}/*")
+foreach(entry IN LISTS written)
+  if(NOT entry IN_LIST allowed_entries)
+    message(FATAL_ERROR "${EXAMPLE} ${arguments} wrote '${entry}' into its working directory "
+                        "(expected only: ${allowed_entries})")
+  endif()
+endforeach()
+
 if(DEFINED EXPECT_ERROR)
   if(result EQUAL 0)
     message(FATAL_ERROR "${EXAMPLE} ${arguments} succeeded; expected an error mentioning '${EXPECT_ERROR}'")
@@ -26,6 +50,83 @@ if(DEFINED EXPECT_ERROR)
 endif()
 if(NOT result EQUAL 0)
   message(FATAL_ERROR "${EXAMPLE} ${arguments} exited with ${result}\n${output}\n${errors}")
+endif()
+if(DEFINED EXPECT_OUTPUT)
+  string(REPLACE "|" ";" expected_texts "${EXPECT_OUTPUT}")
+  foreach(text IN LISTS expected_texts)
+    string(FIND "${output}" "${text}" position)
+    if(position EQUAL -1)
+      message(FATAL_ERROR "${EXAMPLE} ${arguments} did not print '${text}'\n${output}")
+    endif()
+  endforeach()
+endif()
+if(DEFINED EXPECT_HELP)
+  get_filename_component(program "${EXAMPLE}" NAME_WE)
+  string(FIND "${output}" "Usage: ${program}" position)
+  if(NOT position EQUAL 0)
+    message(FATAL_ERROR "${EXAMPLE} --help does not start with 'Usage: ${program}'\n${output}")
+  endif()
+  # Option entries: in the "Options:" section up to the next blank line, an
+  # entry starts with two spaces and the option's name; deeper-indented lines
+  # continue it. ';' and brackets would upset CMake lists: neutralized first.
+  string(REPLACE ";" "," text "${output}")
+  string(REPLACE "[" "(" text "${text}")
+  string(REPLACE "]" ")" text "${text}")
+  string(REPLACE "\n" ";" lines "${text}")
+  set(in_options OFF)
+  set(current "")
+  set(printed "")
+  foreach(line IN LISTS lines)
+    if(line STREQUAL "Options:")
+      set(in_options ON)
+    elseif(in_options)
+      if(line STREQUAL "")
+        break()
+      elseif(line MATCHES "^  (-[-a-zA-Z0-9]+)")
+        set(current "${CMAKE_MATCH_1}")
+        list(APPEND printed "${current}")
+        set("entry_${current}" "${line}")
+      elseif(line MATCHES "^    +(.*)$" AND NOT current STREQUAL "")
+        set("entry_${current}" "${entry_${current}} ${CMAKE_MATCH_1}")
+      else()
+        message(FATAL_ERROR "${EXAMPLE} --help: unexpected line in the options: '${line}'")
+      endif()
+    endif()
+  endforeach()
+  list(REMOVE_ITEM printed "-h")
+  string(REPLACE "|" ";" expected_options "${EXPECT_HELP}")
+  set(expected_names "")
+  foreach(item IN LISTS expected_options)
+    string(FIND "${item}" "=" equals)
+    if(equals EQUAL -1)
+      set(name "${item}")
+      set(default "")
+    else()
+      string(SUBSTRING "${item}" 0 ${equals} name)
+      math(EXPR default_start "${equals} + 1")
+      string(SUBSTRING "${item}" ${default_start} -1 default)
+    endif()
+    list(APPEND expected_names "${name}")
+    if(NOT name IN_LIST printed)
+      message(FATAL_ERROR "${EXAMPLE} --help does not describe ${name}\n${output}")
+    endif()
+    if(NOT default STREQUAL "")
+      string(FIND "${entry_${name}}" "(default: ${default})" position)
+      if(position EQUAL -1)
+        message(FATAL_ERROR "${EXAMPLE} --help: ${name} does not show '(default: ${default})':\n${entry_${name}}")
+      endif()
+    endif()
+  endforeach()
+  foreach(name IN LISTS printed)
+    if(NOT name IN_LIST expected_names)
+      message(FATAL_ERROR "${EXAMPLE} --help describes ${name}, which the test does not expect")
+    endif()
+    string(FIND "${entry_${name}}" "(default: " position)
+    if(position EQUAL -1)
+      message(FATAL_ERROR "${EXAMPLE} --help: ${name} shows no default:\n${entry_${name}}")
+    endif()
+  endforeach()
+  message(STATUS "${EXAMPLE} --help describes ${printed}")
 endif()
 foreach(name IN LISTS outputs)
   set(path "${WORK_DIR}/${name}")
