@@ -64,10 +64,10 @@
 // 2π h (2 r_a + r_b)/6, balance the one-point element forces of a uniform
 // membrane state at the apex (with the shares the apex node of a pressurised
 // sphere carries 4/3 of its load, and its deflection is 4 % high at 32
-// elements on a hemisphere). The uniform pressure p(t)
-// pushes against the normal with the force −p A d at each node (reference
-// area, current director: the library's follower pressure), or along the
-// reference normal (fixed).
+// elements on a hemisphere). The uniform pressure p(t) pushes against the
+// normal with the force −p A d at each node (reference area, current
+// director: the library's follower pressure), or along the reference normal
+// (fixed).
 //
 // Time integration. Explicit central differences (leapfrog) with optional
 // mass-proportional damping c (dynamic relaxation):
@@ -77,6 +77,10 @@
 // assembled system is at most the largest eigenvalue of any element's
 // K_e φ = ω² M_e φ (K_e the linear elastic element stiffness, M_e the
 // element's shares of the lumped masses); Δt = safety · 2/ω_max.
+// Energies: kinetic ½ Σ m v_{n−½}·v_{n+½}, elastic from the stresses
+// (½ σᵀC⁻¹σ through the thickness, ½ Q γ), plastic dissipation σ_{n+1}·Δεᵖ,
+// external work by the trapezoidal rule; their balance tests that the nodal
+// forces are the gradient of the strain energy.
 //
 // Boundary conditions. Apex node: r = 0 and β = 0 (on the axis). Rim: clamped
 // (r, z, β fixed) or equator symmetry (z and β fixed, r free: the mirror plane
