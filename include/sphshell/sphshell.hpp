@@ -27,4 +27,5 @@
 #include <sphshell/io/vtu_writer.hpp>
 
 #include <sphshell/shell/model.hpp>
+#include <sphshell/shell/spherical_cap_ogrid.hpp>
 #include <sphshell/solver.hpp>
