@@ -123,6 +123,7 @@ int main(int argc, char** argv) {
     const auto start = std::chrono::steady_clock::now();
     for (int k = 0; k < solver_steps; ++k) solver.step();
     const double step = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() / solver_steps;
+    std::printf("# stable time step %.4g s, step used %.4g s\n", solver.stable_time_step(), solver.time_step());
     std::printf("# single-process step (J2, Gauss<5>, %d threads): %.2f ms\n",
 #ifdef _OPENMP
                 omp_get_max_threads(),
