@@ -131,3 +131,54 @@ TEST_CASE("halo: bad input is an Error", "[mpi][halo][errors]") {
     for (int length : lengths) CHECK(length == static_cast<int>(message.size()));
   }
 }
+
+TEST_CASE("halo: after a crack rebuild the local rows still gather the serial values bitwise", "[mpi][halo]") {
+  // A crack hides slots of rows; the rows keep their capacity, so the layout
+  // made before the crack still holds every neighbour. A row is rebuilt on its
+  // global form (as the serial solver does) and localised again.
+  const mpi::Communicator comm;
+  mpi_test::Case plate = mpi_test::paper_plate(31);
+  const mpi::DecompositionInput input = plate.input();
+  const mpi::Partition partition = mpi::partition(input, comm.size());
+  const mpi::RankLayout layout = mpi::rank_layout(input, partition, comm.rank());
+  const mpi::HaloPlan plan(comm, layout);
+  // Hide every particle with an index divisible by 7 from the stress points
+  // in the middle band of the plate (a crack-like cut of many rows).
+  const solver::PointGroup group = solver::PointGroup::stress_points;
+  const std::size_t g = solver::index_of(group);
+  std::size_t rebuilt = 0;
+  for (std::size_t row : layout.computed[g]) {
+    const Vector3& at = plate.model.stress_point_position[row];
+    if (std::abs(at.y() - 0.25) > 0.1) continue;
+    plate.points->rebuild_row(plate.model, group, row, [](std::size_t, std::size_t j) { return j % 7 != 0; });
+    ++rebuilt;
+  }
+  CHECK(rebuilt > 0);
+  std::vector<Vector3> x_global(plate.model.particle_count()), d_global(plate.model.particle_count());
+  for (std::size_t i = 0; i < x_global.size(); ++i) {
+    x_global[i] = plate.model.particle_position[i] + 1e-4 * Vector3(std::sin(double(i)), 0.0, std::cos(0.5 * i));
+    d_global[i] = plate.model.particle_normal[i];
+  }
+  std::vector<Vector3> x(layout.local_count(), Vector3::Zero()), d = x;
+  for (std::size_t k = 0; k < layout.owned_count(); ++k) {
+    x[k] = x_global[layout.owned[k]];
+    d[k] = d_global[layout.owned[k]];
+  }
+  mpi::HaloExchange exchange;
+  exchange.exchange(comm, plan, {&x, &d});
+  const approx::ShapeFunctions local = mpi::local_rows(plate.points->shape(group), layout, g);
+  std::size_t different = 0, shrunk = 0;
+  for (std::size_t k = 0; k < layout.computed[g].size(); ++k) {
+    const std::size_t row = layout.computed[g][k];
+    if (local.row_size[k] < static_cast<int>(local.capacity(k))) ++shrunk;
+    const shell::SurfaceGradients serial = plate.points->gather(group, row, x_global, d_global);
+    Vector3 a1 = Vector3::Zero(), n = Vector3::Zero();
+    for (std::size_t s = local.row_begin[k]; s < local.row_begin[k] + local.row_size[k]; ++s) {
+      a1 += local.dphi_d1[s] * x[local.neighbour[s]];
+      n += local.phi[s] * d[local.neighbour[s]];
+    }
+    if (a1 != serial.a1 || n != serial.n) ++different;
+  }
+  CHECK(shrunk > 0);
+  CHECK(different == 0);
+}
