@@ -4,6 +4,10 @@
 #   pkg-config      install and move likewise, compile with `pkg-config --cflags sphshell`
 #   add_subdirectory  vendor the source tree with add_subdirectory (no install)
 #   include-only    compile against -I<source>/include and Eigen alone (no CMake)
+#   find_package-mpi  install and move, find_package(sphshell COMPONENTS mpi), build the
+#                   MPI consumer tests/mpi/downstream and run it with MPIEXEC (a list)
+#   find_package-without-mpi  install and move; the plain consumer, configured as if
+#                   MPI were absent (CMAKE_DISABLE_FIND_PACKAGE_MPI), must still build
 #   cmake -DCONSUMER=<mode> -DSOURCE_DIR=<sphshell> -DWORK_DIR=<dir> -DGENERATOR=<gen>
 #         -DCXX_COMPILER=<c++> -DEXPECTED_VERSION=<x.y.z> [-DPKG_CONFIG=<pkg-config>]
 #         [-DEIGEN_INCLUDE_DIRS=<dirs>] -P check_package.cmake
@@ -29,7 +33,7 @@ if(CXX_COMPILER MATCHES "(g\\+\\+|clang\\+\\+)")
   set(compiler_flags -Wall -Wextra -Wpedantic)
 endif()
 
-if(CONSUMER STREQUAL "find_package" OR CONSUMER STREQUAL "pkg-config")
+if(CONSUMER MATCHES "^find_package" OR CONSUMER STREQUAL "pkg-config")
   run_step(${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${WORK_DIR}/sphshell-build -G ${GENERATOR}
            -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
            -DSPHSHELL_BUILD_TESTS=OFF -DSPHSHELL_BUILD_EXAMPLES=OFF -DSPHSHELL_BUILD_BENCHMARKS=OFF
@@ -43,6 +47,21 @@ endif()
 if(CONSUMER STREQUAL "find_package")
   run_step(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/downstream -B ${WORK_DIR}/downstream-build
            -G ${GENERATOR} -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
+           -DCMAKE_PREFIX_PATH=${WORK_DIR}/moved-prefix -DEXPECTED_VERSION=${EXPECTED_VERSION})
+  run_step(${CMAKE_COMMAND} --build ${WORK_DIR}/downstream-build)
+  run_step(${WORK_DIR}/downstream-build/downstream)
+elseif(CONSUMER STREQUAL "find_package-mpi")
+  run_step(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/mpi/downstream -B ${WORK_DIR}/downstream-build
+           -G ${GENERATOR} -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
+           -DCMAKE_PREFIX_PATH=${WORK_DIR}/moved-prefix -DEXPECTED_VERSION=${EXPECTED_VERSION})
+  run_step(${CMAKE_COMMAND} --build ${WORK_DIR}/downstream-build)
+  run_step(${MPIEXEC} ${WORK_DIR}/downstream-build/downstream_mpi)
+elseif(CONSUMER STREQUAL "find_package-without-mpi")
+  if(NOT EXISTS ${WORK_DIR}/moved-prefix/share/sphshell/cmake/sphshellMpiTargets.cmake)
+    message(FATAL_ERROR "the installed package has no MPI layer: nothing to check without it")
+  endif()
+  run_step(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/downstream -B ${WORK_DIR}/downstream-build
+           -G ${GENERATOR} -DCMAKE_CXX_COMPILER=${CXX_COMPILER} -DCMAKE_DISABLE_FIND_PACKAGE_MPI=ON
            -DCMAKE_PREFIX_PATH=${WORK_DIR}/moved-prefix -DEXPECTED_VERSION=${EXPECTED_VERSION})
   run_step(${CMAKE_COMMAND} --build ${WORK_DIR}/downstream-build)
   run_step(${WORK_DIR}/downstream-build/downstream)

@@ -1,0 +1,13 @@
+// Catch2 under MPI: every rank runs every test case in the same order (the
+// cases call collectives), and reports its own failures; mpirun fails when
+// any rank does. The cases use CHECK, never REQUIRE: a rank that left a case
+// early would leave the others waiting in its collectives.
+#define CATCH_CONFIG_RUNNER
+#include <sphshell/mpi/communicator.hpp>
+
+#include <catch2/catch.hpp>
+
+int main(int argc, char** argv) {
+  sphshell::mpi::Environment environment(argc, argv);
+  return Catch::Session().run(argc, argv);
+}
