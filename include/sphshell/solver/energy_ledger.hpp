@@ -132,6 +132,12 @@ class EnergyLedger {
       message << "energy balance lost (kinetic " << e.kinetic << " J, internal " << e.internal
               << " J, external work " << e.external_work << " J, balance " << e.balance()
               << " J); reduce the time step or check the loads";
+      // The particle holding the most kinetic energy is where a run that blows up is going.
+      if (!kinetic_term_.empty()) {
+        const auto largest = std::max_element(kinetic_term_.begin(), kinetic_term_.end());
+        message << "; the largest kinetic energy is at particle " << (largest - kinetic_term_.begin()) << " ("
+                << *largest << " J)";
+      }
       detail::fail_unstable(at, message.str());
     }
   }
