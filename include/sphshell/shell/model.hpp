@@ -537,14 +537,14 @@ class ShellModel {
     check_finite("particle", "normal", normals);
     for (std::size_t q = 0; q < quads.size(); ++q) {
       const Quad& quad = quads[q];
-      const std::string name = "quad " + std::to_string(q);
+      const auto quad_name = [q] { return "quad " + std::to_string(q); };
       for (std::size_t k = 0; k < 4; ++k) {
         if (quad[k] < 0 || static_cast<std::size_t>(quad[k]) >= positions.size())
-          detail::invalid_parameter(name + " corner " + std::to_string(k), quad[k],
+          detail::invalid_parameter(quad_name() + " corner " + std::to_string(k), quad[k],
                                     "must lie in [0, " + std::to_string(positions.size()) + ")");
         for (std::size_t l = 0; l < k; ++l)
           if (quad[l] == quad[k])
-            detail::invalid_parameter(name + " corners", corners_text(quad),
+            detail::invalid_parameter(quad_name() + " corners", corners_text(quad),
                                       "particle " + std::to_string(quad[k]) +
                                           " is listed twice: four distinct corners (a degenerate quad)");
       }
@@ -561,7 +561,7 @@ class ShellModel {
       }
       const double area = 0.5 * doubled_area.norm();
       if (!(0.5 * largest_corner.norm() > degenerate_area_fraction * longest_squared))
-        detail::invalid_parameter(name + " area", area,
+        detail::invalid_parameter(quad_name() + " area", area,
                                   "must be > 0: corners " + corners_text(quad) +
                                       " are collinear or coincident (a degenerate quad)");
       // A bow-tie's diagonals may have a zero cross product: then its largest corner gives the axis.
@@ -576,13 +576,13 @@ class ShellModel {
         if (next.cross(previous).dot(axis) < 0.0) ++reversed_turns;
       }
       if (reversed_turns >= 2 || !diagonals_span)
-        detail::invalid_parameter(name + " corners", corners_text(quad),
+        detail::invalid_parameter(quad_name() + " corners", corners_text(quad),
                                   "its edges cross (a bow-tie quad): list the corners in order around the quad");
       int against = 0;
       for (int corner : quad)
         if (normals[corner].dot(axis) < 0.0) ++against;
       if (against == 4)
-        detail::invalid_parameter(name + " corners", corners_text(quad),
+        detail::invalid_parameter(quad_name() + " corners", corners_text(quad),
                                   "run clockwise seen from the side the normals point to (an inverted quad): list "
                                   "them counter-clockwise");
       for (int corner : quad) {
@@ -590,12 +590,12 @@ class ShellModel {
         const double cosine = length > 0.0 ? normals[corner].dot(axis) / length : 0.0;
         if (cosine < 0.0)
           detail::invalid_parameter("particle " + std::to_string(corner) + " normal", normals[corner].transpose(),
-                                    "points against " + name + " (corners " + corners_text(quad) +
+                                    "points against " + quad_name() + " (corners " + corners_text(quad) +
                                         ") while its other corners' normals agree with it: neighbouring normals "
                                         "must share one orientation");
         if (length > 0.0 && cosine < in_plane_cosine)
           detail::invalid_parameter("particle " + std::to_string(corner) + " normal", normals[corner].transpose(),
-                                    "lies (within 10°) in the plane of " + name +
+                                    "lies (within 10°) in the plane of " + quad_name() +
                                         ": a normal must point out of the sheet");
       }
     }
@@ -654,7 +654,9 @@ class ShellModel {
   }
   // Each particle's normal agrees in orientation with its nearest stress point's.
   void check_orientation() const {
-    const double reach = 2.0 * std::sqrt(*std::max_element(stress_point_area.begin(), stress_point_area.end()));
+    // The nearest stress point of a grid lies within 0.71 spacings; a particle
+    // with none within one spacing is not checked.
+    const double reach = std::sqrt(*std::max_element(stress_point_area.begin(), stress_point_area.end()));
     const approx::CellList stress_points(stress_point_position, reach);
     for (std::size_t i = 0; i < particle_count(); ++i) {
       int nearest_point = -1;
@@ -677,8 +679,10 @@ class ShellModel {
   }
   // No two particles closer than coincident_spacing_fraction × √A_i.
   void check_separation() const {
+    // Cells about one spacing wide: a few particles each (cells as narrow as
+    // the tolerance would be mostly empty and slow to search).
     double reach = 0.0;
-    for (double area : particle_area) reach = std::max(reach, coincident_spacing_fraction * std::sqrt(area));
+    for (double area : particle_area) reach = std::max(reach, std::sqrt(area));
     const approx::CellList particles(particle_position, reach);
     for (std::size_t i = 0; i < particle_count(); ++i) {
       const double limit = coincident_spacing_fraction * std::sqrt(particle_area[i]);
