@@ -81,6 +81,28 @@ TEST_CASE("The energy guard names the particle with the most kinetic energy", "[
   CHECK(message.find("largest kinetic energy is at particle") != std::string::npos);
 }
 
+TEST_CASE("The default energy guard stops a run within a few steps of losing balance", "[bad_input][run]") {
+  ElasticSolver solver(small_plate(), steel);
+  solver.clamp(solver.model().set("x_min"));
+  solver.add_point_force({solver.model().nearest_particle(Vector3(0.1, 0.05, 0.0))}, Vector3(0.0, 0.0, 100.0));
+  for (int k = 0; k < 41; ++k) solver.step();
+  // A kinematic jump of one particle by 1 mm puts elastic energy into the
+  // shell that no load did work for: the balance is lost at once.
+  std::vector<Vector3> positions = solver.positions();
+  positions[30].z() += 1e-3;
+  solver.set_configuration(positions, solver.directors());
+  const long jumped_at = solver.steps();
+  const std::string message = error_of([&] {
+    for (int k = 0; k < 40; ++k) solver.step();
+  });
+  INFO(message);
+  CHECK(message.find("energy balance lost") != std::string::npos);
+  CHECK(message.find("largest kinetic energy is at particle") != std::string::npos);
+  INFO("stopped " << solver.steps() - jumped_at << " steps after the jump");
+  CHECK(solver.steps() - jumped_at <= solver::EnergyLedger::check_interval);
+  CHECK(solver.steps() - jumped_at <= 4);
+}
+
 TEST_CASE("A particle listed twice in a set is refused", "[bad_input][loads]") {
   ElasticSolver solver(small_plate(), steel);
   require_error([&] { solver.add_point_force({0, 0, 0}, Vector3(0, 0, 1)); }, {"particle index = 0", "listed twice"});
