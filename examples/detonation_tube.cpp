@@ -225,6 +225,12 @@ std::optional<Arguments> parse(int argc, char** argv) {
       detail::invalid_parameter("--notch-offset", a.notch_offset, "a surface notch runs along the stress-point row");
     a.notch_offset = 0.0;
   }
+  // The notch must span a few spacings (checked before the length, which
+  // depends on the spacing, so a coarse spacing is named as the cause).
+  if (!(a.spacing <= notch_length() / 4))
+    detail::invalid_parameter("--spacing", a.spacing,
+                              "must be at most a quarter of the notch length (12.7 mm), so the notch spans several "
+                              "spacings");
   if (!(a.length > notch_length() + 4 * a.spacing))
     detail::invalid_parameter("--length", a.length, "must exceed the notch (50.8 mm) by a few spacings");
   return a;

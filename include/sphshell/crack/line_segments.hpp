@@ -74,6 +74,12 @@ class LineSegments {
   static constexpr double cell_margin = 1.01;
   // A point closer than this fraction of the spacing to a pre-crack lies on it.
   static constexpr double on_precrack_in_spacings = 1e-6;
+  // A pre-crack point farther than this (in spacings) from the tangent plane
+  // of its nearest stress point is off the surface (it would cut nothing).
+  static constexpr double off_surface_in_spacings = 0.25;
+  // A pre-crack whose vertices and piece midpoints all lie this close (in
+  // spacings) to an earlier pre-crack repeats it.
+  static constexpr double repeated_precrack_in_spacings = 1e-3;
   static double distance_to_precrack_piece(const Vector3& point, const Vector3& start, const Vector3& end) {
     return distance_to_segment(point, start, end);
   }
@@ -109,6 +115,7 @@ class LineSegments {
     crack_of_point_.clear();
     segments_.clear();
     crack_id_count_ = 0;
+    precracks_.clear();
     max_segment_length_ = 0.0;
     segment_index_.reset();
     initialized_ = true;
@@ -129,15 +136,30 @@ class LineSegments {
         name << "pre-crack point " << k;
         sphshell::detail::invalid_parameter(name.str(), point.transpose(), "must be finite");
       }
-      bool near_shell = false;
-      stress_point_index_->for_each_within(point, spacing_,
-                                           [&](int, double) { near_shell = true; });
-      if (!near_shell) {
+      int nearest = -1;
+      double nearest_distance_squared = 0.0;
+      stress_point_index_->for_each_within(point, spacing_, [&](int q, double distance_squared) {
+        if (nearest < 0 || distance_squared < nearest_distance_squared) nearest = q, nearest_distance_squared = distance_squared;
+      });
+      if (nearest < 0) {
         std::ostringstream name;
         name << "pre-crack point " << k;
         sphshell::detail::invalid_parameter(name.str(), point.transpose(),
                                             "must lie on the shell: within one spacing (" +
                                                 to_string(spacing_) + " m) of a stress point");
+      }
+      const auto slot = static_cast<std::size_t>(nearest);
+      const double off_surface =
+          std::abs((point - stress_point_positions_[slot]).dot(stress_point_normals_[slot].normalized()));
+      if (off_surface > off_surface_in_spacings * spacing_) {
+        std::ostringstream name;
+        name << "pre-crack point " << k;
+        sphshell::detail::invalid_parameter(
+            name.str(), point.transpose(),
+            "must lie on the shell's surface: it is " + to_string(off_surface) +
+                " m off the tangent plane of the nearest stress point " + std::to_string(nearest) + ", at most " +
+                to_string(off_surface_in_spacings) + " spacings (" + to_string(off_surface_in_spacings * spacing_) +
+                " m) allowed");
       }
       if (k > 0 && (point - polyline[k - 1]).norm() <= zero_length_in_spacings * spacing_) {
         std::ostringstream name;
@@ -146,6 +168,12 @@ class LineSegments {
                                             "a pre-crack piece must not have zero length");
       }
     }
+    for (std::size_t earlier = 0; earlier < precracks_.size(); ++earlier)
+      if (repeats(polyline, precracks_[earlier]))
+        sphshell::detail::invalid_parameter("pre-crack", "(" + std::to_string(polyline.size()) + " points)",
+                                            "repeats pre-crack " + std::to_string(earlier) +
+                                                " (it lies on it): add each pre-crack once");
+    precracks_.push_back(polyline);
     // Stress points on the polyline become points of the pre-crack, in order
     // along it, exactly as damage along that row would have made them: a
     // pre-crack drawn through a row of stress points is the crack that row's
@@ -375,6 +403,20 @@ class LineSegments {
   bool empty() const { return segments_.empty(); }
 
  private:
+  // Whether every vertex and piece midpoint of `polyline` lies on `earlier`.
+  bool repeats(const std::vector<Vector3>& polyline, const std::vector<Vector3>& earlier) const {
+    const double tolerance = repeated_precrack_in_spacings * spacing_;
+    auto on_earlier = [&](const Vector3& point) {
+      for (std::size_t k = 0; k + 1 < earlier.size(); ++k)
+        if (distance_to_segment(point, earlier[k], earlier[k + 1]) <= tolerance) return true;
+      return false;
+    };
+    for (std::size_t k = 0; k < polyline.size(); ++k) {
+      if (!on_earlier(polyline[k])) return false;
+      if (k + 1 < polyline.size() && !on_earlier(0.5 * (polyline[k] + polyline[k + 1]))) return false;
+    }
+    return true;
+  }
   // Nearest crack points within the linking distance. The cell list over the
   // crack points is built once per call; points added during the call are
   // scanned directly until there are enough of them to be worth re-indexing.
@@ -516,6 +558,7 @@ class LineSegments {
   std::vector<int> crack_of_point_;
   std::vector<Segment> segments_;
   int crack_id_count_ = 0;
+  std::vector<std::vector<Vector3>> precracks_;  // as added, for the repeat check
   double max_segment_length_ = 0.0;
   std::optional<approx::CellList> segment_index_;
 };

@@ -73,17 +73,20 @@ class Constraints {
 
   // On every particle of a set (indices already checked).
   void clamp(const std::vector<int>& set) {
+    require_no_motion(set);
     for (int i : set) {
       fix_all_translations(i);
       fix_all_rotations(i);
     }
   }
   void simply_support(const std::vector<int>& set) {
+    require_no_motion(set);
     for (int i : set) fix_all_translations(i);
   }
   // Translations fixed and no rotation about n × t (the director does not tilt along the edge).
   void simply_support_hard(const std::vector<int>& set, const std::vector<Vector3>& normal,
                            const Vector3& edge_tangent) {
+    require_no_motion(set);
     for (int i : set) {
       fix_all_translations(i);
       fix_rotation(i, normal[i].cross(edge_tangent));
@@ -91,12 +94,14 @@ class Constraints {
   }
   // No translation across the plane and no rotation tilting the director out of it.
   void symmetry_plane(const std::vector<int>& set, const std::vector<Vector3>& normal, const Vector3& plane_normal) {
+    require_no_motion(set);
     for (int i : set) {
       fix_translation(i, plane_normal);
       fix_rotation(i, normal[i].cross(plane_normal));
     }
   }
   void fix_translation(const std::vector<int>& set, const Vector3& direction) {
+    require_no_motion(set);
     for (int i : set) fix_translation(i, direction);
   }
   void fix_rotation(const std::vector<int>& set, const Vector3& axis) {
@@ -112,20 +117,38 @@ class Constraints {
       if (!v.allFinite())
         invalid_parameter("prescribed motion at particle " + std::to_string(i), v.transpose(), "must be finite");
     }
+    // A prescribed motion sets all three translations: a particle that has a
+    // translation condition already (or another motion) would get two
+    // conflicting ones, so that is an Error naming the particle. Rotation
+    // conditions combine with it (a moving clamped grip: prescribe the motion,
+    // then fix the rotations).
+    for (int i : set) {
+      const auto found = index_.find(i);
+      if (found == index_.end()) continue;
+      const ParticleConstraint& existing = entries_[found->second];
+      if (!existing.motions.empty())
+        invalid_parameter("prescribed motion at particle " + std::to_string(i), "(a second one)",
+                          "the particle has a prescribed motion already; give one motion per particle");
+      if (!existing.free_translation.isIdentity(0.0))
+        invalid_parameter("prescribed motion at particle " + std::to_string(i), "(on a fixed translation)",
+                          "conflicts with the clamp, support, symmetry plane or fixed translation already on the "
+                          "particle: a prescribed motion sets all three translations; combine it with rotation "
+                          "conditions only");
+    }
     const PrescribedMotion* owned = own(std::move(motion));
     for (int i : set) {
-      fix_all_translations(i);
+      entry(i).free_translation.setZero();
       add_motion(i, owned);
     }
   }
 
   void fix_translation(int particle, const Vector3& direction) {
-    restrict(entry(particle).free_translation, direction, "translation direction");
+    restrict(translation_of(particle), direction, "translation direction");
   }
   void fix_rotation(int particle, const Vector3& axis) {
     restrict(entry(particle).free_rotation, axis, "rotation axis");
   }
-  void fix_all_translations(int particle) { entry(particle).free_translation.setZero(); }
+  void fix_all_translations(int particle) { translation_of(particle).setZero(); }
   void fix_all_rotations(int particle) { entry(particle).free_rotation.setZero(); }
   void add_motion(int particle, const PrescribedMotion* motion) {
     entry(particle).motions.push_back(motion);
@@ -177,6 +200,23 @@ class Constraints {
     particles_.push_back(particle);
     entries_.emplace_back();
     return entries_.back();
+  }
+  // Checked for a whole set before any of it changes.
+  void require_no_motion(const std::vector<int>& set) {
+    for (int i : set) {
+      const auto found = index_.find(i);
+      if (found != index_.end() && !entries_[found->second].motions.empty()) translation_of(i);
+    }
+  }
+  // The free translations of a particle about to get a translation condition;
+  // one under a prescribed motion has none left to fix (that is an Error).
+  Matrix3& translation_of(int particle) {
+    ParticleConstraint& constraint = entry(particle);
+    if (!constraint.motions.empty())
+      invalid_parameter("translation condition at particle " + std::to_string(particle), "(on a prescribed motion)",
+                        "conflicts with the prescribed motion already on the particle, which sets all three "
+                        "translations; fix only rotations there");
+    return constraint.free_translation;
   }
   // Removes `direction` from the free subspace P: P ← P − (P c)(P c)ᵀ/|P c|².
   static void restrict(Matrix3& free, const Vector3& direction, const char* name) {

@@ -13,18 +13,22 @@
 #include <cstddef>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
 namespace sphshell {
 
 namespace time_function {
-// f(t) = 1 from t_start on (a step load).
+// f(t) = 1 from t_start on (a step load). t_start must be finite.
 struct Step {
   double t_start = 0.0;
   double operator()(double t) const { return t >= t_start ? 1.0 : 0.0; }
+  // An Error naming the parameter unless t_start is finite (a NaN start would never switch the load on).
+  void validate() const { detail::require_finite("time_function::Step::t_start", t_start); }
 };
 // f(t) rises linearly from 0 at t_start to 1 at t_start + rise_time, then stays 1.
+// rise_time must be finite and >= 0, t_start finite.
 struct Ramp {
   double rise_time = 0.0;  // s; 0 makes it a step at t_start
   double t_start = 0.0;
@@ -32,8 +36,26 @@ struct Ramp {
     if (t <= t_start) return 0.0;
     return t >= t_start + rise_time ? 1.0 : (t - t_start) / rise_time;
   }
+  void validate() const {
+    detail::require_nonnegative("time_function::Ramp::rise_time", rise_time);
+    detail::require_finite("time_function::Ramp::t_start", t_start);
+  }
 };
 }  // namespace time_function
+
+namespace detail {
+template <class F, class = void>
+struct has_validate : std::false_type {};
+template <class F>
+struct has_validate<F, std::void_t<decltype(std::declval<const F&>().validate())>> : std::true_type {};
+
+// A time function's own check (Step, Ramp, or a user type with validate()),
+// called when a load is added; other callables are taken as they are.
+template <class TimeFunction>
+void check_time_function(const TimeFunction& time) {
+  if constexpr (has_validate<TimeFunction>::value) time.validate();
+}
+}  // namespace detail
 
 // Which way a pressure pushes.
 enum class PressureDirection {
@@ -94,7 +116,9 @@ template <class TimeFunction>
 class PointForceLoad final : public Load {
  public:
   PointForceLoad(std::vector<int> particles, Vector3 force, TimeFunction time_function)
-      : particles_(std::move(particles)), force_(force), time_function_(std::move(time_function)) {}
+      : particles_(std::move(particles)), force_(force), time_function_(std::move(time_function)) {
+    check_time_function(time_function_);
+  }
   void apply(LoadContext& c) const override {
     const Vector3 f = time_function_(c.time) * force_;
     for (int i : particles_) c.force[i] += f;
@@ -110,7 +134,9 @@ template <class TimeFunction>
 class PointMomentLoad final : public Load {
  public:
   PointMomentLoad(std::vector<int> particles, Vector3 moment, TimeFunction time_function)
-      : particles_(std::move(particles)), moment_(moment), time_function_(std::move(time_function)) {}
+      : particles_(std::move(particles)), moment_(moment), time_function_(std::move(time_function)) {
+    check_time_function(time_function_);
+  }
   void apply(LoadContext& c) const override {
     const Vector3 m = time_function_(c.time) * moment_;
     for (int i : particles_) c.moment[i] += m;
@@ -127,7 +153,9 @@ template <class TimeFunction>
 class GravityLoad final : public Load {
  public:
   GravityLoad(std::vector<int> particles, Vector3 acceleration, TimeFunction time_function)
-      : particles_(std::move(particles)), acceleration_(acceleration), time_function_(std::move(time_function)) {}
+      : particles_(std::move(particles)), acceleration_(acceleration), time_function_(std::move(time_function)) {
+    check_time_function(time_function_);
+  }
   void apply(LoadContext& c) const override {
     const Vector3 g = time_function_(c.time) * acceleration_;
     for (int i : particles_) c.force[i] += c.mass[i] * g;

@@ -3,17 +3,22 @@
 // mid-surface and the stress points staggered between them (docs/method.md §1),
 // in structure-of-arrays storage, with builders for the usual shapes.
 
+#include <sphshell/approx/neighbour_search.hpp>
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
+
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <map>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <unordered_map>
 #include <utility>
@@ -94,10 +99,10 @@ class ShellModel {
   static ShellModel from_quads(std::vector<Vector3> positions, std::vector<Vector3> normals,
                                const std::vector<Quad>& quads, double thickness) {
     check_sizes(positions, normals);
+    check_quads(positions, normals, quads);
     std::vector<Vector3> centres;
     std::vector<Vector3> centre_normals;
     for (const Quad& quad : quads) {
-      check_quad(quad, positions.size());
       Vector3 centre = Vector3::Zero();
       Vector3 normal = Vector3::Zero();
       for (int corner : quad) {
@@ -118,6 +123,7 @@ class ShellModel {
                                std::vector<Vector3> stress_positions,
                                std::vector<Vector3> stress_normals, double thickness) {
     check_sizes(positions, normals);
+    check_quads(positions, normals, quads);
     if (stress_positions.size() != quads.size() || stress_normals.size() != quads.size())
       detail::invalid_parameter("stress point count", stress_positions.size(),
                                 "must equal the number of quads (" + std::to_string(quads.size()) + ")");
@@ -125,13 +131,16 @@ class ShellModel {
     std::vector<double> stress_areas;
     stress_areas.reserve(quads.size());
     for (const Quad& quad : quads) {
-      check_quad(quad, positions.size());
       const Vector3 diagonal1 = positions[quad[2]] - positions[quad[0]];
       const Vector3 diagonal2 = positions[quad[3]] - positions[quad[1]];
       const double area = 0.5 * diagonal1.cross(diagonal2).norm();
       stress_areas.push_back(area);
       for (int corner : quad) areas[corner] += area / 4.0;
     }
+    for (std::size_t i = 0; i < positions.size(); ++i)
+      if (!(areas[i] > 0.0))
+        detail::invalid_parameter("particle " + std::to_string(i), positions[i].transpose(),
+                                  "belongs to no quad: every particle must be a corner of a quad");
     ShellModel model(std::move(positions), std::move(normals), std::move(areas),
                      std::move(stress_positions), std::move(stress_normals),
                      std::move(stress_areas), thickness);
@@ -153,6 +162,7 @@ class ShellModel {
   static ShellModel from_cells(std::vector<Vector3> positions, const std::vector<Cell>& cells,
                                double thickness) {
     if (cells.empty()) detail::invalid_parameter("cell count", 0, "a shell needs cells");
+    check_finite("particle", "position", positions);
     for (std::size_t c = 0; c < cells.size(); ++c) check_cell(cells[c], c, positions.size());
     if (const std::optional<CellEdgeProblem> problem = find_cell_edge_problem(cells))
       detail::invalid_parameter(
@@ -337,8 +347,14 @@ class ShellModel {
   // The thickness the model was built with; set_thickness can change it in regions.
   double thickness() const { return thickness_; }
   // Wall thickness at a particle and at a stress point (m).
-  double particle_thickness(std::size_t i) const { return particle_thickness_.at(i); }
-  double stress_point_thickness(std::size_t p) const { return stress_point_thickness_.at(p); }
+  double particle_thickness(std::size_t i) const {
+    check_index("particle", i, particle_count());
+    return particle_thickness_[i];
+  }
+  double stress_point_thickness(std::size_t p) const {
+    check_index("stress point", p, stress_point_count());
+    return stress_point_thickness_[p];
+  }
   double minimum_thickness() const {
     return std::min(*std::min_element(particle_thickness_.begin(), particle_thickness_.end()),
                     *std::min_element(stress_point_thickness_.begin(), stress_point_thickness_.end()));
@@ -349,7 +365,7 @@ class ShellModel {
   // many points changed; a region that holds no point is an Error.
   template <class Predicate>
   std::size_t set_thickness(Predicate&& where, double d) {
-    detail::require_positive("thickness", d);
+    require_thin("thickness", d, extent());
     std::size_t count = 0;
     for (std::size_t i = 0; i < particle_position.size(); ++i)
       if (where(particle_position[i])) particle_thickness_[i] = d, ++count;
@@ -363,12 +379,12 @@ class ShellModel {
   // mesh file's shell sections; the mid-surface stays where it is.
   void set_particle_thickness(std::size_t i, double d) {
     check_index("particle", i, particle_count());
-    detail::require_positive("particle " + std::to_string(i) + " thickness", d);
+    require_thin("particle " + std::to_string(i) + " thickness", d, extent());
     particle_thickness_[i] = d;
   }
   void set_stress_point_thickness(std::size_t p, double d) {
     check_index("stress point", p, stress_point_count());
-    detail::require_positive("stress point " + std::to_string(p) + " thickness", d);
+    require_thin("stress point " + std::to_string(p) + " thickness", d, extent());
     stress_point_thickness_[p] = d;
   }
   std::size_t particle_count() const { return particle_position.size(); }
@@ -398,7 +414,11 @@ class ShellModel {
 
   // Named particle sets, for boundary conditions, loads and probes.
   template <class Predicate>
+  // A name in use (a builder's own set such as "boundary" too) is an Error:
+  // replacing a set silently would move the conditions and loads that use it.
   const ParticleSet& define_set(const std::string& name, Predicate&& contains) {
+    if (has_set(name))
+      detail::invalid_parameter("particle set name", name, "a set of that name exists; choose another name");
     ParticleSet members;
     for (std::size_t i = 0; i < particle_position.size(); ++i)
       if (contains(particle_position[i])) members.push_back(static_cast<int>(i));
@@ -478,6 +498,215 @@ class ShellModel {
                       std::move(centre_normals), thickness);
   }
 
+  // Geometry checks (docs/method.md §1; the limits are named so a message can state them).
+  // A quad whose area is below this fraction of its longest side squared is degenerate.
+  static constexpr double degenerate_area_fraction = 1e-12;
+  // A normal closer than this to a cell's plane (cosine of the angle to the
+  // cell normal, cos 80°) lies "in the sheet's plane".
+  static constexpr double in_plane_cosine = 0.17364817766693033;
+  // Particles closer than this fraction of the local spacing √A_i are near-coincident
+  // (small enough for cells a thousand times longer than wide).
+  static constexpr double coincident_spacing_fraction = 1e-3;
+  // The two area sets (particles, stress points) cover the same surface: their
+  // sums may differ by at most this fraction.
+  static constexpr double area_sum_tolerance = 0.02;
+  // One area this many times the median of its set is an outlier: the support
+  // radius follows the largest spacing, so it would widen every row.
+  static constexpr double area_outlier_ratio = 64.0;
+  // Particles whose spread across their main line is below this fraction of
+  // their extent lie on one line; a sheet flat to this fraction is planar.
+  static constexpr double collinear_fraction = 1e-6;
+  static constexpr double planar_fraction = 1e-9;
+
+  static void check_finite(const char* what, const char* quantity, const std::vector<Vector3>& values) {
+    for (std::size_t i = 0; i < values.size(); ++i)
+      if (!values[i].allFinite())
+        detail::invalid_parameter(std::string(what) + " " + std::to_string(i) + " " + quantity,
+                                  values[i].transpose(), "must be finite");
+  }
+  static std::string corners_text(const Quad& quad) {
+    return "{" + std::to_string(quad[0]) + ", " + std::to_string(quad[1]) + ", " + std::to_string(quad[2]) + ", " +
+           std::to_string(quad[3]) + "}";
+  }
+  // Every quad by index: corners in range and distinct, not degenerate, not
+  // self-intersecting, and counter-clockwise seen from its corners' normals.
+  static void check_quads(const std::vector<Vector3>& positions, const std::vector<Vector3>& normals,
+                          const std::vector<Quad>& quads) {
+    if (quads.empty()) detail::invalid_parameter("quad count", 0, "a shell needs quads");
+    check_finite("particle", "position", positions);
+    check_finite("particle", "normal", normals);
+    for (std::size_t q = 0; q < quads.size(); ++q) {
+      const Quad& quad = quads[q];
+      const auto quad_name = [q] { return "quad " + std::to_string(q); };
+      for (std::size_t k = 0; k < 4; ++k) {
+        if (quad[k] < 0 || static_cast<std::size_t>(quad[k]) >= positions.size())
+          detail::invalid_parameter(quad_name() + " corner " + std::to_string(k), quad[k],
+                                    "must lie in [0, " + std::to_string(positions.size()) + ")");
+        for (std::size_t l = 0; l < k; ++l)
+          if (quad[l] == quad[k])
+            detail::invalid_parameter(quad_name() + " corners", corners_text(quad),
+                                      "particle " + std::to_string(quad[k]) +
+                                          " is listed twice: four distinct corners (a degenerate quad)");
+      }
+      const Vector3 doubled_area = (positions[quad[2]] - positions[quad[0]]).cross(positions[quad[3]] - positions[quad[1]]);
+      double longest_squared = 0.0;
+      for (std::size_t k = 0; k < 4; ++k)
+        longest_squared = std::max(longest_squared, (positions[quad[(k + 1) % 4]] - positions[quad[k]]).squaredNorm());
+      // The largest corner triangle: zero only when all four corners lie on one line.
+      Vector3 largest_corner = Vector3::Zero();
+      for (std::size_t k = 0; k < 4; ++k) {
+        const Vector3& here = positions[quad[k]];
+        const Vector3 corner = (positions[quad[(k + 1) % 4]] - here).cross(positions[quad[(k + 3) % 4]] - here);
+        if (corner.norm() > largest_corner.norm()) largest_corner = corner;
+      }
+      const double area = 0.5 * doubled_area.norm();
+      if (!(0.5 * largest_corner.norm() > degenerate_area_fraction * longest_squared))
+        detail::invalid_parameter(quad_name() + " area", area,
+                                  "must be > 0: corners " + corners_text(quad) +
+                                      " are collinear or coincident (a degenerate quad)");
+      // A bow-tie's diagonals may have a zero cross product: then its largest corner gives the axis.
+      const bool diagonals_span = area > degenerate_area_fraction * longest_squared;
+      const Vector3 axis = diagonals_span ? doubled_area.normalized() : largest_corner.normalized();
+      // Turning direction at each corner about the quad's own normal: a simple
+      // quad turns one way at three or four corners, a bow-tie at two only.
+      int reversed_turns = 0;
+      for (std::size_t k = 0; k < 4; ++k) {
+        const Vector3& here = positions[quad[k]];
+        const Vector3 next = positions[quad[(k + 1) % 4]] - here, previous = positions[quad[(k + 3) % 4]] - here;
+        if (next.cross(previous).dot(axis) < 0.0) ++reversed_turns;
+      }
+      if (reversed_turns >= 2 || !diagonals_span)
+        detail::invalid_parameter(quad_name() + " corners", corners_text(quad),
+                                  "its edges cross (a bow-tie quad): list the corners in order around the quad");
+      int against = 0;
+      for (int corner : quad)
+        if (normals[corner].dot(axis) < 0.0) ++against;
+      if (against == 4)
+        detail::invalid_parameter(quad_name() + " corners", corners_text(quad),
+                                  "run clockwise seen from the side the normals point to (an inverted quad): list "
+                                  "them counter-clockwise");
+      for (int corner : quad) {
+        const double length = normals[corner].norm();
+        const double cosine = length > 0.0 ? normals[corner].dot(axis) / length : 0.0;
+        if (cosine < 0.0)
+          detail::invalid_parameter("particle " + std::to_string(corner) + " normal", normals[corner].transpose(),
+                                    "points against " + quad_name() + " (corners " + corners_text(quad) +
+                                        ") while its other corners' normals agree with it: neighbouring normals "
+                                        "must share one orientation");
+        if (length > 0.0 && cosine < in_plane_cosine)
+          detail::invalid_parameter("particle " + std::to_string(corner) + " normal", normals[corner].transpose(),
+                                    "lies (within 10°) in the plane of " + quad_name() +
+                                        ": a normal must point out of the sheet");
+      }
+    }
+  }
+  // The bounding-box diagonal of the particles: a shell's thickness lies below it.
+  double extent() const {
+    Vector3 lower = particle_position.front(), upper = lower;
+    for (const Vector3& x : particle_position) lower = lower.cwiseMin(x), upper = upper.cwiseMax(x);
+    return (upper - lower).norm();
+  }
+  static void require_thin(const std::string& name, double d, double extent) {
+    detail::require_positive(name, d);
+    if (!(d < extent))
+      detail::invalid_parameter(name, d,
+                                "must be below the shell's extent " + std::to_string(extent) +
+                                    " m (the diagonal of its particles' bounding box): a shell is thin");
+  }
+  static double median(std::vector<double> values) {
+    const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+    std::nth_element(values.begin(), middle, values.end());
+    return *middle;
+  }
+  static void check_outliers(const std::vector<double>& areas, const std::string& what) {
+    const double typical = median(areas);
+    for (std::size_t i = 0; i < areas.size(); ++i)
+      if (areas[i] > area_outlier_ratio * typical)
+        detail::invalid_parameter(what + " " + std::to_string(i) + " area", areas[i],
+                                  "is " + std::to_string(areas[i] / typical) + " times the median " +
+                                      std::to_string(typical) + " m²; at most " + std::to_string(area_outlier_ratio) +
+                                      " times: the support radius follows the largest spacing, so one large area "
+                                      "widens every row");
+  }
+  // The sheet spans a surface: not one line; a flat sheet's normals point out of its plane.
+  void check_spans_a_surface() const {
+    Vector3 mean = Vector3::Zero();
+    for (const Vector3& x : particle_position) mean += x;
+    mean /= static_cast<double>(particle_position.size());
+    Matrix3 scatter = Matrix3::Zero();
+    for (const Vector3& x : particle_position) scatter += (x - mean) * (x - mean).transpose();
+    const Eigen::SelfAdjointEigenSolver<Matrix3> principal(scatter);
+    const Vector3 spread = principal.eigenvalues().cwiseMax(0.0).cwiseSqrt();  // ascending
+    if (!(spread[1] > collinear_fraction * spread[2]))
+      detail::invalid_parameter("particle positions", "(all on one line)",
+                                "a shell needs particles spanning a surface, at least 3 not on one line");
+    if (spread[0] > planar_fraction * spread[2]) return;
+    const Vector3 plane_normal = principal.eigenvectors().col(0);
+    auto check = [&](const std::vector<Vector3>& normals, const std::string& what) {
+      for (std::size_t i = 0; i < normals.size(); ++i)
+        if (std::abs(normals[i].dot(plane_normal)) < in_plane_cosine)
+          detail::invalid_parameter(what + " " + std::to_string(i) + " normal", normals[i].transpose(),
+                                    "lies (within 10°) in the plane of the flat sheet: a normal must point out of "
+                                    "the sheet");
+    };
+    check(particle_normal, "particle");
+    check(stress_point_normal, "stress point");
+  }
+  // Each particle's normal agrees in orientation with its nearest stress point's.
+  void check_orientation() const {
+    // The nearest stress point of a grid lies within 0.71 spacings; a particle
+    // with none within one spacing is not checked.
+    const double reach = std::sqrt(*std::max_element(stress_point_area.begin(), stress_point_area.end()));
+    const approx::CellList stress_points(stress_point_position, reach);
+    for (std::size_t i = 0; i < particle_count(); ++i) {
+      int nearest_point = -1;
+      double nearest_distance = std::numeric_limits<double>::infinity();
+      stress_points.for_each_within(particle_position[i], reach, [&](int p, double distance_squared) {
+        if (distance_squared < nearest_distance) nearest_distance = distance_squared, nearest_point = p;
+      });
+      if (nearest_point >= 0 && particle_normal[i].dot(stress_point_normal[nearest_point]) < 0.0)
+        detail::invalid_parameter("particle " + std::to_string(i) + " normal", particle_normal[i].transpose(),
+                                  "points against the normal (" +
+                                      vector_text(stress_point_normal[nearest_point]) + ") of the nearest stress point " +
+                                      std::to_string(nearest_point) +
+                                      ": neighbouring normals must share one orientation");
+    }
+  }
+  static std::string vector_text(const Vector3& v) {
+    std::ostringstream text;
+    text << v.transpose();
+    return text.str();
+  }
+  // No two particles closer than coincident_spacing_fraction × √A_i.
+  void check_separation() const {
+    // Cells about one spacing wide: a few particles each (cells as narrow as
+    // the tolerance would be mostly empty and slow to search).
+    double reach = 0.0;
+    for (double area : particle_area) reach = std::max(reach, std::sqrt(area));
+    const approx::CellList particles(particle_position, reach);
+    for (std::size_t i = 0; i < particle_count(); ++i) {
+      const double limit = coincident_spacing_fraction * std::sqrt(particle_area[i]);
+      particles.for_each_within(particle_position[i], limit, [&](int j, double distance_squared) {
+        if (static_cast<std::size_t>(j) <= i) return;
+        detail::invalid_parameter(
+            "distance between particles " + std::to_string(i) + " and " + std::to_string(j),
+            std::sqrt(distance_squared),
+            "must be at least " + std::to_string(coincident_spacing_fraction) + " of the local spacing √A = " +
+                std::to_string(std::sqrt(particle_area[i])) + " m: near-coincident particles (merge them)");
+      });
+    }
+  }
+  void check_area_sums() const {
+    double particles = 0.0, stress_points = 0.0;
+    for (double area : particle_area) particles += area;
+    for (double area : stress_point_area) stress_points += area;
+    if (std::abs(particles - stress_points) > area_sum_tolerance * std::max(particles, stress_points))
+      detail::invalid_parameter("sum of the particle areas", particles,
+                                "must equal the sum of the stress point areas " + std::to_string(stress_points) +
+                                    " m² within " + std::to_string(100.0 * area_sum_tolerance) +
+                                    " %: each set of areas covers the mid-surface once");
+  }
+
   static void require_count(const char* name, int value, int minimum) {
     if (value < minimum)
       detail::invalid_parameter(name, value, "must be at least " + std::to_string(minimum));
@@ -505,11 +734,6 @@ class ShellModel {
     const bool triangle = !cells_.empty() && cells_[p].is_triangle();
     return triangle ? 2.0 * stress_point_area[p] : stress_point_area[p];
   }
-  static void check_quad(const Quad& quad, std::size_t particle_count) {
-    for (int corner : quad)
-      if (corner < 0 || static_cast<std::size_t>(corner) >= particle_count)
-        detail::invalid_parameter("quad corner index", corner, "out of range");
-  }
   static int nearest(const std::vector<Vector3>& points, const Vector3& point) {
     int best = 0;
     double best_distance = (points[0] - point).squaredNorm();
@@ -535,8 +759,22 @@ class ShellModel {
     if (stress_point_normal.size() != m || stress_point_area.size() != m)
       detail::invalid_parameter("stress point array sizes", stress_point_normal.size(),
                                 "positions, normals and areas must have the same length");
+    // Particle and stress point numbers are int (sets, quads, neighbour lists).
+    constexpr auto largest_index = static_cast<std::size_t>(std::numeric_limits<int>::max());
+    if (n > largest_index || m > largest_index)
+      detail::invalid_parameter("particle and stress point counts", std::to_string(n) + " and " + std::to_string(m),
+                                "must be at most 2^31 - 1 each (the library's indices are int)");
+    if (n < 3)
+      detail::invalid_parameter("particle count", n, "a shell needs at least 3 particles, not on one line");
     normalize_all(particle_position, particle_normal, particle_area, "particle");
     normalize_all(stress_point_position, stress_point_normal, stress_point_area, "stress point");
+    check_spans_a_surface();
+    require_thin("thickness", thickness_, extent());
+    check_outliers(stress_point_area, "stress point");
+    check_outliers(particle_area, "particle");
+    check_area_sums();
+    check_orientation();
+    check_separation();
   }
   static void normalize_all(const std::vector<Vector3>& positions, std::vector<Vector3>& normals,
                             const std::vector<double>& areas, const std::string& what) {

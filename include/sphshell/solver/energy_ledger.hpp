@@ -45,9 +45,10 @@ namespace solver {
 class EnergyLedger {
  public:
   // The balance is checked every check_interval steps (the elastic energy
-  // costs a pass over all states), from step first_checked_step on (the
+  // costs a pass over all states: about 2 % of a step's time when checked
+  // every step, on the square plate), from step first_checked_step on (the
   // start-up half step and the first steps carry no balance yet).
-  static constexpr long check_interval = 16;
+  static constexpr long check_interval = 4;
   static constexpr long first_checked_step = 21;
   // Below the energy of this strain throughout the shell the sums are
   // round-off (e.g. before a travelling load arrives) and carry no balance.
@@ -132,6 +133,12 @@ class EnergyLedger {
       message << "energy balance lost (kinetic " << e.kinetic << " J, internal " << e.internal
               << " J, external work " << e.external_work << " J, balance " << e.balance()
               << " J); reduce the time step or check the loads";
+      // The particle holding the most kinetic energy is where a run that blows up is going.
+      if (!kinetic_term_.empty()) {
+        const auto largest = std::max_element(kinetic_term_.begin(), kinetic_term_.end());
+        message << "; the largest kinetic energy is at particle " << (largest - kinetic_term_.begin()) << " ("
+                << *largest << " J)";
+      }
       detail::fail_unstable(at, message.str());
     }
   }

@@ -3,6 +3,7 @@
 // layout, visibility filtering and the Shepard fallback. A method only turns
 // the weights of one row's visible neighbours into Φ and ∇Φ.
 
+#include <sphshell/approx/memory_estimate.hpp>
 #include <sphshell/approx/neighbour_search.hpp>
 #include <sphshell/approx/shape_functions.hpp>
 #include <sphshell/core/error.hpp>
@@ -15,6 +16,7 @@
 #include <cmath>
 #include <cstddef>
 #include <exception>
+#include <new>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -46,10 +48,24 @@ inline constexpr double coincidence_tolerance_factor = 1e-9;
 // Neighbours per row reserved up front (a support of two spacings holds about 12).
 inline constexpr std::size_t expected_neighbours = 16;
 
-[[noreturn]] inline void throw_no_visible_neighbour(std::size_t eval_index) {
+// Names the cause: no particle within the support at all (the support is too
+// small for the spacing: the solver's SolverOptions::support_radius_factor, or
+// cells far longer than wide, whose spacing √A is far below their length), or
+// every candidate hidden (by cracks).
+[[noreturn]] inline void throw_no_visible_neighbour(std::size_t eval_index, const Vector3& x, double support,
+                                                    std::size_t candidates) {
   std::ostringstream message;
-  message << "sphshell: evaluation point " << eval_index
-          << " has no visible neighbour within the kernel support (shape functions undefined)";
+  message.precision(6);
+  message << "sphshell: evaluation point " << eval_index << " at (" << x.transpose()
+          << ") has no visible neighbour within the kernel support (shape functions undefined): ";
+  if (candidates == 0)
+    message << "no particle lies within the support radius " << support
+            << " m; the support is too small for the particle spacing there: raise "
+               "SolverOptions::support_radius_factor (the support radius in units of the spacing √A; allowed: "
+               "enough to reach 3 particles not on one line), or refine cells that are far longer than wide";
+  else
+    message << "all " << candidates << " particles within the support radius " << support
+            << " m are hidden (cut off by cracks)";
   throw Error(message.str());
 }
 
@@ -109,7 +125,7 @@ void compute_row(ShapeFunctions& sf, std::size_t row, const std::vector<Vector3>
     else
       ws.ordered[capacity - 1 - hidden_count++] = j;
   }
-  if (visible_count == 0) throw_no_visible_neighbour(row);
+  if (visible_count == 0) throw_no_visible_neighbour(row, x, Kernel::support_radius_factor * h, capacity);
   const auto ordered_begin = ws.ordered.begin();
   std::reverse(ordered_begin + static_cast<std::ptrdiff_t>(visible_count),
                ordered_begin + static_cast<std::ptrdiff_t>(capacity));
@@ -144,7 +160,7 @@ void compute_row(ShapeFunctions& sf, std::size_t row, const std::vector<Vector3>
   // a (nearly) singular system by returning false.
   const bool linear = visible_count >= 3 && weight_sum > 0.0 && Method::solve(ws, h, phi, d1, d2);
   if (!linear) {
-    if (!(weight_sum > 0.0)) throw_no_visible_neighbour(row);
+    if (!(weight_sum > 0.0)) throw_no_visible_neighbour(row, x, Kernel::support_radius_factor * h, capacity);
     for (std::size_t k = 0; k < visible_count; ++k) {
       phi[k] = ws.weight[k] / weight_sum;
       d1[k] = 0.0;
@@ -157,10 +173,10 @@ void compute_row(ShapeFunctions& sf, std::size_t row, const std::vector<Vector3>
 }
 
 template <class Kernel, class Method, class Visible>
-ShapeFunctions build_all(const std::vector<Vector3>& particles,
-                         const std::vector<double>& volumes,
-                         const std::vector<Vector3>& eval_positions,
-                         const std::vector<TangentFrame>& eval_frames, double h, Visible& visible) {
+ShapeFunctions build_all_unguarded(const std::vector<Vector3>& particles,
+                                   const std::vector<double>& volumes,
+                                   const std::vector<Vector3>& eval_positions,
+                                   const std::vector<TangentFrame>& eval_frames, double h, Visible& visible) {
   static_assert(kernel::check_kernel<Kernel>());
   require_positive("h", h);
   check_sizes(particles.size(), volumes.size(), eval_positions.size(), eval_frames.size());
@@ -248,6 +264,29 @@ ShapeFunctions build_all(const std::vector<Vector3>& particles,
   }
   if (error) std::rethrow_exception(error);
   return sf;
+}
+
+// The build, with an allocation failure turned into an Error that names the
+// size asked for (rows, the slots expected from the particle density) and the
+// memory the machine offers.
+template <class Kernel, class Method, class Visible>
+ShapeFunctions build_all(const std::vector<Vector3>& particles, const std::vector<double>& volumes,
+                         const std::vector<Vector3>& eval_positions, const std::vector<TangentFrame>& eval_frames,
+                         double h, Visible& visible) {
+  try {
+    return build_all_unguarded<Kernel, Method>(particles, volumes, eval_positions, eval_frames, h, visible);
+  } catch (const std::bad_alloc&) {
+    double covered = 0.0;
+    for (double volume : volumes) covered += volume;
+    const double slots = static_cast<double>(eval_positions.size()) *
+                         expected_row_size(particles.size(), covered, Kernel::support_radius_factor * h);
+    std::ostringstream message;
+    message << "sphshell: out of memory building the shape functions of " << eval_positions.size()
+            << " evaluation points over " << particles.size() << " particles (std::bad_alloc): about " << slots
+            << " neighbour slots, " << format_bytes(slots * bytes_per_slot) << " with the solver's per-slot data; "
+            << format_bytes(available_memory()) << " available";
+    throw Error(message.str());
+  }
 }
 
 template <class Kernel, class Method, class Visible>

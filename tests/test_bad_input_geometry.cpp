@@ -1,0 +1,134 @@
+// Bad geometry (issue 15): each kind of inconsistent model ends in a
+// sphshell::Error naming the quad, particle or option at fault and its value,
+// at construction, instead of a misleading error later or a silent result.
+#include "bad_input_support.hpp"
+
+#include <cmath>
+#include <limits>
+
+using namespace bad_input;
+
+TEST_CASE("A particle index past the end of the thickness arrays is an Error", "[bad_input][geometry]") {
+  const ShellModel model = ShellModel::rectangular_plate(0.1, 0.1, 5, 5, 0.01);
+  require_error([&] { model.particle_thickness(999); }, {"particle index = 999", "below the count (25)"});
+  require_error([&] { model.stress_point_thickness(16); }, {"stress point index = 16"});
+}
+
+TEST_CASE("Normals in the plane of a flat sheet are named, not the support radius", "[bad_input][geometry]") {
+  GeneralPlate plate;
+  for (Vector3& n : plate.normals) n = Vector3::UnitX();
+  for (Vector3& n : plate.stress_normals) n = Vector3::UnitX();
+  require_error([&] { plate.build(); }, {"particle 0 normal", "plane of the flat sheet"});
+  QuadPlate quads;
+  for (Vector3& n : quads.normals) n = Vector3::UnitY();
+  require_error([&] { quads.build(); }, {"particle 0 normal", "plane of quad 0"});
+}
+
+TEST_CASE("A single particle and collinear particles are refused as such", "[bad_input][geometry]") {
+  require_error(
+      [] {
+        ShellModel({Vector3::Zero()}, {Vector3::UnitZ()}, {1e-4}, {Vector3(0.005, 0.005, 0)}, {Vector3::UnitZ()},
+                   {1e-4}, 0.001);
+      },
+      {"particle count = 1", "at least 3 particles"});
+  std::vector<Vector3> line, up;
+  for (int i = 0; i < 6; ++i) line.emplace_back(0.01 * i, 0.0, 0.0), up.push_back(Vector3::UnitZ());
+  require_error(
+      [&] {
+        ShellModel(line, up, std::vector<double>(6, 1e-4), {Vector3(0.025, 0.0, 0.0)}, {Vector3::UnitZ()}, {6e-4},
+                   0.001);
+      },
+      {"one line"});
+}
+
+TEST_CASE("A support too small for the spacing names support_radius_factor", "[bad_input][geometry]") {
+  SolverOptions options;
+  options.support_radius_factor = 0.5;
+  require_error([&] { ElasticSolver(ShellModel::rectangular_plate(0.1, 0.1, 6, 6, 0.01), steel, options); },
+                {"support_radius_factor", "support radius"});
+  // A plate 10⁴ times longer than wide: √(cell area) is far below the cells' length.
+  require_error([] { ElasticSolver(ShellModel::rectangular_plate(1.0, 1e-4, 11, 11, 1e-5), steel); },
+                {"support_radius_factor", "longer than wide"});
+  // 1 m × 1 nm: the particles lie on one line to round-off.
+  require_error([] { ShellModel::rectangular_plate(1.0, 1e-9, 11, 11, 1e-10); }, {"one line"});
+}
+
+TEST_CASE("Degenerate, bow-tie and missing quads are named by quad or particle", "[bad_input][geometry]") {
+  QuadPlate degenerate;
+  degenerate.positions[6] = degenerate.positions[0] + 0.5 * (degenerate.positions[1] - degenerate.positions[0]);
+  degenerate.positions[5] = degenerate.positions[0] + 0.25 * (degenerate.positions[1] - degenerate.positions[0]);
+  degenerate.quads[0] = {0, 1, 6, 5};  // four points on one line
+  require_error([&] { degenerate.build(); }, {"quad 0 area", "degenerate quad"});
+
+  QuadPlate bow_tie;
+  bow_tie.quads[5] = {bow_tie.quads[5][0], bow_tie.quads[5][1], bow_tie.quads[5][3], bow_tie.quads[5][2]};
+  require_error([&] { bow_tie.build(); }, {"quad 5 corners", "bow-tie"});
+
+  QuadPlate lonely;
+  lonely.positions.emplace_back(0.2, 0.2, 0.0);
+  lonely.normals.emplace_back(0.0, 0.0, 1.0);
+  require_error([&] { lonely.build(); }, {"particle 25", "belongs to no quad"});
+}
+
+TEST_CASE("A NaN coordinate of a from_quads model names its particle", "[bad_input][geometry]") {
+  QuadPlate plate;
+  plate.positions[4].y() = std::numeric_limits<double>::quiet_NaN();
+  require_error([&] { plate.build(); }, {"particle 4 position", "must be finite"});
+}
+
+TEST_CASE("Normals alternating in orientation are refused", "[bad_input][geometry]") {
+  QuadPlate quads(6, 6);
+  for (std::size_t i = 0; i < quads.normals.size(); i += 2) quads.normals[i] = -Vector3::UnitZ();
+  require_error([&] { quads.build(); }, {"normal", "points against quad"});
+  GeneralPlate plate;
+  for (std::size_t i = 1; i < plate.normals.size(); i += 2) plate.normals[i] = -Vector3::UnitZ();
+  require_error([&] { plate.build(); }, {"particle 1 normal", "points against", "nearest stress point"});
+}
+
+TEST_CASE("Area sets that do not cover the surface once are refused", "[bad_input][geometry]") {
+  GeneralPlate doubled_stress;
+  for (double& a : doubled_stress.stress_areas) a *= 2.0;
+  require_error([&] { doubled_stress.build(); }, {"sum of the particle areas", "covers the mid-surface once"});
+  GeneralPlate doubled_particles;
+  for (double& a : doubled_particles.areas) a *= 2.0;
+  require_error([&] { doubled_particles.build(); }, {"sum of the particle areas", "covers the mid-surface once"});
+  // The exact tributary areas pass, and reproduce the surface.
+  const ShellModel good = GeneralPlate().build();
+  double covered = 0.0;
+  for (double a : good.particle_area) covered += a;
+  CHECK(covered == Approx(0.01).epsilon(1e-12));
+}
+
+TEST_CASE("One stress-point area far above the others is refused", "[bad_input][geometry]") {
+  GeneralPlate plate;
+  plate.stress_areas[7] *= 1e4;
+  require_error([&] { plate.build(); }, {"stress point 7 area", "times the median", "at most 64"});
+}
+
+TEST_CASE("Near-coincident particles are refused", "[bad_input][geometry]") {
+  GeneralPlate plate;
+  plate.positions[8] = plate.positions[7] + Vector3(1e-7, 0.0, 0.0);
+  require_error([&] { plate.build(); }, {"particles 7 and 8", "near-coincident"});
+}
+
+TEST_CASE("Repeated corners and clockwise quads are named by quad", "[bad_input][geometry]") {
+  QuadPlate repeated;
+  repeated.quads[0] = {0, 0, 1, 6};
+  require_error([&] { repeated.build(); }, {"quad 0 corners", "{0, 0, 1, 6}", "listed twice"});
+  QuadPlate clockwise;
+  for (Quad& q : clockwise.quads) std::swap(q[1], q[3]);
+  require_error([&] { clockwise.build(); }, {"quad 0 corners", "clockwise"});
+}
+
+TEST_CASE("A thickness beyond the shell's extent is refused", "[bad_input][geometry]") {
+  require_error([] { ShellModel::rectangular_plate(0.1, 0.1, 11, 11, 10.0); }, {"thickness = 10", "extent"});
+  ShellModel model = ShellModel::rectangular_plate(0.1, 0.1, 11, 11, 0.01);
+  require_error([&] { model.set_particle_thickness(3, 5.0); }, {"particle 3 thickness = 5", "extent"});
+}
+
+TEST_CASE("The builders' models pass the new checks", "[bad_input][geometry]") {
+  CHECK_NOTHROW(ShellModel::rectangular_plate(0.5, 0.5, 51, 51, 0.01));
+  CHECK_NOTHROW(ShellModel::spherical_cap(1.0, 0.5, 21, 0.01));
+  CHECK_NOTHROW(ShellModel::cylindrical_panel(0.1, 0.3, 2 * M_PI, 3, 3, 0.001));
+  CHECK_NOTHROW(ShellModel::cylindrical_panel(0.1, 0.3, 0.5, 4, 30, 0.001));
+}
