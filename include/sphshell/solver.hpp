@@ -197,8 +197,8 @@ class Solver {
       detail::invalid_parameter("stress point index", stress_point, "out of range");
     output_.add_probe(csv_path, typename Output::StressProbe{stress_point}, *this);
   }
-  // Writes one ParaView frame now (particles and stress points), whatever the
-  // output interval; requires output_directory.
+  // Writes one ParaView frame now (particles, stress points and cracks),
+  // whatever the output interval; requires output_directory.
   void write_frame() { output_.write_frame(*this); }
 
   // A pre-crack: a polyline on the shell (reference coordinates). Pairs across
@@ -253,7 +253,9 @@ class Solver {
     output_.write_scheduled(*this);
   }
 
-  // Steps until time t_end, calling observer(*this) after every step.
+  // Steps until time t_end (the step nearest it: the run stops within half a
+  // step of t_end), calling observer(*this) after every step. With frames on
+  // (OutputOptions), the last state is a frame, whether or not one was due.
   // The progress line (MonitoringOptions) then reports the share done and the time left.
   template <class Observer>
   void run_until(double t_end, Observer&& observer) {
@@ -263,6 +265,7 @@ class Solver {
       step();
       observer(*this);
     }
+    output_.finish(*this);
     progress_.end_run();
   }
   void run_until(double t_end) {
