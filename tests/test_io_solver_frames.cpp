@@ -120,6 +120,42 @@ TEST_CASE("Frames draw the shell as cells; removed stress points leave gaps", "[
   CHECK(cracks.array("Cells", "types").values == std::vector<double>(cracks.cells(), 3.0));  // VTK_LINE
 }
 
+TEST_CASE("A slit between particle rows shows: the cells it cuts become vertices", "[io][output][frames]") {
+  // The pre-crack x = 0.1025 runs between the particle column x = 0.10 and the
+  // stress-point column x = 0.105: it removes no stress point, but cuts the
+  // ten cells of that column (their stress points no longer see the corners
+  // at x = 0.10).
+  ScratchDirectory scratch("frames_slit");
+  const std::string directory = (scratch / "frames").string();
+  CrackSolver solver(ShellModel::rectangular_plate(0.2, 0.1, 21, 11, 0.005), steel, exact_frames(directory));
+  solver.add_precrack({Vector3(0.1025, -0.002, 0.0), Vector3(0.1025, 0.102, 0.0)});
+  REQUIRE(solver.precrack_stress_point_count() == 0);
+  solver.run_until(1e-5);
+  const ShellModel& model = solver.model();
+  std::vector<double> cut, drawn_types, drawn_indices;
+  for (std::size_t s = 0; s < solver.stress_point_count(); ++s)
+    if (std::abs(model.stress_point_position[s].x() - 0.105) < 1e-9) cut.push_back(static_cast<double>(s));
+    else drawn_indices.push_back(static_cast<double>(s));
+  REQUIRE(cut.size() == 10);
+  const test_support::Vtu stress = test_support::read_vtu(last_frame(directory, "stress_points"));
+  CHECK(stress.cells() == 200);
+  std::vector<double> types(190, 9.0);
+  types.insert(types.end(), 10, 1.0);  // the cut ones as vertices, after the quads
+  CHECK(stress.array("Cells", "types").values == types);
+  std::vector<double> order = drawn_indices;
+  order.insert(order.end(), cut.begin(), cut.end());
+  CHECK(stress.array("CellData", "stress_point").values == order);
+  // The vertices sit at the stress points, after the particles.
+  CHECK(stress.points() == solver.particle_count() + 10);
+  const std::vector<double> points = stress.array("Points", "Points").values;
+  const std::vector<Vector3> current = solver.stress_point_positions();
+  for (std::size_t j = 0; j < cut.size(); ++j)
+    for (int c = 0; c < 3; ++c)
+      CHECK(points[3 * (solver.particle_count() + j) + std::size_t(c)] == current[std::size_t(cut[j])][c]);
+  const test_support::Vtu particles = test_support::read_vtu(last_frame(directory, "particles"));
+  CHECK(particles.cells() == 190);  // every particle is still a corner of a drawn quad
+}
+
 TEST_CASE("Reference coordinates: Warp By Vector of displacement gives the deformed shell", "[io][output][frames]") {
   ScratchDirectory scratch("frames_reference");
   const std::string directory = (scratch / "frames").string();

@@ -70,6 +70,10 @@ def boundary_edges(grid):
     return edges.GetOutput().GetNumberOfCells()
 
 
+def particles_count(directory, series):
+    return read(directory, series["particles"][0][1]).GetNumberOfPoints()
+
+
 def main(directory, stdout_file, end_time, stress_points, encoding):
     printed = open(stdout_file, encoding="utf-8").read()
     damaged = int(re.search(r"(\d+) damaged stress points", printed).group(1))
@@ -93,6 +97,11 @@ def main(directory, stdout_file, end_time, stress_points, encoding):
     check(damaged > 0, f"the run fractured: {damaged} damaged stress points printed")
     check(removed == damaged,
           f"last frame: {last.GetNumberOfCells()} cells, {removed} removed = the {damaged} damaged stress points")
+    quads = sum(1 for c in range(last.GetNumberOfCells()) if last.GetCellType(c) == VTK_QUAD)
+    vertices = sum(1 for c in range(last.GetNumberOfCells()) if last.GetCellType(c) == VTK_VERTEX)
+    check(quads + vertices == last.GetNumberOfCells() and vertices == last.GetNumberOfPoints() - particles_count(directory, series),
+          f"last frame: {quads} quads and {vertices} vertex cells (stress points whose cell a crack cuts, "
+          f"each at a point after the particles)")
     kept = last.GetCellData().GetArray("stress_point")
     kept_indices = {int(kept.GetTuple1(c)) for c in range(kept.GetNumberOfTuples())}
     check(len(kept_indices) == last.GetNumberOfCells() and max(kept_indices) < stress_points,

@@ -8,12 +8,15 @@
 // A frame draws the shell as its cells (ShellModel::cells(): the quads or
 // triangles whose centres are the stress points), so ParaView's default
 // Surface view shows a surface:
-//   particles_N.vtu      the particles as the corners of the active cells
-//                        (plus a vertex cell for a particle no active cell
-//                        holds), with the particle data as point data;
+//   particles_N.vtu      the particles as the corners of the same cells
+//                        (plus a vertex cell for a particle none holds), with
+//                        the particle data as point data;
 //   stress_points_N.vtu  one cell per active stress point over its corner
 //                        particles, with the stress-point data as cell data; a
-//                        removed stress point has no cell, so a crack is a gap;
+//                        removed stress point has no cell, so a crack is a gap,
+//                        and one whose cell a crack cuts (it no longer sees a
+//                        corner) is a vertex cell at its own position, so that
+//                        a slit between rows of particles shows as a gap too;
 //   cracks_N.vtu         the crack segments as lines.
 // A model from the general constructor has no cells: its frames are point
 // clouds (one vertex cell per particle, and per active stress point).
@@ -32,6 +35,7 @@
 //   template <class Solver> std::vector<double> row(const Solver&) const;
 
 #include <sphshell/core/error.hpp>
+#include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/io/csv_probe.hpp>
 #include <sphshell/io/pvd_collection.hpp>
@@ -240,10 +244,15 @@ class SolverOutput {
     std::string key;
   };
 
-  // The points of a frame and what was added to the reference to get them.
+  // The points of a frame and what was added to the reference to get them,
+  // and how each stress point is drawn: the active ones whose cell no crack
+  // cuts as that cell (`drawn`), the active ones whose cell a crack cuts as a
+  // vertex at the stress point (`cut`), both in index order.
   struct FramePoints {
     std::vector<Vector3> particles;
     std::vector<Vector3> particle_displacement;
+    std::vector<int> drawn;
+    std::vector<int> cut;
   };
 
   bool writes_frames() const { return !options_.output_directory.empty() && options_.output_interval > 0.0; }
@@ -365,18 +374,45 @@ class SolverOutput {
     points.particle_displacement.resize(n);
     for (std::size_t i = 0; i < n; ++i) points.particle_displacement[i] = solver.displacement(static_cast<int>(i));
     points.particles = deformed() ? solver.positions() : solver.model().particle_position;
+    const bool with_cells = !solver.model().cells().empty();
+    for (std::size_t p = 0; p < solver.stress_point_count(); ++p) {
+      const int s = static_cast<int>(p);
+      if (solver.is_removed(s)) continue;
+      (with_cells && is_cut(solver, p) ? points.cut : points.drawn).push_back(s);
+    }
     return points;
   }
 
-  // The active stress points' cells (triangles, quads) over the particles.
+  // Whether a crack runs through stress point p's cell: p no longer sees one
+  // of its corners (the crack policy's visibility, in the reference
+  // configuration, as for the shape functions). Drawn whole, such a cell
+  // would bridge the crack, a slit between particle rows would not show.
   template <class Solver>
-  static void add_active_cells(const Solver& solver, io::VtuCells& cells, std::vector<char>* covered) {
+  static bool is_cut(const Solver& solver, std::size_t p) {
+    if constexpr (Solver::crack_type::enabled) {
+      const auto& crack = solver.crack();
+      if (crack.segments().empty()) return false;
+      const ShellModel& model = solver.model();
+      const TangentFrame frame = tangent_frame(model.stress_point_normal[p]);
+      for (const int corner : model.cells()[p])
+        if (!crack.visible(model.stress_point_position[p], model.particle_position[std::size_t(corner)], frame))
+          return true;
+    }
+    (void)solver;
+    (void)p;
+    return false;
+  }
+
+  // The drawn stress points' cells (triangles, quads) over the particles.
+  template <class Solver>
+  static void add_drawn_cells(const Solver& solver, const FramePoints& points, io::VtuCells& cells,
+                              std::vector<char>* covered) {
     const std::vector<Cell>& model_cells = solver.model().cells();
-    for (std::size_t s = 0; s < model_cells.size(); ++s) {
-      if (solver.is_removed(static_cast<int>(s))) continue;
-      cells.add_polygon(model_cells[s].begin(), model_cells[s].end());
+    for (const int s : points.drawn) {
+      const Cell& cell = model_cells[std::size_t(s)];
+      cells.add_polygon(cell.begin(), cell.end());
       if (covered)
-        for (const int corner : model_cells[s]) (*covered)[std::size_t(corner)] = 1;
+        for (const int corner : cell) (*covered)[std::size_t(corner)] = 1;
     }
   }
 
@@ -387,7 +423,7 @@ class SolverOutput {
     grid.time = solver.time();
     grid.points = points.particles;
     std::vector<char> covered(n, 0);
-    add_active_cells(solver, grid.cells, &covered);
+    if (!solver.model().cells().empty()) add_drawn_cells(solver, points, grid.cells, &covered);
     for (std::size_t i = 0; i < n; ++i)
       if (!covered[i]) grid.cells.add_vertex(static_cast<int>(i));
     std::vector<Vector3> rotation_values(n);
@@ -402,8 +438,9 @@ class SolverOutput {
     }
     grid.note = note(solver.model().cells().empty()
                          ? "the particles, one vertex cell each (the model has no cells)."
-                         : "the particles with the active cells over them (a particle no active cell holds is a "
-                           "vertex cell); particle data as point data.",
+                         : "the particles with the cells of the active stress points over them, but for cells a "
+                           "crack cuts (a particle no such cell holds is a vertex cell); particle data as point "
+                           "data.",
                      solver.time());
     return grid;
   }
@@ -418,15 +455,21 @@ class SolverOutput {
     const bool with_cells = !model.cells().empty();
     io::VtuGrid grid;
     grid.time = solver.time();
-    std::vector<int> active;
-    for (std::size_t s = 0; s < m; ++s)
-      if (!solver.is_removed(static_cast<int>(s))) active.push_back(static_cast<int>(s));
+    // Cell data follow the cells: the drawn stress points, then the cut ones.
+    std::vector<int> active = points.drawn;
+    active.insert(active.end(), points.cut.begin(), points.cut.end());
+    const std::vector<Vector3> current = solver.stress_point_positions();
     if (with_cells) {
       grid.points = points.particles;
-      add_active_cells(solver, grid.cells, nullptr);
-      grid.point_fields = {vector_field("displacement", points.particle_displacement)};
+      add_drawn_cells(solver, points, grid.cells, nullptr);
+      std::vector<Vector3> displacement = points.particle_displacement;
+      for (const int s : points.cut) {
+        grid.cells.add_vertex(static_cast<int>(grid.points.size()));
+        grid.points.push_back(deformed() ? current[std::size_t(s)] : model.stress_point_position[std::size_t(s)]);
+        displacement.push_back(current[std::size_t(s)] - model.stress_point_position[std::size_t(s)]);
+      }
+      grid.point_fields = {vector_field("displacement", displacement)};
     } else {
-      const std::vector<Vector3> current = solver.stress_point_positions();
       std::vector<Vector3> displacement(m);
       for (std::size_t s = 0; s < m; ++s) displacement[s] = current[s] - model.stress_point_position[s];
       grid.points = deformed() ? current : model.stress_point_position;
@@ -461,9 +504,11 @@ class SolverOutput {
     const std::string heights =
         " Through-thickness points are named by their height zeta along the director as a fraction of the wall "
         "thickness d: bottom (zeta < 0, the side the director points away from) to top (zeta > 0).";
-    grid.note = note((with_cells ? std::string("one cell per active stress point over its corner particles; a "
-                                               "removed stress point has no cell, so cracks show as gaps; "
-                                               "stress-point data as cell data.")
+    grid.note = note((with_cells ? std::string("one cell per active stress point over its corner particles (the "
+                                               "first points are the particles); a removed stress point has no "
+                                               "cell, so cracks show as gaps; a stress point whose cell a crack "
+                                               "cuts is a vertex cell at its own position (points after the "
+                                               "particles), so slits show too; stress-point data as cell data.")
                                  : std::string("the stress points, a vertex cell per active one (the model has no "
                                                "cells); stress-point data as cell data.")) +
                          heights,
