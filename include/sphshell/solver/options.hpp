@@ -83,9 +83,10 @@ struct OutputOptions {
   // particles.pvd, stress_points.pvd and cracks.pvd inside output_directory
   // (created if missing). The shell is drawn as its cells (ShellModel::cells()):
   // the particle file carries point data, the stress-point file one cell per
-  // stress point with its data; a removed stress point's cell is left out, so
-  // cracks show as gaps. A directory used before loses its earlier frames
-  // (particles_*.vtu, stress_points_*.vtu, cracks_*.vtu, the three .pvd and
+  // stress point with its data; a removed stress point's cell is left out and
+  // a cell a crack cuts is drawn as a vertex at its stress point, so cracks
+  // show as gaps (solver/output.hpp has the details). A directory used before
+  // loses its earlier frames (particles_*.vtu, stress_points_*.vtu, cracks_*.vtu, the three .pvd and
   // their .tmp files) when the first frame is written; other files stay.
   // output_interval > 0 needs an output_directory; with a directory and an
   // interval of 0, frames are written only by Solver::write_frame().
