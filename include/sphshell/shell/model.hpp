@@ -385,15 +385,17 @@ class ShellModel {
   }
   static void normalize_all(const std::vector<Vector3>& positions, std::vector<Vector3>& normals,
                             const std::vector<double>& areas, const std::string& what) {
+    // The names are formed only for an error: a model of millions of
+    // particles would otherwise spend seconds building strings.
+    auto name = [&](std::size_t i, const char* quantity) { return what + " " + std::to_string(i) + " " + quantity; };
     for (std::size_t i = 0; i < positions.size(); ++i) {
-      const std::string name = what + " " + std::to_string(i);
       if (!positions[i].allFinite())
-        detail::invalid_parameter(name + " position", positions[i].transpose(), "must be finite");
+        detail::invalid_parameter(name(i, "position"), positions[i].transpose(), "must be finite");
       const double length = normals[i].norm();
       if (!(length > 0.0) || !std::isfinite(length))
-        detail::invalid_parameter(name + " normal length", length, "must be finite and non-zero");
+        detail::invalid_parameter(name(i, "normal length"), length, "must be finite and non-zero");
       normals[i] /= length;
-      detail::require_positive(name + " area", areas[i]);
+      if (!(areas[i] > 0.0) || !std::isfinite(areas[i])) detail::require_positive(name(i, "area"), areas[i]);
     }
   }
 
