@@ -13,14 +13,22 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <random>
 #include <string>
+#include <thread>
 #include <vector>
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 using namespace sphshell;
 namespace fs = std::filesystem;
@@ -415,4 +423,67 @@ TEST_CASE("Periodic checkpoints: every N steps, atomically replaced", "[checkpoi
   negative.checkpoint_path = options.checkpoint_path;
   negative.checkpoint_every_steps = -1;
   CHECK_THROWS_WITH(J2Solver(j2_plate(), mild_steel, negative), Catch::Contains("checkpoint_every_steps"));
+}
+
+TEST_CASE("Periodic checkpoints by wall-clock time", "[checkpoint][solver]") {
+  ScratchDirectory scratch("checkpoint_wall_clock");
+  SolverOptions options;
+  options.checkpoint_path = (scratch / "timed.ckpt").string();
+  options.checkpoint_every_seconds = 1e-9;  // due after every step
+  J2Solver solver(j2_plate(), mild_steel, options);
+  set_up_j2(solver);
+  steps(solver, 3);
+  CHECK(J2Solver::from_checkpoint(options.checkpoint_path, j2_plate(), mild_steel).steps() == 3);
+  // An hour apart: none in a few steps.
+  options.checkpoint_path = (scratch / "hourly.ckpt").string();
+  options.checkpoint_every_seconds = 3600.0;
+  J2Solver hourly(j2_plate(), mild_steel, options);
+  steps(hourly, 3);
+  CHECK_FALSE(fs::exists(options.checkpoint_path));
+}
+
+// The child of the kill test: saves a checkpoint after every step until killed.
+TEST_CASE("kill child: checkpoints after every step until killed", "[.kill_child]") {
+  const char* path = std::getenv("SPHSHELL_CHECKPOINT_KILL_PATH");
+  if (path == nullptr) return;
+  SolverOptions options;
+  options.checkpoint_path = path;
+  options.checkpoint_every_steps = 1;
+  J2Solver solver(j2_plate(), mild_steel, options);
+  solver.clamp(solver.model().set("boundary"));
+  solver.add_uniform_pressure(solver.model().all_particles(), 1e5);  // elastic: runs as long as it is let
+  for (;;) solver.step();
+}
+
+TEST_CASE("Killed while writing checkpoints, the last one is whole", "[checkpoint][kill]") {
+  ScratchDirectory scratch("checkpoint_kill");
+  const std::string path = (scratch / "killed.ckpt").string();
+  const std::string self = fs::read_symlink("/proc/self/exe").string();
+  std::mt19937 random(20261202);
+  std::uniform_int_distribution<int> delay_ms(30, 300);
+  int loaded = 0, with_temporary = 0;
+  for (int trial = 0; trial < 12; ++trial) {
+    fs::remove(path);
+    const pid_t child = fork();
+    REQUIRE(child >= 0);
+    if (child == 0) {
+      setenv("SPHSHELL_CHECKPOINT_KILL_PATH", path.c_str(), 1);
+      execl(self.c_str(), self.c_str(), "kill child: checkpoints after every step until killed", nullptr);
+      _exit(127);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms(random)));
+    kill(child, SIGKILL);
+    int status = 0;
+    waitpid(child, &status, 0);
+    REQUIRE(WIFSIGNALED(status));
+    with_temporary += fs::exists(path + ".tmp");
+    if (!fs::exists(path)) continue;  // killed before its first checkpoint
+    J2Solver restored(j2_plate(), mild_steel);
+    REQUIRE_NOTHROW(restored.load_checkpoint(path));
+    CHECK(restored.steps() > 0);
+    ++loaded;
+  }
+  WARN("checkpoint kill test: " << loaded << " of 12 kills left a checkpoint, all loaded; " << with_temporary
+                                << " left a partial temporary");
+  CHECK(loaded > 0);
 }
