@@ -93,6 +93,22 @@ void require_bitwise_equal(const S& restarted, const S& reference) {
   CHECK(same_bits(a.balance(), b.balance()));
 }
 
+// Every file of two output folders, byte for byte; returns the file count.
+std::size_t require_same_files(const fs::path& restarted_dir, const fs::path& reference_dir) {
+  std::map<std::string, std::string> reference_files, restarted_files;
+  for (const auto& entry : fs::directory_iterator(reference_dir))
+    reference_files[entry.path().filename().string()] = file_bytes(entry.path());
+  for (const auto& entry : fs::directory_iterator(restarted_dir))
+    restarted_files[entry.path().filename().string()] = file_bytes(entry.path());
+  for (const auto& [name, bytes] : reference_files) {
+    INFO("file " << name);
+    REQUIRE(restarted_files.count(name) == 1);
+    CHECK(restarted_files[name] == bytes);
+  }
+  CHECK(restarted_files.size() == reference_files.size());
+  return reference_files.size();
+}
+
 // ---------------------------------------------------------------- J2 -----
 
 ShellModel j2_plate() { return ShellModel::rectangular_plate(0.2, 0.2, 11, 11, 0.004); }
@@ -165,21 +181,10 @@ TEST_CASE("A J2 run restarted from its checkpoint is bitwise the uninterrupted r
   require_bitwise_equal(restarted, reference);
   // Probe files continue without duplicated or missing rows, and the frames
   // (the .vtu files and the three collections) are byte for byte the same.
-  std::map<std::string, std::string> reference_files, restarted_files;
-  for (const auto& entry : fs::directory_iterator(reference_dir))
-    reference_files[entry.path().filename().string()] = file_bytes(entry.path());
-  for (const auto& entry : fs::directory_iterator(restarted_dir))
-    restarted_files[entry.path().filename().string()] = file_bytes(entry.path());
   // Two probes, two collections, and frames at t = 0, every 10 µs to 0.238 ms and the end: 25 of each.
-  CHECK(reference_files.size() == 2 + 2 + 2 * 25);
-  CHECK(reference_files.count("particles_000024.vtu") == 1);
-  for (const auto& [name, bytes] : reference_files) {
-    INFO("file " << name);
-    REQUIRE(restarted_files.count(name) == 1);
-    CHECK(restarted_files[name] == bytes);
-  }
-  CHECK(restarted_files.size() == reference_files.size());
-  const std::string centre = reference_files["centre.csv"];
+  CHECK(require_same_files(restarted_dir, reference_dir) == 2 + 2 + 2 * 25);
+  CHECK(fs::exists(reference_dir / "particles_000024.vtu"));
+  const std::string centre = file_bytes(reference_dir / "centre.csv");
   CHECK(std::count(centre.begin(), centre.end(), '\n') == 1 + 1 + total_steps);  // header, t = 0, every step
 }
 
@@ -257,22 +262,65 @@ TEST_CASE("A fracture run restarted while its cracks grow is bitwise the uninter
 
 TEST_CASE("A pre-crack is part of the checkpoint", "[checkpoint][fracture][solver]") {
   ScratchDirectory scratch("checkpoint_precrack");
-  auto build = [] {
-    CrackSolver solver(ShellModel::rectangular_plate(0.2, 0.1, 21, 11, 0.005), table_3_steel);
+  auto build = [](const fs::path& frames) {
+    SolverOptions options;
+    options.output_directory = frames.string();
+    options.output_interval = 1e-5;  // every ≈ 10 steps
+    CrackSolver solver(ShellModel::rectangular_plate(0.2, 0.1, 21, 11, 0.005), table_3_steel, options);
     solver.clamp(solver.model().set("x_min"));
     solver.prescribe_velocity(solver.model().set("x_max"), [](const Vector3&, double) { return Vector3(2.0, 0.0, 0.0); });
     return solver;
   };
-  CrackSolver reference = build();
+  // The reference writes its frames (with the crack series) and a probe into
+  // one folder; the checkpointed run into another, and goes on past the
+  // checkpoint before the restart.
+  const fs::path reference_dir = scratch / "reference", restarted_dir = scratch / "restarted";
+  CrackSolver reference = build(reference_dir);
   reference.add_precrack({Vector3(0.105, -0.002, 0.0), Vector3(0.105, 0.102, 0.0)});
-  for (int n = 0; n < 60; ++n) reference.step();
+  reference.add_stress_point_probe((reference_dir / "tip.csv").string(), 42);
+  for (int n = 0; n < 120; ++n) reference.step();
+  reference.run_until(reference.time());
   const std::string checkpoint = (scratch / "strip.ckpt").string();
-  reference.save_checkpoint(checkpoint);
-  for (int n = 0; n < 60; ++n) reference.step();
-  CrackSolver restarted = build();  // no add_precrack: the checkpoint has it
+  {
+    CrackSolver first = build(restarted_dir);
+    first.add_precrack({Vector3(0.105, -0.002, 0.0), Vector3(0.105, 0.102, 0.0)});
+    first.add_stress_point_probe((restarted_dir / "tip.csv").string(), 42);
+    for (int n = 0; n < 60; ++n) first.step();
+    first.save_checkpoint(checkpoint);
+    for (int n = 0; n < 30; ++n) first.step();
+  }
+  CrackSolver restarted = build(restarted_dir);  // no add_precrack: the checkpoint has it
   restarted.load_checkpoint(checkpoint);
+  restarted.add_stress_point_probe((restarted_dir / "tip.csv").string(), 42);
   CHECK(restarted.precrack_stress_point_count() == reference.precrack_stress_point_count());
   for (int n = 0; n < 60; ++n) restarted.step();
+  restarted.run_until(restarted.time());
+  require_bitwise_equal(restarted, reference);
+  CHECK(restarted.crack().segments() == reference.crack().segments());
+  // tip.csv, three collections and 7 frames of each series (t = 0 and every 10 µs);
+  // the killed run had gone on 30 steps (and frames) past the checkpoint.
+  CHECK(require_same_files(restarted_dir, reference_dir) == 1 + 3 + 3 * 7);
+}
+
+TEST_CASE("Resultant sections (Global) and NSPH restart bitwise too", "[checkpoint][solver]") {
+  using GlobalSolver = Solver<approx::NSPH<kernel::WendlandC2>, thickness::Global, material::LemaitreDamage>;
+  ScratchDirectory scratch("checkpoint_global");
+  auto build = [] {
+    GlobalSolver solver(j2_plate(), table_3_steel);
+    solver.clamp(solver.model().set("boundary"));
+    solver.add_uniform_pressure(solver.model().all_particles(), j2_pressure, time_function::Ramp{1e-4});
+    return solver;
+  };
+  GlobalSolver reference = build();
+  for (int n = 0; n < 300; ++n) reference.step();
+  const std::string checkpoint = (scratch / "global.ckpt").string();
+  GlobalSolver first = build();
+  for (int n = 0; n < 200; ++n) first.step();
+  first.save_checkpoint(checkpoint);
+  REQUIRE(first.equivalent_plastic_strain(5, 0) > 0.0);  // the resultant state carries plastic flow
+  GlobalSolver restarted = build();
+  restarted.load_checkpoint(checkpoint);
+  for (int n = 0; n < 100; ++n) restarted.step();
   require_bitwise_equal(restarted, reference);
 }
 
