@@ -255,29 +255,29 @@ inline io::BinaryReader read_file(const std::string& path, const std::array<std:
   if (bytes.size() < sizeof magic || std::memcmp(bytes.data(), magic, sizeof magic) != 0)
     throw Error("sphshell: " + name + " is not a sphshell checkpoint (it does not start with \"SPHSHCKP\")");
   io::BinaryReader reader(std::move(bytes), name + " (header)", sizeof magic);
-  auto truncated = [&](const Error&) -> Error {
-    return Error("sphshell: " + name + " is truncated or its header is damaged: the header does not fit in the " +
-                 std::to_string(reader.position()) + " bytes read");
+  // A field that does not fit: the file ends in its header, or a damaged
+  // length points past it.
+  auto read_header = [&](auto&... fields) {
+    try {
+      reader(fields...);
+    } catch (const Error&) {
+      throw Error("sphshell: " + name + " is truncated or its header is damaged: the header does not fit in the " +
+                  std::to_string(reader.position()) + " bytes read");
+    }
   };
   std::uint32_t version = 0;
   std::string written_by;
   std::array<std::string, 5> file_policies;
   std::uint64_t payload_size = 0, payload_checksum = 0, header_checksum = 0;
-  std::size_t header_end = 0;
-  try {
-    reader(version);
-    if (version != format_version)
-      throw Error("sphshell: " + name + " has format version " + std::to_string(version) + "; this library (" +
-                  library_version() + ") reads version " + std::to_string(format_version));
-    reader(written_by);
-    for (std::string& policy : file_policies) reader(policy);
-    reader(payload_size, payload_checksum);
-    header_end = reader.position();
-    reader(header_checksum);
-  } catch (const Error& error) {
-    if (std::string(error.what()).find("format version") != std::string::npos) throw;
-    throw truncated(error);
-  }
+  read_header(version);
+  if (version != format_version)
+    throw Error("sphshell: " + name + " has format version " + std::to_string(version) + "; this library (" +
+                library_version() + ") reads version " + std::to_string(format_version));
+  read_header(written_by);
+  for (std::string& policy : file_policies) read_header(policy);
+  read_header(payload_size, payload_checksum);
+  const std::size_t header_end = reader.position();
+  read_header(header_checksum);
   // Header checksum over everything before it, then the policies (a foreign
   // file is named as such before its size is judged), then the payload.
   const std::size_t payload_begin = reader.position();
