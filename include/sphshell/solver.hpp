@@ -353,7 +353,7 @@ class Solver {
       steps_ = static_cast<long>(steps);
       const double time = start_time_ + static_cast<double>(steps_) * time_step_;
       if (std::memcmp(&time, &time_, sizeof time) != 0)
-        in.fail("its time " + to_string(time_) + " s is not t0 + n dt = " + to_string(time) + " s");
+        in.fail("its time " + solver::number_text(time_) + " s is not t0 + n dt = " + solver::number_text(time) + " s");
       in.open_section("PART");
       particles_.load(in);
       in.close_section();

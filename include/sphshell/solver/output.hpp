@@ -180,7 +180,7 @@ class SolverOutput {
   void save(Writer& out) const {
     out(static_cast<std::int64_t>(frames_written_), static_cast<std::int64_t>(last_frame_step_), next_frame_time_,
         next_probe_time_);
-    out(options_.output_directory.empty() ? std::string() : identity_of(options_.output_directory));
+    out(options_.output_directory.empty() ? std::string() : io::identity_of(options_.output_directory));
     const bool series = particle_collection_ != nullptr;
     out(series);
     if (series)
@@ -227,7 +227,7 @@ class SolverOutput {
     crack_collection_.reset();
     frames_written_ = 0;
     const bool same_directory =
-        !options_.output_directory.empty() && directory == identity_of(options_.output_directory);
+        !options_.output_directory.empty() && directory == io::identity_of(options_.output_directory);
     if (series && same_directory) {
       frames_written_ = static_cast<long>(frames);
       restore_series(entries, Solver::crack_type::enabled);
@@ -381,7 +381,7 @@ class SolverOutput {
 
   // The number N of a frame file "<series>_N.vtu" (or its .tmp), -1 for any other name.
   static long frame_number(std::string name) {
-    if (!is_frame_file(name)) return -1;
+    if (!io::is_frame_file(name)) return -1;
     const std::string temporary = ".tmp", extension = ".vtu";
     if (name.size() > temporary.size() && name.compare(name.size() - temporary.size(), temporary.size(), temporary) == 0)
       name.resize(name.size() - temporary.size());
@@ -396,7 +396,7 @@ class SolverOutput {
   // frames the run wrote after the checkpoint (numbers from frames_written_
   // on) are removed, so the folder is as it was then.
   void restore_series(const std::array<std::vector<SeriesEntry>, 3>& entries, bool with_cracks) {
-    make_directory(options_.output_directory, "", "output_directory");
+    io::make_directory(options_.output_directory, "", "output_directory");
     particle_collection_ = std::make_unique<io::PvdCollection>(series_path("particles.pvd"), false);
     stress_point_collection_ = std::make_unique<io::PvdCollection>(series_path("stress_points.pvd"), false);
     std::vector<io::PvdCollection*> collections{particle_collection_.get(), stress_point_collection_.get()};
@@ -418,7 +418,7 @@ class SolverOutput {
     if (error)
       throw Error("sphshell: cannot list output_directory '" + options_.output_directory + "' (" + error.message() +
                   ")");
-    for (const fs::path& file : later) remove_file(file.string());
+    for (const fs::path& file : later) io::remove_file(file.string());
   }
 
   // The points of a frame and what was added to the reference to get them,
