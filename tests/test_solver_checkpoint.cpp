@@ -535,3 +535,32 @@ TEST_CASE("Killed while writing checkpoints, the last one is whole", "[checkpoin
                                 << " left a partial temporary");
   CHECK(loaded > 0);
 }
+
+namespace {
+// A stepper with a member and no save/load: such a solver steps as before,
+// but cannot be checkpointed.
+struct CountingStepper : stepper::CentralDifference {
+  long velocity_updates = 0;
+  void advance_velocities(const stepper::StepContext& context, solver::ParticleState& state,
+                          const solver::Inertia& inertia, const solver::ParticleForces& forces) {
+    ++velocity_updates;
+    CentralDifference::advance_velocities(context, state, inertia, forces);
+  }
+};
+}  // namespace
+
+TEST_CASE("Periodic checkpoints of a solver that cannot be checkpointed are refused when it is built",
+          "[checkpoint][errors]") {
+  using CountingSolver =
+      Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<3>, material::Elastic, crack::None, CountingStepper>;
+  static_assert(!CountingSolver::can_checkpoint && J2Solver::can_checkpoint && CrackSolver::can_checkpoint);
+  ScratchDirectory scratch("checkpoint_not_possible");
+  SolverOptions options;
+  options.checkpoint_path = (scratch / "never.ckpt").string();
+  options.checkpoint_every_steps = 10;
+  CHECK_THROWS_WITH(CountingSolver(j2_plate(), {210e9, 0.3}, options),
+                    Catch::Contains("checkpoint_path") && Catch::Contains("periodic checkpoints need policies"));
+  CountingSolver solver(j2_plate(), {210e9, 0.3});
+  solver.step();
+  CHECK(solver.integrator().velocity_updates == 1);
+}

@@ -92,6 +92,8 @@ class Solver {
   using MaterialParameters = typename Material::Parameters;
   // Per stress point, the thickness output points k (integral points; one for Global).
   static constexpr int output_points = Section::output_points;
+  // Whether save_checkpoint compiles for these policies (solver/checkpoint.hpp).
+  static constexpr bool can_checkpoint = solver::checkpoint::can_checkpoint<Crack, Stepper, SectionState>();
 
   Solver(ShellModel model, const MaterialParameters& parameters, SolverOptions options = {}) try
       : model_(std::move(model)),
@@ -118,6 +120,12 @@ class Solver {
       time_step_ = options_.safety_factor * stable_time_step_;
     }
     solver::check_damping(options_.damping, time_step_);
+    if (!can_checkpoint && checkpoints_.enabled())
+      detail::invalid_parameter("checkpoint_path", options_.checkpoint_path,
+                                "periodic checkpoints need policies that can be checkpointed: a material State "
+                                "that lists its fields (for_each_field), a crack policy and a stepper with state "
+                                "that have save/load (see solver/checkpoint.hpp); set checkpoint_every_steps and "
+                                "checkpoint_every_seconds to 0");
   } catch (const std::bad_alloc&) {
     // Members are gone here; the estimate check_memory made is kept for the message.
     throw Error("sphshell: out of memory building the solver (std::bad_alloc): " + solver::memory_estimate_text());
@@ -269,10 +277,11 @@ class Solver {
       throw Error(failure_);
     }
     // Outside the latch: the state is whole, a failed write leaves the solver usable.
-    if (checkpoints_.is_due(steps_)) {
-      save_checkpoint(checkpoints_.path());
-      checkpoints_.written(steps_);
-    }
+    if constexpr (can_checkpoint)
+      if (checkpoints_.is_due(steps_)) {
+        save_checkpoint(checkpoints_.path());
+        checkpoints_.written(steps_);
+      }
   }
 
   // Checkpoint and restart (solver/checkpoint.hpp has the file format). A
@@ -312,7 +321,7 @@ class Solver {
     out.end_section();
     out.begin_section("STEP");
     if constexpr (!std::is_empty_v<Stepper>) {
-      static_assert(has_checkpoint_members<Stepper>::value,
+      static_assert(solver::checkpoint::has_save_load<Stepper>::value,
                     "save_checkpoint: the stepper has members but no save/load; add `template <class Writer> void "
                     "save(Writer&) const` and `template <class Reader> void load(Reader&)` (stepper/stepper.hpp)");
       stepper_.save(out);
@@ -554,12 +563,6 @@ class Solver {
   static constexpr double negligible_rotation_sine = 1e-300;
 
   StepTime now() const { return {steps_, time_}; }
-
-  template <class Policy, class = void>
-  struct has_checkpoint_members : std::false_type {};
-  template <class Policy>
-  struct has_checkpoint_members<Policy, std::void_t<decltype(std::declval<const Policy&>().save(
-                                            std::declval<io::BinaryWriter&>()))>> : std::true_type {};
 
   static std::array<std::string, 5> policies() {
     return solver::checkpoint::policy_names<Approx, Rule, Material, Crack, Stepper>();

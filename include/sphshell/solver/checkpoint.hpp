@@ -57,7 +57,9 @@
 #include <iterator>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <typeinfo>
+#include <utility>
 #include <vector>
 
 namespace sphshell::solver::checkpoint {
@@ -89,6 +91,24 @@ std::string type_name() {
   }
 #endif
   return mangled;
+}
+
+// A policy that stores its own state: save(Writer&) const (and load(Reader&)).
+template <class Policy, class = void>
+struct has_save_load : std::false_type {};
+template <class Policy>
+struct has_save_load<Policy, std::void_t<decltype(std::declval<const Policy&>().save(std::declval<io::BinaryWriter&>()))>>
+    : std::true_type {};
+
+// Whether a Solver of these policies can be checkpointed: its stepper is
+// empty or stores itself, its section state lists its fields, and its crack
+// policy (if enabled) stores itself. save_checkpoint says at compile time
+// which is missing; periodic checkpoints of a solver that cannot are an Error
+// when it is built, so a solver that never checkpoints needs none of it.
+template <class Crack, class Stepper, class SectionState>
+constexpr bool can_checkpoint() {
+  return (std::is_empty_v<Stepper> || has_save_load<Stepper>::value) && io::is_serialisable<SectionState>() &&
+         (!Crack::enabled || has_save_load<Crack>::value);
 }
 
 inline constexpr std::array<const char*, 5> policy_roles{"approximation", "thickness rule", "material law",
@@ -324,6 +344,7 @@ class Schedule {
     last_write_ = Clock::now();
   }
   const std::string& path() const { return path_; }
+  bool enabled() const { return !path_.empty() && (every_steps_ > 0 || every_seconds_ > 0.0); }
 
  private:
   using Clock = std::chrono::steady_clock;
