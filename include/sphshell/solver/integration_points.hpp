@@ -72,6 +72,7 @@ class IntegrationPoints {
       for (std::size_t row = 0; row < count(group); ++row)
         reference_[point(group, row)] = gather(group, row, model.particle_position, model.particle_normal);
     build_slot_transpose(model.particle_count());
+    for (PointGroup group : point_groups) rebuilt_[index_of(group)].assign(count(group), 0);
   }
 
   // Points of a group, all points, and the global index of a group's row.
@@ -222,11 +223,9 @@ class IntegrationPoints {
   }
 
  private:
-  void mark_rebuilt(PointGroup group, std::size_t row) {
-    std::vector<unsigned char>& rebuilt = rebuilt_[index_of(group)];
-    if (rebuilt.size() != count(group)) rebuilt.resize(count(group), 0);
-    rebuilt[row] = 1;
-  }
+  // Rows are rebuilt in parallel: each sets its own flag, in an array sized
+  // by the constructor (never resized here).
+  void mark_rebuilt(PointGroup group, std::size_t row) { rebuilt_[index_of(group)][row] = 1; }
 
   void compute_weights(const ShellModel& model, const PhysicsOptions& physics,
                        const ParticleIntegrationOptions& particle_integration, double shear_modulus,
