@@ -28,6 +28,8 @@
 #include <sphshell/shell/constraints.hpp>
 #include <sphshell/shell/loads.hpp>
 #include <sphshell/shell/model.hpp>
+#include <sphshell/io/binary_stream.hpp>
+#include <sphshell/solver/checkpoint.hpp>
 #include <sphshell/solver/energy_ledger.hpp>
 #include <sphshell/solver/fracture.hpp>
 #include <sphshell/solver/integration_points.hpp>
@@ -45,7 +47,10 @@
 
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
+#include <cstring>
 #include <limits>
+#include <array>
 #include <memory>
 #include <new>
 #include <sstream>
@@ -87,6 +92,8 @@ class Solver {
   using MaterialParameters = typename Material::Parameters;
   // Per stress point, the thickness output points k (integral points; one for Global).
   static constexpr int output_points = Section::output_points;
+  // Whether save_checkpoint compiles for these policies (solver/checkpoint.hpp).
+  static constexpr bool can_checkpoint = solver::checkpoint::can_checkpoint<Crack, Stepper, SectionState>();
 
   Solver(ShellModel model, const MaterialParameters& parameters, SolverOptions options = {}) try
       : model_(std::move(model)),
@@ -100,7 +107,8 @@ class Solver {
         assembler_(options_.nonlinear, points_),
         ledger_(options_.monitoring(), law_.youngs_modulus(), solver::shell_volume(model_)),
         progress_(options_.monitoring()),
-        output_(options_.output()) {
+        output_(options_.output()),
+        checkpoints_(options_.output()) {
     fracture_.initialize(model_, points_);
     stable_time_step_ = solver::stable_time_step(model_, law_, options_.physics(), points_, states_);
     if (options_.time_step > 0.0) {
@@ -112,6 +120,12 @@ class Solver {
       time_step_ = options_.safety_factor * stable_time_step_;
     }
     solver::check_damping(options_.damping, time_step_);
+    if (!can_checkpoint && checkpoints_.enabled())
+      detail::invalid_parameter("checkpoint_path", options_.checkpoint_path,
+                                "periodic checkpoints need policies that can be checkpointed: a material State "
+                                "that lists its fields (for_each_field), a crack policy and a stepper with state "
+                                "that have save/load (see solver/checkpoint.hpp); set checkpoint_every_steps and "
+                                "checkpoint_every_seconds to 0");
   } catch (const std::bad_alloc&) {
     // Members are gone here; the estimate check_memory made is kept for the message.
     throw Error("sphshell: out of memory building the solver (std::bad_alloc): " + solver::memory_estimate_text());
@@ -262,6 +276,135 @@ class Solver {
       failure_ = "sphshell: out of memory (std::bad_alloc) in step " + std::to_string(steps_);
       throw Error(failure_);
     }
+    // Outside the latch: the state is whole, a failed write leaves the solver usable.
+    if constexpr (can_checkpoint)
+      if (checkpoints_.is_due(steps_)) {
+        save_checkpoint(checkpoints_.path());
+        checkpoints_.written(steps_);
+      }
+  }
+
+  // Checkpoint and restart (solver/checkpoint.hpp has the file format). A
+  // checkpoint holds the whole state between two steps: particles, every
+  // integration point's material state, strains and resultants, cracks and
+  // fragments with the shape functions they changed, the energy books, t0, the
+  // step count and Δt, the step latch, and the output and probe schedules. A
+  // solver of the same five policies, model, material and result-changing
+  // options that loads it continues bit for bit as the saving one would have.
+  // The file is replaced atomically (a kill while writing leaves the previous
+  // one whole).
+  void save_checkpoint(const std::string& path) const {
+    io::BinaryWriter out;
+    out.begin_section("IDNT");
+    out(identity());
+    out.end_section();
+    out.begin_section("TIME");
+    out(start_time_, static_cast<std::int64_t>(steps_), time_step_, time_, forces_current_, failure_);
+    out.end_section();
+    out.begin_section("PART");
+    particles_.save(out);
+    out.end_section();
+    out.begin_section("FORC");
+    forces_.save(out);
+    out.end_section();
+    out.begin_section("PNTS");
+    points_.save(out);
+    out.end_section();
+    out.begin_section("SECT");
+    states_.save(out);
+    out.end_section();
+    out.begin_section("FRAC");
+    fracture_.save(out);
+    out.end_section();
+    out.begin_section("ENRG");
+    ledger_.save(out);
+    out.end_section();
+    out.begin_section("STEP");
+    if constexpr (!std::is_empty_v<Stepper>) {
+      static_assert(solver::checkpoint::has_save_load<Stepper>::value,
+                    "save_checkpoint: the stepper has members but no save/load; add `template <class Writer> void "
+                    "save(Writer&) const` and `template <class Reader> void load(Reader&)` (stepper/stepper.hpp)");
+      stepper_.save(out);
+    }
+    out.end_section();
+    out.begin_section("OUTP");
+    output_.save(out);
+    out.end_section();
+    solver::checkpoint::write_file(path, policies(), out);
+  }
+
+  // Loads a checkpoint into this solver, which must have been built with the
+  // same policies, model, material and result-changing options (an Error
+  // names what differs, or what is wrong with the file: not a checkpoint,
+  // another format version, truncated, corrupted). Conditions and loads stay
+  // as this solver has them; pre-cracks come from the checkpoint (do not add
+  // them again). Probes already added continue their files from the
+  // checkpoint's rows; probes added later do too, when their file is one the
+  // checkpoint recorded. An Error after the file was accepted leaves the
+  // solver stopped (step() refuses).
+  void load_checkpoint(const std::string& path) {
+    io::BinaryReader in = solver::checkpoint::read_file(path, policies());
+    solver::checkpoint::Identity file;
+    in.open_section("IDNT");
+    in(file);
+    in.close_section();
+    solver::checkpoint::check_identity(file, identity(), path);
+    try {
+      // Rows a crack rebuilt here since construction go back to the model's.
+      if (points_.any_rebuilt())
+        points_ = solver::IntegrationPoints<Approx>(model_, options_.physics(), options_.particle_integration(),
+                                                    law_.shear_modulus());
+      assembler_ = solver::InternalForceAssembler(options_.nonlinear, points_);
+      std::int64_t steps = 0;
+      in.open_section("TIME");
+      in(start_time_, steps, time_step_, time_, forces_current_, failure_);
+      in.close_section();
+      steps_ = static_cast<long>(steps);
+      const double time = start_time_ + static_cast<double>(steps_) * time_step_;
+      if (std::memcmp(&time, &time_, sizeof time) != 0)
+        in.fail("its time " + solver::number_text(time_) + " s is not t0 + n dt = " + solver::number_text(time) + " s");
+      in.open_section("PART");
+      particles_.load(in);
+      in.close_section();
+      in.open_section("FORC");
+      forces_.load(in);
+      in.close_section();
+      in.open_section("PNTS");
+      points_.load(in, model_.particle_count());
+      in.close_section();
+      in.open_section("SECT");
+      states_.load(in);
+      in.close_section();
+      in.open_section("FRAC");
+      fracture_.load(in);
+      in.close_section();
+      in.open_section("ENRG");
+      ledger_.load(in);
+      in.close_section();
+      in.open_section("STEP");
+      if constexpr (!std::is_empty_v<Stepper>) stepper_.load(in);
+      in.close_section();
+      in.open_section("OUTP");
+      output_.load(in, *this);
+      in.close_section();
+      if (!in.at_end()) in.fail("there are bytes after its last section");
+    } catch (const Error& error) {
+      failure_ = std::string("sphshell: loading a checkpoint failed part-way, so this solver's state is mixed and it "
+                             "cannot step; the error was: ") +
+                 error.what();
+      throw;
+    }
+    checkpoints_.written(steps_);
+  }
+
+  // A solver built from a checkpoint: the model, material and options as for
+  // the run that wrote it, the state from the file. Then give the conditions,
+  // loads and probes as for that run (not its pre-cracks: they are in the file).
+  static Solver from_checkpoint(const std::string& path, ShellModel model, const MaterialParameters& parameters,
+                                SolverOptions options = {}) {
+    Solver solver(std::move(model), parameters, std::move(options));
+    solver.load_checkpoint(path);
+    return solver;
   }
 
  private:
@@ -420,6 +563,22 @@ class Solver {
   static constexpr double negligible_rotation_sine = 1e-300;
 
   StepTime now() const { return {steps_, time_}; }
+
+  static std::array<std::string, 5> policies() {
+    return solver::checkpoint::policy_names<Approx, Rule, Material, Crack, Stepper>();
+  }
+  // What a checkpoint must agree on with the solver loading it.
+  solver::checkpoint::Identity identity() const {
+    solver::checkpoint::Identity id;
+    id.counts = {{"particle count", static_cast<std::uint64_t>(model_.particle_count())},
+                 {"stress point count", static_cast<std::uint64_t>(model_.stress_point_count())},
+                 {"integration point count", static_cast<std::uint64_t>(points_.size())},
+                 {"shape-function slot count", static_cast<std::uint64_t>(points_.slot_count())}};
+    id.model = solver::checkpoint::model_fingerprints(model_);
+    id.material = solver::checkpoint::material_constants(law_);
+    id.options = solver::checkpoint::result_options(options_, time_step_);
+    return id;
+  }
   Parts fracture_parts() { return Parts{model_, particles_, points_, states_, assembler_, forces_}; }
 
   // A set's indices in range and each listed once (solver/run_checks.hpp).
@@ -474,6 +633,7 @@ class Solver {
   solver::EnergyLedger ledger_;
   solver::ProgressReporter progress_;
   Output output_;
+  solver::checkpoint::Schedule checkpoints_;
   Stepper stepper_;
   detail::Constraints constraints_;
   ExternalLoads loads_;

@@ -14,6 +14,15 @@
 // default-constructible. check_crack_policy asserts each. LineSegments adds
 // introspection for users (is_damaged, damaged_count, crack_count,
 // total_length, crack_lengths, empty). crack::None has none of them.
+//
+// Checkpoints (solver/checkpoint.hpp): an enabled policy whose solver is
+// checkpointed also provides
+//   template <class Writer> void save(Writer&) const;
+//   template <class Reader> void load(Reader&);
+// storing everything its answers depend on (topology, counters) and
+// rebuilding its search structures on load, so that a restored run asks and
+// gets the same answers bit for bit. save_checkpoint names a policy without
+// them at compile time.
 
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>

@@ -33,6 +33,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -45,6 +46,11 @@ struct Segment {
   int start_point;
   int end_point;
   int crack_id;
+  // The fields a checkpoint stores (crack.hpp).
+  template <class S, class F>
+  static void for_each_field(S& self, F&& field) {
+    field(self.start_point, self.end_point, self.crack_id);
+  }
 };
 
 inline bool operator==(const Segment& left, const Segment& right) {
@@ -402,6 +408,37 @@ class LineSegments {
     return lengths;
   }
   bool empty() const { return segments_.empty(); }
+
+  // Checkpoints (crack.hpp): the topology and counters; the geometry given to
+  // initialize() is the model's, and the segment index is rebuilt from the
+  // segments (its answers depend on them and on max_segment_length_ only).
+  template <class Writer>
+  void save(Writer& out) const {
+    out(crack_point_of_stress_point_, static_cast<std::uint64_t>(damaged_count_), points_, crack_of_point_, segments_,
+        crack_id_count_, precracks_, max_segment_length_);
+  }
+  template <class Reader>
+  void load(Reader& in) {
+    require_initialized("load");
+    std::uint64_t damaged = 0;
+    in.read_exact(crack_point_of_stress_point_, "crack point of each stress point");
+    in(damaged, points_, crack_of_point_, segments_, crack_id_count_, precracks_, max_segment_length_);
+    damaged_count_ = static_cast<std::size_t>(damaged);
+    // The indices must point into the arrays (the checksum vouches for the
+    // bytes, this for the meaning).
+    const auto point_count = static_cast<int>(points_.size());
+    if (crack_of_point_.size() != points_.size()) in.fail("crack ids and crack points differ in number");
+    for (const int point : crack_point_of_stress_point_)
+      if (point < -1 || point >= point_count) in.fail("a stress point names crack point " + std::to_string(point));
+    for (const int id : crack_of_point_)
+      if (id < 0 || id >= crack_id_count_) in.fail("a crack point names crack " + std::to_string(id));
+    for (const Segment& segment : segments_)
+      if (segment.start_point < 0 || segment.start_point >= point_count || segment.end_point < 0 ||
+          segment.end_point >= point_count || segment.crack_id < 0 || segment.crack_id >= crack_id_count_)
+        in.fail("a crack segment names a point or crack that does not exist");
+    segment_index_.reset();
+    if (!segments_.empty() || !precracks_.empty()) rebuild_segment_index();
+  }
 
  private:
   // Whether every vertex and piece midpoint of `polyline` lies on `earlier`.

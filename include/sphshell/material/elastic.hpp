@@ -132,6 +132,11 @@ struct Elastic {
   };
   struct State {
     StressVoigt stress;
+    // The fields a checkpoint stores (material.hpp).
+    template <class S, class F>
+    static void for_each_field(S& self, F&& field) {
+      field(self.stress);
+    }
   };
   struct UpdateResult {
     bool plastic;

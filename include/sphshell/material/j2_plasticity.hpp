@@ -31,6 +31,11 @@ struct J2Plasticity {
     StressVoigt stress;
     double eps_p;    // equivalent plastic strain ε̄p
     double sigma_y;  // current yield stress σs = σs0 + Ep ε̄p
+    // The fields a checkpoint stores (material.hpp).
+    template <class S, class F>
+    static void for_each_field(S& self, F&& field) {
+      field(self.stress, self.eps_p, self.sigma_y);
+    }
   };
   struct UpdateResult {
     bool plastic;

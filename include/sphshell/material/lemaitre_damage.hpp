@@ -56,6 +56,11 @@ struct LemaitreDamage {
     double sigma_y;
     double D;
     bool failed;
+    // The fields a checkpoint stores (material.hpp).
+    template <class S, class F>
+    static void for_each_field(S& self, F&& field) {
+      field(self.stress, self.eps_p, self.sigma_y, self.D, self.failed);
+    }
   };
   struct UpdateResult {
     bool plastic;

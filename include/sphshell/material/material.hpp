@@ -23,6 +23,15 @@
 // is_material_law<Law> checks all of it; each has_* trait checks one member, and
 // check_material_law<Law>() static_asserts them one by one so a compile error
 // names the missing member.
+//
+// Checkpoints (solver/checkpoint.hpp) store each integral point's State field
+// by field. A law whose solver is checkpointed gives its State
+//   template <class S, class F> static void for_each_field(S& self, F&& field)
+//   { field(self.stress, self.eps_p, ...); }
+// listing every field (S is State or const State; fields are numbers, bools,
+// enums, Eigen fixed-size matrices or structs that list theirs the same way).
+// save_checkpoint names the State that lacks it at compile time; solvers that
+// never checkpoint do not need it.
 
 #include <sphshell/core/types.hpp>
 

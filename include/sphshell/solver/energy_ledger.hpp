@@ -126,6 +126,17 @@ class EnergyLedger {
     return report;
   }
 
+  // Checkpoints (solver/checkpoint.hpp): the books. The per-particle terms
+  // and remembered velocities are rewritten by every step before use.
+  template <class Writer>
+  void save(Writer& out) const {
+    out(previous_internal_energy_, internal_energy_, external_work_, damping_work_, kinetic_energy_);
+  }
+  template <class Reader>
+  void load(Reader& in) {
+    in(previous_internal_energy_, internal_energy_, external_work_, damping_work_, kinetic_energy_);
+  }
+
   // Whether step n is one whose balance is checked.
   static bool is_check_step(long step) { return step % check_interval == 0; }
 

@@ -21,7 +21,10 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <sstream>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace sphshell::solver {
@@ -51,10 +54,24 @@ class FractureManager {
   double released_energy() const { return 0.0; }
   bool is_fragment(std::size_t) const { return false; }
   std::size_t fragment_count() const { return 0; }
+  // Checkpoints: nothing to store.
+  template <class Writer>
+  void save(Writer&) const {}
+  template <class Reader>
+  void load(Reader&) {}
 
  private:
   Crack crack_;
 };
+
+namespace fracture_detail {
+template <class Policy, class Writer, class = void>
+struct has_checkpoint_members : std::false_type {};
+template <class Policy, class Writer>
+struct has_checkpoint_members<Policy, Writer,
+                              std::void_t<decltype(std::declval<const Policy&>().save(std::declval<Writer&>()))>>
+    : std::true_type {};
+}  // namespace fracture_detail
 
 template <class Crack>
 class FractureManager<Crack, true> {
@@ -132,6 +149,28 @@ class FractureManager<Crack, true> {
   bool is_fragment(std::size_t particle) const { return fragment_[particle] != 0; }
   std::size_t fragment_count() const {
     return static_cast<std::size_t>(std::count(fragment_.begin(), fragment_.end(), 1));
+  }
+
+  // Checkpoints (solver/checkpoint.hpp): the crack policy's topology, the
+  // fragments and the counters. The maps between stress points and particles
+  // follow from the model.
+  template <class Writer>
+  void save(Writer& out) const {
+    static_assert(fracture_detail::has_checkpoint_members<Crack, Writer>::value,
+                  "save_checkpoint: the crack policy cannot be checkpointed; add `template <class Writer> void "
+                  "save(Writer&) const` and `template <class Reader> void load(Reader&)` (crack/crack.hpp)");
+    crack_.save(out);
+    out(fragment_, static_cast<std::uint64_t>(damaged_stress_points_), static_cast<std::uint64_t>(precrack_stress_points_),
+        released_energy_);
+  }
+  template <class Reader>
+  void load(Reader& in) {
+    crack_.load(in);
+    std::uint64_t damaged = 0, precrack = 0;
+    in.read_exact(fragment_, "fragment flags");
+    in(damaged, precrack, released_energy_);
+    damaged_stress_points_ = static_cast<std::size_t>(damaged);
+    precrack_stress_points_ = static_cast<std::size_t>(precrack);
   }
 
  private:

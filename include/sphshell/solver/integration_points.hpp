@@ -21,6 +21,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -71,6 +72,7 @@ class IntegrationPoints {
       for (std::size_t row = 0; row < count(group); ++row)
         reference_[point(group, row)] = gather(group, row, model.particle_position, model.particle_normal);
     build_slot_transpose(model.particle_count());
+    for (PointGroup group : point_groups) rebuilt_[index_of(group)].assign(count(group), 0);
   }
 
   // Points of a group, all points, and the global index of a group's row.
@@ -119,9 +121,75 @@ class IntegrationPoints {
   // stays visible.
   template <class Visible>
   void rebuild_row(const ShellModel& model, PointGroup group, std::size_t row, Visible&& visible) {
+    // Flagged first: a rebuild that throws (nothing visible) leaves its row changed too.
+    mark_rebuilt(group, row);
     Approx::rebuild_row(shape_[index_of(group)], row, model.particle_position, model.particle_area,
                         positions(model, group)[row], frame(group, row), smoothing_length_, visible);
     reference_[point(group, row)] = gather(group, row, model.particle_position, model.particle_normal);
+  }
+
+  // Checkpoints (solver/checkpoint.hpp): the rows cracks rebuilt, whole (all
+  // their slots, the hidden ones too, which later rebuilds start from) with
+  // their reference gradients. Every other row is as the constructor built it
+  // from the model, which is deterministic. The slot transpose is rebuilt.
+  template <class Writer>
+  void save(Writer& out) const {
+    for (PointGroup group : point_groups) {
+      const std::vector<unsigned char>& rebuilt = rebuilt_[index_of(group)];
+      const approx::ShapeFunctions& sf = shape(group);
+      std::vector<std::uint64_t> rows;
+      for (std::size_t row = 0; row < rebuilt.size(); ++row)
+        if (rebuilt[row]) rows.push_back(row);
+      out(rows);
+      for (const std::uint64_t row : rows) {
+        const std::size_t begin = sf.row_begin[row], end = sf.row_begin[row + 1];
+        out(static_cast<std::uint64_t>(end - begin), sf.row_size[row], sf.shepard[row]);
+        for (std::size_t s = begin; s < end; ++s) out(sf.neighbour[s], sf.phi[s], sf.dphi_d1[s], sf.dphi_d2[s]);
+        const shell::SurfaceGradients& g = reference_[point(group, row)];
+        out(g.a1, g.a2, g.n, g.n1, g.n2);
+      }
+    }
+  }
+  // Whether a crack changed any row since construction (a solver loading a
+  // checkpoint then starts again from freshly built rows).
+  bool any_rebuilt() const {
+    for (const std::vector<unsigned char>& rebuilt : rebuilt_)
+      for (const unsigned char flag : rebuilt)
+        if (flag) return true;
+    return false;
+  }
+  // Into freshly built rows (any_rebuilt() false).
+  template <class Reader>
+  void load(Reader& in, std::size_t particle_count) {
+    for (PointGroup group : point_groups) {
+      approx::ShapeFunctions& sf = shape_[index_of(group)];
+      std::vector<unsigned char>& rebuilt = rebuilt_[index_of(group)];
+      rebuilt.assign(sf.rows(), 0);
+      std::vector<std::uint64_t> rows;
+      in(rows);
+      for (const std::uint64_t row : rows) {
+        if (row >= sf.rows())
+          in.fail(std::string("rebuilt ") + name_of(group) + " row " + std::to_string(row) + " out of range");
+        std::uint64_t capacity = 0;
+        in(capacity);
+        if (capacity != sf.capacity(row))
+          in.fail(std::string(name_of(group)) + " row " + std::to_string(row) + " has " + std::to_string(capacity) +
+                  " slots there and " + std::to_string(sf.capacity(row)) + " here");
+        in(sf.row_size[row], sf.shepard[row]);
+        if (sf.row_size[row] < 0 || static_cast<std::size_t>(sf.row_size[row]) > capacity)
+          in.fail(std::string(name_of(group)) + " row " + std::to_string(row) + " uses more slots than it has");
+        for (std::size_t s = sf.row_begin[row]; s < sf.row_begin[row + 1]; ++s) {
+          in(sf.neighbour[s], sf.phi[s], sf.dphi_d1[s], sf.dphi_d2[s]);
+          if (sf.neighbour[s] < 0 || static_cast<std::size_t>(sf.neighbour[s]) >= particle_count)
+            in.fail(std::string(name_of(group)) + " row " + std::to_string(row) + " names particle " +
+                    std::to_string(sf.neighbour[s]));
+        }
+        shell::SurfaceGradients& g = reference_[point(group, row)];
+        in(g.a1, g.a2, g.n, g.n1, g.n2);
+        rebuilt[row] = 1;
+      }
+    }
+    build_slot_transpose(particle_count);
   }
 
   // Slots: every (row, neighbour) entry of both groups, numbered across them.
@@ -155,6 +223,10 @@ class IntegrationPoints {
   }
 
  private:
+  // Rows are rebuilt in parallel: each sets its own flag, in an array sized
+  // by the constructor (never resized here).
+  void mark_rebuilt(PointGroup group, std::size_t row) { rebuilt_[index_of(group)][row] = 1; }
+
   void compute_weights(const ShellModel& model, const PhysicsOptions& physics,
                        const ParticleIntegrationOptions& particle_integration, double shear_modulus,
                        std::size_t stress_points, std::size_t particle_points) {
@@ -188,6 +260,7 @@ class IntegrationPoints {
   std::vector<double> membrane_bending_weight_, shear_weight_;
   std::vector<shell::SurfaceGradients> reference_;
   std::vector<std::size_t> particle_slot_begin_, particle_slots_;
+  std::array<std::vector<unsigned char>, 2> rebuilt_;  // per row: changed by a crack since construction
 };
 
 }  // namespace sphshell::solver

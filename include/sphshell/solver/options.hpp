@@ -109,6 +109,14 @@ struct OutputOptions {
   // Probes (add_particle_probe, add_stress_point_probe) write a CSV row every
   // probe_interval seconds (0: every step); each probe needs a file of its own.
   double probe_interval = 0.0;
+  // Periodic checkpoints (Solver::save_checkpoint) into checkpoint_path, after
+  // every checkpoint_every_steps-th step and/or when checkpoint_every_seconds
+  // of wall-clock time have passed since the last one (0: not on that count).
+  // Each replaces the previous one atomically. The wall clock only schedules
+  // the writes; the run's numbers never depend on it.
+  std::string checkpoint_path;
+  long checkpoint_every_steps = 0;
+  double checkpoint_every_seconds = 0.0;
 };
 
 struct SolverOptions : PhysicsOptions,
@@ -152,6 +160,13 @@ inline void validate(const SolverOptions& options) {
     detail::invalid_parameter("output_interval", options.output_interval,
                               "needs an output_directory for the frames; set one, or 0 for no frames");
   detail::require_nonnegative("probe_interval", options.probe_interval);
+  if (options.checkpoint_every_steps < 0)
+    detail::invalid_parameter("checkpoint_every_steps", options.checkpoint_every_steps, "must be >= 0 (0: not by steps)");
+  detail::require_nonnegative("checkpoint_every_seconds", options.checkpoint_every_seconds);
+  if ((options.checkpoint_every_steps > 0 || options.checkpoint_every_seconds > 0.0) && options.checkpoint_path.empty())
+    detail::invalid_parameter("checkpoint_path", "(empty)",
+                              "periodic checkpoints (checkpoint_every_steps or checkpoint_every_seconds > 0) need a "
+                              "file; set one, or set both to 0");
   const io::VtuEncoding encoding = options.frame_encoding;
   if (encoding != io::VtuEncoding::ascii && encoding != io::VtuEncoding::binary && encoding != io::VtuEncoding::zlib)
     detail::invalid_parameter("frame_encoding", static_cast<int>(encoding), "must be ascii, binary or zlib");

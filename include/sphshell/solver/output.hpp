@@ -47,6 +47,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -147,6 +148,8 @@ class SolverOutput {
     if (!options_.output_directory.empty()) io::make_directory(options_.output_directory, "", "output_directory");
   }
 
+  // A probe on a file a loaded checkpoint recorded continues that file (no
+  // header, no row now: the file has both).
   template <class Probe, class Solver>
   void add_probe(const std::string& csv_path, Probe probe, const Solver& solver) {
     const std::string key = io::identity_of(csv_path);
@@ -157,8 +160,92 @@ class SolverOutput {
     create_parent_directory(csv_path);
     if constexpr (std::is_same_v<Probe, StressProbe>)
       probe.point_names = thickness_point_names<typename Solver::rule_type>();
-    probes_.push_back(OpenProbe{io::CsvProbe(csv_path, probe.columns()), std::move(probe), key});
+    const ProbeVariant variant{std::move(probe)};
+    for (auto record = restored_probes_.begin(); record != restored_probes_.end(); ++record)
+      if (record->key == key) {
+        check_same_probe(*record, variant, csv_path);
+        probes_.push_back(OpenProbe{io::CsvProbe(csv_path, columns_of(variant), record->written), variant, key});
+        restored_probes_.erase(record);
+        return;
+      }
+    probes_.push_back(OpenProbe{io::CsvProbe(csv_path, columns_of(variant)), variant, key});
     write_probe(probes_.back(), solver);
+  }
+
+  // Checkpoints (solver/checkpoint.hpp): the schedule (frames written, the
+  // latest frame's step, the next frame and probe times), the frame series
+  // (the collections' entries) and each probe's file (path, what it probes,
+  // its length and content hash).
+  template <class Writer>
+  void save(Writer& out) const {
+    out(static_cast<std::int64_t>(frames_written_), static_cast<std::int64_t>(last_frame_step_), next_frame_time_,
+        next_probe_time_);
+    out(options_.output_directory.empty() ? std::string() : io::identity_of(options_.output_directory));
+    const bool series = particle_collection_ != nullptr;
+    out(series);
+    if (series)
+      for (const io::PvdCollection* collection :
+           {particle_collection_.get(), stress_point_collection_.get(), crack_collection_.get()})
+        out(collection ? entries_of(*collection) : std::vector<SeriesEntry>{});
+    std::vector<ProbeRecord> records;
+    for (const OpenProbe& open : probes_) {
+      ProbeRecord record;
+      record.key = open.key;
+      record.kind = static_cast<std::uint32_t>(open.probe.index());
+      record.index = probed_index(open.probe);
+      record.written = open.file.written();
+      records.push_back(record);
+    }
+    out(records);
+  }
+
+  // The schedule as it was; the series continues in the same
+  // output_directory (its collections as they were, the frames written after
+  // the checkpoint removed) and starts anew at the next frame in another one.
+  // Probes already added continue their files (or restart them, if the
+  // checkpoint has none of theirs); the others continue when added.
+  template <class Reader, class Solver>
+  void load(Reader& in, const Solver& solver) {
+    std::int64_t frames = 0, last_step = 0;
+    double next_frame = 0.0, next_probe = 0.0;
+    std::string directory;
+    bool series = false;
+    std::array<std::vector<SeriesEntry>, 3> entries;
+    std::vector<ProbeRecord> records;
+    in(frames, last_step, next_frame, next_probe, directory, series);
+    if (series)
+      for (std::vector<SeriesEntry>& list : entries) in(list);
+    in(records);
+    for (const ProbeRecord& record : records)
+      if (record.kind > 1) in.fail("a probe of unknown kind " + std::to_string(record.kind));
+
+    last_frame_step_ = static_cast<long>(last_step);
+    next_frame_time_ = next_frame;
+    next_probe_time_ = next_probe;
+    particle_collection_.reset();
+    stress_point_collection_.reset();
+    crack_collection_.reset();
+    frames_written_ = 0;
+    const bool same_directory =
+        !options_.output_directory.empty() && directory == io::identity_of(options_.output_directory);
+    if (series && same_directory) {
+      frames_written_ = static_cast<long>(frames);
+      restore_series(entries, Solver::crack_type::enabled);
+    }
+    restored_probes_ = records;
+    for (OpenProbe& open : probes_) {
+      auto record = std::find_if(restored_probes_.begin(), restored_probes_.end(),
+                                 [&](const ProbeRecord& r) { return r.key == open.key; });
+      const std::string path = open.file.path();
+      if (record == restored_probes_.end()) {
+        open.file = io::CsvProbe(path, columns_of(open.probe));  // a probe new to the run: starts now
+        write_probe(open, solver);
+        continue;
+      }
+      check_same_probe(*record, open.probe, path);
+      open.file = io::CsvProbe(path, columns_of(open.probe), record->written);
+      restored_probes_.erase(record);
+    }
   }
 
   // Before the first step: the reference configuration at t = 0.
@@ -237,13 +324,102 @@ class SolverOutput {
   // Probe rows within this fraction of a step of their time are due.
   static constexpr double schedule_tolerance = 1e-9;
 
+  using ProbeVariant = std::variant<ParticleProbe, StressProbe>;
+
   // A CSV file, the probe that fills it and the file's identity (its
   // absolute, normalized path) to keep two probes off one file.
   struct OpenProbe {
     io::CsvProbe file;
-    std::variant<ParticleProbe, StressProbe> probe;
+    ProbeVariant probe;
     std::string key;
   };
+
+  // A probe file as a checkpoint recorded it: kind 0 a particle probe, 1 a
+  // stress-point probe, of particle or stress point `index`.
+  struct ProbeRecord {
+    std::string key;
+    std::uint32_t kind = 0;
+    std::int64_t index = 0;
+    io::CsvProbe::Resume written;
+    template <class S, class F>
+    static void for_each_field(S& self, F&& field) {
+      field(self.key, self.kind, self.index, self.written.bytes, self.written.hash);
+    }
+  };
+  // One entry of a .pvd collection (the file relative to it).
+  struct SeriesEntry {
+    double time = 0.0;
+    std::int32_t part = 0;
+    std::string file;
+    template <class S, class F>
+    static void for_each_field(S& self, F&& field) {
+      field(self.time, self.part, self.file);
+    }
+  };
+
+  static std::vector<std::string> columns_of(const ProbeVariant& probe) {
+    return std::visit([](const auto& p) { return p.columns(); }, probe);
+  }
+  static std::int64_t probed_index(const ProbeVariant& probe) {
+    if (const auto* particle = std::get_if<ParticleProbe>(&probe)) return particle->particle;
+    return std::get<StressProbe>(probe).stress_point;
+  }
+  static void check_same_probe(const ProbeRecord& record, const ProbeVariant& probe, const std::string& path) {
+    static const char* const kinds[] = {"particle", "stress point"};
+    if (record.kind != probe.index() || record.index != probed_index(probe))
+      throw Error("sphshell: probe file '" + path + "' is, in the checkpoint, the file of the " + kinds[record.kind] +
+                  " probe of " + kinds[record.kind] + " " + std::to_string(record.index) + ", not of " +
+                  kinds[probe.index()] + " " + std::to_string(probed_index(probe)) +
+                  ": give this probe another file, or probe what the run probed");
+  }
+  static std::vector<SeriesEntry> entries_of(const io::PvdCollection& collection) {
+    std::vector<SeriesEntry> entries;
+    for (const io::PvdCollection::Entry& entry : collection.entries())
+      entries.push_back({entry.time, static_cast<std::int32_t>(entry.part), entry.file});
+    return entries;
+  }
+
+  // The number N of a frame file "<series>_N.vtu" (or its .tmp), -1 for any other name.
+  static long frame_number(std::string name) {
+    if (!io::is_frame_file(name)) return -1;
+    const std::string temporary = ".tmp", extension = ".vtu";
+    if (name.size() > temporary.size() && name.compare(name.size() - temporary.size(), temporary.size(), temporary) == 0)
+      name.resize(name.size() - temporary.size());
+    if (name.size() <= extension.size() || name.compare(name.size() - extension.size(), extension.size(), extension) != 0)
+      return -1;  // a collection
+    name.resize(name.size() - extension.size());
+    const std::size_t underscore = name.rfind('_');
+    return std::stol(name.substr(underscore + 1));  // is_frame_file vouches for the digits
+  }
+
+  // The collections as the checkpoint had them, rewritten together; the
+  // frames the run wrote after the checkpoint (numbers from frames_written_
+  // on) are removed, so the folder is as it was then.
+  void restore_series(const std::array<std::vector<SeriesEntry>, 3>& entries, bool with_cracks) {
+    io::make_directory(options_.output_directory, "", "output_directory");
+    particle_collection_ = std::make_unique<io::PvdCollection>(series_path("particles.pvd"), false);
+    stress_point_collection_ = std::make_unique<io::PvdCollection>(series_path("stress_points.pvd"), false);
+    std::vector<io::PvdCollection*> collections{particle_collection_.get(), stress_point_collection_.get()};
+    if (with_cracks) {
+      crack_collection_ = std::make_unique<io::PvdCollection>(series_path("cracks.pvd"), false);
+      collections.push_back(crack_collection_.get());
+    }
+    for (std::size_t k = 0; k < collections.size(); ++k)
+      for (const SeriesEntry& entry : entries[k]) collections[k]->stage(entry.time, series_path(entry.file), entry.part);
+    io::write_together({collections.begin(), collections.end()});
+    namespace fs = std::filesystem;
+    std::error_code error;
+    std::vector<fs::path> later;
+    for (fs::directory_iterator entry(options_.output_directory, error), end; !error && entry != end;
+         entry.increment(error)) {
+      const long number = frame_number(entry->path().filename().string());
+      if (number >= frames_written_) later.push_back(entry->path());
+    }
+    if (error)
+      throw Error("sphshell: cannot list output_directory '" + options_.output_directory + "' (" + error.message() +
+                  ")");
+    for (const fs::path& file : later) io::remove_file(file.string());
+  }
 
   // The points of a frame and what was added to the reference to get them,
   // and how each stress point is drawn: the active ones whose cell no crack
@@ -505,6 +681,7 @@ class SolverOutput {
   long last_frame_step_ = -1;  // the step of the latest frame; -1 before the first
   double next_frame_time_ = 0.0;
   double next_probe_time_ = 0.0;
+  std::vector<ProbeRecord> restored_probes_;  // probe files of a loaded checkpoint, not yet added again
 };
 
 }  // namespace sphshell::solver

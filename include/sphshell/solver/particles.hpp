@@ -42,6 +42,19 @@ struct ParticleState {
   }
   std::size_t size() const { return position.size(); }
   std::size_t owned_count() const { return ranges.owned_count(); }
+
+  // Checkpoints (solver/checkpoint.hpp); the ranges are the model's.
+  template <class Writer>
+  void save(Writer& out) const {
+    out(position, director, velocity, angular_velocity);
+  }
+  template <class Reader>
+  void load(Reader& in) {
+    in.read_exact(position, "particle positions");
+    in.read_exact(director, "particle directors");
+    in.read_exact(velocity, "particle velocities");
+    in.read_exact(angular_velocity, "particle angular velocities");
+  }
 };
 
 // Lumped translational mass m (kg) and rotary inertia I (kg·m²) per particle.
@@ -82,6 +95,20 @@ struct ParticleForces {
         internal_director(particles, Vector3::Zero()),
         external(particles, Vector3::Zero()),
         external_moment(particles, Vector3::Zero()) {}
+
+  // Checkpoints (solver/checkpoint.hpp): the forces of the last evaluation,
+  // which the next step starts from.
+  template <class Writer>
+  void save(Writer& out) const {
+    out(internal, internal_director, external, external_moment);
+  }
+  template <class Reader>
+  void load(Reader& in) {
+    in.read_exact(internal, "internal forces");
+    in.read_exact(internal_director, "internal director forces");
+    in.read_exact(external, "external forces");
+    in.read_exact(external_moment, "external moments");
+  }
 };
 
 }  // namespace sphshell::solver

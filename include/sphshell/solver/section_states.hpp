@@ -108,6 +108,26 @@ class SectionStates {
     return 0.0;
   }
 
+  // Checkpoints (solver/checkpoint.hpp): every point's material state (each
+  // law's State, for_each_field; Section<Rule, Law>::State per rule), the
+  // strains of its last update, its resultants and whether it is active.
+  // The sections themselves follow from the model and the law.
+  template <class Writer>
+  void save(Writer& out) const {
+    out(state_, membrane_strain_, curvature_, shear_, shear_force_, membrane_, moment_, active_);
+  }
+  template <class Reader>
+  void load(Reader& in) {
+    in.read_exact(state_, "integration point states");
+    in.read_exact(membrane_strain_, "membrane strains");
+    in.read_exact(curvature_, "curvatures");
+    in.read_exact(shear_, "transverse shear strains");
+    in.read_exact(shear_force_, "transverse shear forces");
+    in.read_exact(membrane_, "membrane forces");
+    in.read_exact(moment_, "bending moments");
+    in.read_exact(active_, "active flags");
+  }
+
   // Distinct sections (one per wall thickness).
   const std::vector<Section>& sections() const { return sections_; }
 

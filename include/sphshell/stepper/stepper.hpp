@@ -17,6 +17,13 @@
 // advance_configuration. Only the owned particles
 // (state.ranges.owned_begin … owned_end) are the stepper's to update.
 // check_stepper<S>() names a missing member.
+//
+// Checkpoints: a stepper is part of the solver's state. An empty one (as
+// CentralDifference: its start-up half step follows from the step count) has
+// nothing to store; one with members provides
+//   template <class Writer> void save(Writer&) const;
+//   template <class Reader> void load(Reader&);
+// and save_checkpoint says so at compile time when they are missing.
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/solver/particles.hpp>

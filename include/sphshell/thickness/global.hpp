@@ -64,6 +64,11 @@ struct ResultantState {
   double sigma_y = 0.0;  // current yield stress; +inf for laws without plasticity
   double D = 0.0;
   bool failed = false;
+  // The fields a checkpoint stores (thickness.hpp).
+  template <class S, class F>
+  static void for_each_field(S& self, F&& field) {
+    field(self.membrane, self.moment, self.eps_p, self.sigma_y, self.D, self.failed);
+  }
 };
 
 template <class Law>

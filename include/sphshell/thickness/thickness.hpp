@@ -12,6 +12,11 @@
 // The stress integration itself lives in Section<Rule, Law> (section.hpp): one class
 // template for every rule, specialized for Global, so the solver spells the same type
 // whatever the rule is.
+//
+// Checkpoints store Section<Rule, Law>::State: for the integral rules an array
+// of the law's states (each listing its fields, material.hpp); a Section of a
+// rule of its own (as Global's) lists the fields of its State with a static
+// for_each_field, as ResultantState does.
 
 #include <sphshell/core/types.hpp>
 
