@@ -263,7 +263,8 @@ class FractureManager<Crack, true> {
         parts.points.gather(group, row, parts.particles.position, parts.particles.director);
     parts.states.restart_strains(p, parts.assembler.strains_of(current, parts.points.reference(p)));
     parts.assembler.clear_slots(group, row, parts.points);
-    parts.assembler.scatter_point(group, row, current, parts.points, parts.states);
+    parts.states.tied_shear_energy(p) =
+        parts.assembler.scatter_point(group, row, current, parts.particles, parts.points, parts.states);
     return Rebuild::rebuilt;
   }
 
