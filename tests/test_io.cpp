@@ -229,13 +229,16 @@ TEST_CASE("VTU point cloud: structure and bit-exact round trip", "[io][vtu]") {
   CHECK(points.attributes.at("NumberOfComponents") == "3");
   CHECK(bitwise_equal(coordinates, points.bytes));
 
-  std::vector<std::int64_t> identity(count), ends(count);
+  // Indices that fit in Int32 are written as Int32.
+  std::vector<std::int32_t> identity(count), ends(count);
   for (std::size_t i = 0; i < count; ++i) {
-    identity[i] = static_cast<std::int64_t>(i);
-    ends[i] = static_cast<std::int64_t>(i + 1);
+    identity[i] = static_cast<std::int32_t>(i);
+    ends[i] = static_cast<std::int32_t>(i + 1);
   }
-  CHECK(values_of<std::int64_t>(vtu.array("Cells", "connectivity")) == identity);
-  CHECK(values_of<std::int64_t>(vtu.array("Cells", "offsets")) == ends);
+  CHECK(vtu.array("Cells", "connectivity").attributes.at("type") == "Int32");
+  CHECK(vtu.array("Cells", "offsets").attributes.at("type") == "Int32");
+  CHECK(values_of<std::int32_t>(vtu.array("Cells", "connectivity")) == identity);
+  CHECK(values_of<std::int32_t>(vtu.array("Cells", "offsets")) == ends);
   CHECK(values_of<std::uint8_t>(vtu.array("Cells", "types")) ==
         std::vector<std::uint8_t>(count, 1));
 
@@ -266,10 +269,10 @@ TEST_CASE("VTU line set: segments as VTK_LINE cells with point and cell data", "
   const DecodedVtu vtu = read_vtu(path);
   CHECK(vtu.piece_attributes.at("NumberOfPoints") == "4");
   CHECK(vtu.piece_attributes.at("NumberOfCells") == "3");
-  CHECK(values_of<std::int64_t>(vtu.array("Cells", "connectivity")) ==
-        std::vector<std::int64_t>{0, 1, 1, 2, 2, 3});
-  CHECK(values_of<std::int64_t>(vtu.array("Cells", "offsets")) ==
-        std::vector<std::int64_t>{2, 4, 6});
+  CHECK(values_of<std::int32_t>(vtu.array("Cells", "connectivity")) ==
+        std::vector<std::int32_t>{0, 1, 1, 2, 2, 3});
+  CHECK(values_of<std::int32_t>(vtu.array("Cells", "offsets")) ==
+        std::vector<std::int32_t>{2, 4, 6});
   CHECK(values_of<std::uint8_t>(vtu.array("Cells", "types")) == std::vector<std::uint8_t>{3, 3, 3});
   CHECK(bitwise_equal(point_fields[0].values, vtu.array("PointData", "damage").bytes));
   CHECK(bitwise_equal(cell_fields[0].values, vtu.array("CellData", "formed at step").bytes));

@@ -215,8 +215,8 @@ class Solver {
       detail::invalid_parameter("stress point index", stress_point, "out of range");
     output_.add_probe(csv_path, typename Output::StressProbe{stress_point}, *this);
   }
-  // Writes one ParaView frame now (particles and stress points), whatever the
-  // output interval; requires output_directory.
+  // Writes one ParaView frame now (particles, stress points and cracks),
+  // whatever the output interval; requires output_directory.
   void write_frame() { output_.write_frame(*this); }
 
   // A pre-crack: a polyline on the shell (reference coordinates). Pairs across
@@ -289,7 +289,9 @@ class Solver {
   }
 
  public:
-  // Steps until time t_end, calling observer(*this) after every step.
+  // Steps until time t_end (the step nearest it: the run stops within half a
+  // step of t_end), calling observer(*this) after every step. With frames on
+  // (OutputOptions), the last state is a frame, whether or not one was due.
   // The progress line (MonitoringOptions) then reports the share done and the time left.
   template <class Observer>
   void run_until(double t_end, Observer&& observer) {
@@ -299,6 +301,7 @@ class Solver {
       step();
       observer(*this);
     }
+    output_.finish(*this);
     progress_.end_run();
   }
   void run_until(double t_end) {

@@ -5,6 +5,7 @@
 #include <sphshell/core/error.hpp>
 #include <sphshell/io/output_file.hpp>
 
+#include <cerrno>
 #include <fstream>
 #include <string>
 #include <utility>
@@ -30,7 +31,8 @@ inline std::string csv_field(const std::string& text) {
 // Column names should carry their units, e.g. "time [s]", "w_centre [m]".
 // Numbers are written as the shortest decimal that reads back to the same
 // double (NaN and infinities as "nan", "inf", "-inf"); every row is flushed so
-// the file is usable while the run goes on, or after it crashed.
+// the file is usable while the run goes on, or after it crashed. A failed
+// write throws Error naming the file and the system's reason.
 class CsvProbe {
  public:
   CsvProbe(const std::string& path, std::vector<std::string> columns)
@@ -38,8 +40,9 @@ class CsvProbe {
     if (columns_.empty()) throw Error("sphshell: CSV probe '" + path_ + "' needs at least one column");
     for (const std::string& column : columns_)
       if (column.empty()) throw Error("sphshell: CSV probe '" + path_ + "' has an empty column name");
+    errno = 0;
     stream_.open(path_, std::ios::trunc);
-    if (!stream_) throw Error("sphshell: cannot open CSV probe '" + path_ + "' for writing");
+    if (!stream_) fail("cannot open CSV probe '" + path_ + "' for writing");
     for (std::size_t i = 0; i < columns_.size(); ++i)
       stream_ << (i == 0 ? "" : ",") << detail::csv_field(columns_[i]);
     stream_ << '\n';
@@ -63,7 +66,12 @@ class CsvProbe {
  private:
   void flush() {
     stream_.flush();
-    if (!stream_) throw Error("sphshell: failed while writing CSV probe '" + path_ + "'");
+    if (!stream_) fail("failed while writing CSV probe '" + path_ + "'");
+  }
+  // The message with the system's reason (errno), e.g. a full disk.
+  [[noreturn]] static void fail(const std::string& what) {
+    const int error_number = errno;
+    throw Error("sphshell: " + what + (error_number != 0 ? " (" + detail::errno_text(error_number) + ")" : ""));
   }
 
   std::string path_;

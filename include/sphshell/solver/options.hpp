@@ -6,6 +6,7 @@
 // Units are SI. The method behind each option is in docs/method.md.
 
 #include <sphshell/core/error.hpp>
+#include <sphshell/io/vtu_format.hpp>
 
 #include <cmath>
 #include <iosfwd>
@@ -90,16 +91,44 @@ struct MonitoringOptions {
   double energy_tolerance = 0.1;
 };
 
+// Where the points of a ParaView frame sit (OutputOptions::frame_coordinates).
+enum class FrameCoordinates {
+  // The current positions: ParaView's default view shows the deformed shell.
+  // The point array "displacement" is there to colour by; Warp By Vector
+  // would add it a second time.
+  deformed,
+  // The reference positions: Warp By Vector with "displacement" (scale 1)
+  // shows the deformed shell, any other scale exaggerates it.
+  reference,
+};
+
 // Files.
 struct OutputOptions {
-  // ParaView output: every output_interval seconds of simulated time, one .vtu
-  // of the particles and one of the stress points, gathered in particles.pvd and
-  // stress_points.pvd inside output_directory (created if missing). An empty
-  // directory writes nothing.
+  // ParaView output: every output_interval seconds of simulated time, and at
+  // the end of every run_until, one .vtu of the particles, one of the stress
+  // points and (with a crack policy) one of the crack segments, listed in
+  // particles.pvd, stress_points.pvd and cracks.pvd inside output_directory
+  // (created if missing). The shell is drawn as its cells (ShellModel::cells()):
+  // the particle file carries point data, the stress-point file one cell per
+  // stress point with its data; a removed stress point's cell is left out and
+  // a cell a crack cuts is drawn as a vertex at its stress point, so cracks
+  // show as gaps (solver/output.hpp has the details). A directory used before
+  // loses its earlier frames (particles_*.vtu, stress_points_*.vtu, cracks_*.vtu, the three .pvd and
+  // their .tmp files) when the first frame is written; other files stay.
+  // output_interval > 0 needs an output_directory; with a directory and an
+  // interval of 0, frames are written only by Solver::write_frame().
   std::string output_directory;
   double output_interval = 0.0;
+  // How frames are stored (io/vtu_format.hpp). The defaults suit big runs:
+  // zlib-compressed (when sphshell is built with zlib, else raw binary) and
+  // single precision, a fraction of the size of raw doubles, read natively by
+  // ParaView. float64 keeps every bit for post-processing; ascii is for
+  // reading a frame in a text editor.
+  io::VtuEncoding frame_encoding = io::vtu_zlib_available ? io::VtuEncoding::zlib : io::VtuEncoding::binary;
+  io::VtuPrecision frame_precision = io::VtuPrecision::float32;
+  FrameCoordinates frame_coordinates = FrameCoordinates::deformed;
   // Probes (add_particle_probe, add_stress_point_probe) write a CSV row every
-  // probe_interval seconds (0: every step).
+  // probe_interval seconds (0: every step); each probe needs a file of its own.
   double probe_interval = 0.0;
 };
 
@@ -140,7 +169,24 @@ inline void validate(const SolverOptions& options) {
   if (options.max_steps_per_run < 1)
     detail::invalid_parameter("max_steps_per_run", options.max_steps_per_run, "must be >= 1");
   detail::require_nonnegative("output_interval", options.output_interval);
+  if (options.output_interval > 0.0 && options.output_directory.empty())
+    detail::invalid_parameter("output_interval", options.output_interval,
+                              "needs an output_directory for the frames; set one, or 0 for no frames");
   detail::require_nonnegative("probe_interval", options.probe_interval);
+  const io::VtuEncoding encoding = options.frame_encoding;
+  if (encoding != io::VtuEncoding::ascii && encoding != io::VtuEncoding::binary && encoding != io::VtuEncoding::zlib)
+    detail::invalid_parameter("frame_encoding", static_cast<int>(encoding), "must be ascii, binary or zlib");
+  if (encoding == io::VtuEncoding::zlib && !io::vtu_zlib_available)
+    detail::invalid_parameter("frame_encoding", "zlib",
+                              "needs sphshell built with zlib (SPHSHELL_HAVE_ZLIB and -lz, as the CMake target "
+                              "and pkg-config file give when zlib was found); use binary or ascii");
+  if (options.frame_precision != io::VtuPrecision::float32 && options.frame_precision != io::VtuPrecision::float64)
+    detail::invalid_parameter("frame_precision", static_cast<int>(options.frame_precision),
+                              "must be float32 or float64");
+  if (options.frame_coordinates != FrameCoordinates::deformed &&
+      options.frame_coordinates != FrameCoordinates::reference)
+    detail::invalid_parameter("frame_coordinates", static_cast<int>(options.frame_coordinates),
+                              "must be deformed or reference");
 }
 
 }  // namespace sphshell

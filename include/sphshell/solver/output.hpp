@@ -1,15 +1,41 @@
 #pragma once
 // The solver's output: ParaView frames (particles, stress points and, with a
 // crack policy, crack segments, each series in a .pvd collection) on the
-// output schedule, and CSV probes. Output is an observer: it reads the
-// Solver's public accessors, so it holds no state of the run but its own
-// schedule and files.
+// output schedule and at the end of every run_until, and CSV probes. Output is
+// an observer: it reads the Solver's public accessors, so it holds no state of
+// the run but its own schedule and files.
+//
+// A frame draws the shell as its cells (ShellModel::cells(): the quads or
+// triangles whose centres are the stress points), so ParaView's default
+// Surface view shows a surface:
+//   particles_N.vtu      the particles as the corners of the same cells
+//                        (plus a vertex cell for a particle none holds), with
+//                        the particle data as point data;
+//   stress_points_N.vtu  one cell per active stress point over its corner
+//                        particles, with the stress-point data as cell data; a
+//                        removed stress point has no cell, so a crack is a gap,
+//                        and one whose cell a crack cuts (it no longer sees a
+//                        corner) is a vertex cell at its own position, so that
+//                        a slit between rows of particles shows as a gap too;
+//   cracks_N.vtu         the crack segments as lines.
+// A model from the general constructor has no cells: its frames are point
+// clouds (one vertex cell per particle, and per active stress point).
+// Points sit at the deformed or the reference positions
+// (OutputOptions::frame_coordinates); every file says which in a comment at
+// its top and carries the point array "displacement". Each file holds its
+// time as FieldData TimeValue.
+//
+// Kill safety: a frame's .vtu files are written (each atomically) before the
+// three collections are rewritten together (io::write_together), so at any
+// moment the collections list the same frames and every listed file is
+// complete, but for the microseconds of the final atomic swaps.
 //
 // A probe is a type whose column names and row values sit together:
 //   std::vector<std::string> columns() const;
 //   template <class Solver> std::vector<double> row(const Solver&) const;
 
 #include <sphshell/core/error.hpp>
+#include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/io/csv_probe.hpp>
 #include <sphshell/io/pvd_collection.hpp>
@@ -20,15 +46,52 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <set>
 #include <sstream>
 #include <string>
+#include <system_error>
+#include <type_traits>
 #include <utility>
 #include <variant>
 #include <vector>
 
 namespace sphshell::solver {
+
+// The thickness output points of a rule named by where they sit: their height
+// ζ along the director as a fraction of the wall thickness d, the first
+// (ζ < 0, the side the director points away from) "bottom", the last "top",
+// ζ = 0 "mid"; e.g. Gauss<3>: "bottom zeta=-0.387d", "mid zeta=0",
+// "top zeta=+0.387d". A resultant rule (Global) has one, "whole section".
+template <class Rule>
+std::vector<std::string> thickness_point_names() {
+  if constexpr (Rule::num_points == 0) {
+    return {"whole section"};
+  } else {
+    std::vector<std::string> names;
+    const int count = Rule::num_points;
+    for (int k = 0; k < count; ++k) {
+      // Reference points lie on [-1, 1]: ζ/d is half of one.
+      const double fraction = 0.5 * Rule::reference_points[std::size_t(k)];
+      char height[32];
+      if (fraction == 0.0)
+        std::snprintf(height, sizeof height, "zeta=0");
+      else
+        std::snprintf(height, sizeof height, "zeta=%+.3gd", fraction);
+      std::string name;
+      if (fraction == 0.0)
+        name = "mid ";
+      else if (k == 0)
+        name = "bottom ";
+      else if (k == count - 1)
+        name = "top ";
+      names.push_back(name + height);
+    }
+    return names;
+  }
+}
 
 // One particle's history: t, displacement, velocity, rotation vector.
 struct ParticleProbe {
@@ -44,14 +107,20 @@ struct ParticleProbe {
 };
 
 // One stress point's history: t, then each integral-point quantity at each
-// thickness output point (in the rule's order, ζ ascending).
+// thickness output point (in the rule's order, ζ ascending), the column named
+// by the point's number and position, e.g. "equivalent_stress_1 (bottom
+// zeta=-0.453d) [Pa]".
 template <int OutputPoints>
 struct StressPointProbe {
+  explicit StressPointProbe(int point) : stress_point(point) {}
   int stress_point;
+  std::vector<std::string> point_names;  // thickness_point_names of the rule (set by SolverOutput::add_probe)
   std::vector<std::string> columns() const {
     std::vector<std::string> names{"t [s]"};
     for (const IntegralPointQuantityInfo& info : integral_point_quantities)
-      for (int k = 1; k <= OutputPoints; ++k) names.push_back(info.name + ("_" + std::to_string(k)) + info.unit);
+      for (int k = 1; k <= OutputPoints; ++k)
+        names.push_back(info.name + ("_" + std::to_string(k)) + " (" + point_names.at(std::size_t(k - 1)) + ")" +
+                        info.unit);
     return names;
   }
   template <class Solver>
@@ -71,38 +140,58 @@ class SolverOutput {
   static constexpr int output_points = OutputPoints;
   using StressProbe = StressPointProbe<output_points>;
 
-  explicit SolverOutput(const OutputOptions& options) : options_(options) {}
+  // Creates the output directory at once, so that a path that cannot be one
+  // fails before the run rather than at its first frame.
+  explicit SolverOutput(const OutputOptions& options) : options_(options) {
+    if (!options_.output_directory.empty()) make_directory(options_.output_directory, "", "output_directory");
+  }
 
   template <class Probe, class Solver>
   void add_probe(const std::string& csv_path, Probe probe, const Solver& solver) {
+    const std::string key = identity_of(csv_path);
+    for (const OpenProbe& open : probes_)
+      if (open.key == key)
+        throw Error("sphshell: probe file '" + csv_path + "' is already the file of another probe (added as '" +
+                    open.file.path() + "'); give each probe a file of its own");
     create_parent_directory(csv_path);
-    probes_.push_back(OpenProbe{io::CsvProbe(csv_path, probe.columns()), std::move(probe)});
+    if constexpr (std::is_same_v<Probe, StressProbe>)
+      probe.point_names = thickness_point_names<typename Solver::rule_type>();
+    probes_.push_back(OpenProbe{io::CsvProbe(csv_path, probe.columns()), std::move(probe), key});
     write_probe(probes_.back(), solver);
   }
 
   // Before the first step: the reference configuration at t = 0.
   template <class Solver>
   void start(const Solver& solver) {
-    if (frames_written_ == 0 && writes_frames()) {
-      write_frame(solver);
-      next_frame_time_ = options_.output_interval;
-    }
+    if (!writes_frames()) return;
+    if (frames_written_ == 0) write_frame(solver);
+    next_frame_time_ = solver.time() + options_.output_interval;
   }
 
-  // After a step: the frames and probe rows that are due.
+  // After a step: the frames and probe rows that are due. A frame is due at
+  // the step nearest its time (within half a step), as run_until's end is.
   template <class Solver>
   void write_scheduled(const Solver& solver) {
-    const double tolerance = schedule_tolerance * solver.time_step();
     const double time = solver.time();
-    if (writes_frames() && time >= next_frame_time_ - tolerance) {
-      write_frame(solver);
-      next_frame_time_ += options_.output_interval *
-                          std::max(1.0, std::floor((time - next_frame_time_) / options_.output_interval + 1.0));
+    const double frame_tolerance = 0.5 * solver.time_step();
+    if (writes_frames() && time >= next_frame_time_ - frame_tolerance) {
+      if (last_frame_step_ != solver.steps()) write_frame(solver);
+      // Past every frame time this step covered, if the interval is below a step.
+      const double passed = std::floor((time + frame_tolerance - next_frame_time_) / options_.output_interval);
+      next_frame_time_ += options_.output_interval * (std::max(0.0, passed) + 1.0);
     }
-    if (!probes_.empty() && time >= next_probe_time_ - tolerance) {
+    const double probe_tolerance = schedule_tolerance * solver.time_step();
+    if (!probes_.empty() && time >= next_probe_time_ - probe_tolerance) {
       for (OpenProbe& probe : probes_) write_probe(probe, solver);
       next_probe_time_ = time + options_.probe_interval;
     }
+  }
+
+  // At the end of run_until: the last state is always a frame (unless the
+  // schedule wrote it at this step already).
+  template <class Solver>
+  void finish(const Solver& solver) {
+    if (writes_frames() && last_frame_step_ != solver.steps()) write_frame(solver);
   }
 
   // One frame now, whatever the schedule.
@@ -110,41 +199,150 @@ class SolverOutput {
   void write_frame(const Solver& solver) {
     if (options_.output_directory.empty())
       detail::invalid_parameter("output_directory", "(empty)", "set it to write ParaView frames");
-    if (!particle_collection_) {
-      std::filesystem::create_directories(options_.output_directory);
-      particle_collection_ = std::make_unique<io::PvdCollection>(options_.output_directory + "/particles.pvd");
-      stress_point_collection_ =
-          std::make_unique<io::PvdCollection>(options_.output_directory + "/stress_points.pvd");
+    constexpr bool with_cracks = Solver::crack_type::enabled;
+    if (!particle_collection_) start_series(with_cracks);
+    char number[32];
+    std::snprintf(number, sizeof number, "%06ld", frames_written_);
+    const std::string particle_file = series_path("particles_" + std::string(number) + ".vtu");
+    const std::string stress_file = series_path("stress_points_" + std::string(number) + ".vtu");
+    const std::string crack_file = series_path("cracks_" + std::string(number) + ".vtu");
+    const io::VtuFormat format{options_.frame_encoding, options_.frame_precision};
+    const FramePoints points = frame_points(solver);
+    io::write_vtu(particle_file, particle_grid(solver, points), format);
+    io::write_vtu(stress_file, stress_point_grid(solver, points), format);
+    if constexpr (with_cracks) io::write_vtu(crack_file, crack_grid(solver), format);
+    // Every file of the frame is complete before any collection lists it.
+    particle_collection_->stage(solver.time(), particle_file);
+    stress_point_collection_->stage(solver.time(), stress_file);
+    std::vector<const io::PvdCollection*> collections{particle_collection_.get(), stress_point_collection_.get()};
+    if constexpr (with_cracks) {
+      crack_collection_->stage(solver.time(), crack_file);
+      collections.push_back(crack_collection_.get());
     }
-    std::ostringstream suffix;
-    suffix.width(6);
-    suffix.fill('0');
-    suffix << frames_written_++;
-    const std::string particle_file = options_.output_directory + "/particles_" + suffix.str() + ".vtu";
-    const std::string stress_file = options_.output_directory + "/stress_points_" + suffix.str() + ".vtu";
-    io::write_vtu_points(particle_file, solver.positions(), particle_fields(solver));
-    particle_collection_->add(solver.time(), particle_file);
-    io::write_vtu_points(stress_file, solver.stress_point_positions(), stress_point_fields(solver));
-    stress_point_collection_->add(solver.time(), stress_file);
-    if constexpr (Solver::crack_type::enabled) write_crack_frame(solver, suffix.str());
+    io::write_together(collections);
+    ++frames_written_;
+    last_frame_step_ = solver.steps();
   }
+
+  // The frames written so far in this run.
+  long frames_written() const { return frames_written_; }
 
   static void create_parent_directory(const std::string& path) {
     const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-    if (!parent.empty()) std::filesystem::create_directories(parent);
+    if (!parent.empty()) make_directory(parent.string(), "probe file '" + path + "': ", "its folder");
   }
 
  private:
-  // Frames and rows within this fraction of a step of their time are due.
+  // Probe rows within this fraction of a step of their time are due.
   static constexpr double schedule_tolerance = 1e-9;
 
-  // A CSV file and the probe that fills it.
+  // A CSV file, the probe that fills it and the file's identity (its
+  // absolute, normalized path) to keep two probes off one file.
   struct OpenProbe {
     io::CsvProbe file;
     std::variant<ParticleProbe, StressProbe> probe;
+    std::string key;
+  };
+
+  // The points of a frame and what was added to the reference to get them,
+  // and how each stress point is drawn: the active ones whose cell no crack
+  // cuts as that cell (`drawn`), the active ones whose cell a crack cuts as a
+  // vertex at the stress point (`cut`), both in index order.
+  struct FramePoints {
+    std::vector<Vector3> particles;
+    std::vector<Vector3> particle_displacement;
+    std::vector<int> drawn;
+    std::vector<int> cut;
   };
 
   bool writes_frames() const { return !options_.output_directory.empty() && options_.output_interval > 0.0; }
+  bool deformed() const { return options_.frame_coordinates == FrameCoordinates::deformed; }
+
+  std::string series_path(const std::string& name) const { return options_.output_directory + "/" + name; }
+
+  // A folder that exists, or is created; anything else is an Error naming it
+  // and the system's reason (not a folder, under a file, on a read-only or
+  // virtual file system such as /proc). lead starts the message, noun names
+  // the folder: ("", "output_directory") or ("probe file 'p.csv': ", "its folder").
+  static void make_directory(const std::string& directory, const std::string& lead, const std::string& noun) {
+    namespace fs = std::filesystem;
+    std::error_code error;
+    const fs::file_status status = fs::status(directory, error);
+    if (fs::is_directory(status)) return;
+    if (fs::exists(status))
+      throw Error("sphshell: " + lead + noun + " '" + directory + "' is a file, not a folder");
+    error.clear();
+    fs::create_directories(directory, error);
+    if (error || !fs::is_directory(fs::status(directory, error)))
+      throw Error("sphshell: " + lead + "cannot create " + noun + " '" + directory + "' (" +
+                  (error ? error.message() : std::string("not created")) + ")");
+  }
+
+  static std::string identity_of(const std::string& path) {
+    namespace fs = std::filesystem;
+    std::error_code error;
+    fs::path absolute = fs::absolute(path, error);
+    if (error) absolute = path;
+    const fs::path canonical = fs::weakly_canonical(absolute, error);
+    return (error ? absolute.lexically_normal() : canonical).string();
+  }
+
+  // A frame file of this library's series: particles, stress_points or
+  // cracks, then "_<digits>.vtu" or ".pvd", optionally ".tmp" (a write cut
+  // short by a kill).
+  static bool is_frame_file(std::string name) {
+    const std::string temporary = ".tmp";
+    if (name.size() > temporary.size() && name.compare(name.size() - temporary.size(), temporary.size(), temporary) == 0)
+      name.resize(name.size() - temporary.size());
+    for (const std::string series : {"particles", "stress_points", "cracks"}) {
+      if (name.compare(0, series.size(), series) != 0) continue;
+      const std::string rest = name.substr(series.size());
+      if (rest == ".pvd") return true;
+      const std::string extension = ".vtu";
+      if (rest.size() > 1 + extension.size() && rest[0] == '_' &&
+          rest.compare(rest.size() - extension.size(), extension.size(), extension) == 0) {
+        const std::string digits = rest.substr(1, rest.size() - 1 - extension.size());
+        if (std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; })) return true;
+      }
+    }
+    return false;
+  }
+
+  // The collections of this run, empty, in place of an earlier run's: first
+  // a stale cracks.pvd of a run with cracks when this one has none, then the
+  // collections are replaced together (so that at no moment do they list
+  // different frames, or frames that are gone), then the earlier frames and
+  // the temporaries of a killed run are removed. Other files stay.
+  void start_series(bool with_cracks) {
+    make_directory(options_.output_directory, "", "output_directory");
+    if (!with_cracks) remove_file(series_path("cracks.pvd"));
+    particle_collection_ = std::make_unique<io::PvdCollection>(series_path("particles.pvd"), false);
+    stress_point_collection_ = std::make_unique<io::PvdCollection>(series_path("stress_points.pvd"), false);
+    std::vector<const io::PvdCollection*> collections{particle_collection_.get(), stress_point_collection_.get()};
+    if (with_cracks) {
+      crack_collection_ = std::make_unique<io::PvdCollection>(series_path("cracks.pvd"), false);
+      collections.push_back(crack_collection_.get());
+    }
+    io::write_together(collections);
+    namespace fs = std::filesystem;
+    std::error_code error;
+    std::vector<fs::path> stale;
+    for (fs::directory_iterator entry(options_.output_directory, error), end; !error && entry != end;
+         entry.increment(error)) {
+      const std::string name = entry->path().filename().string();
+      if (is_frame_file(name) && name.compare(name.size() - 4, 4, ".pvd") != 0) stale.push_back(entry->path());
+    }
+    if (error)
+      throw Error("sphshell: cannot list output_directory '" + options_.output_directory + "' (" + error.message() +
+                  ")");
+    for (const fs::path& file : stale) remove_file(file.string());
+  }
+
+  static void remove_file(const std::string& path) {
+    std::error_code error;
+    std::filesystem::remove(path, error);
+    if (error) throw Error("sphshell: cannot remove the earlier frame file '" + path + "' (" + error.message() + ")");
+  }
 
   template <class Solver>
   static void write_probe(OpenProbe& open, const Solver& solver) {
@@ -158,97 +356,206 @@ class SolverOutput {
     return field;
   }
 
-  template <class Solver>
-  static std::vector<io::PointField> particle_fields(const Solver& solver) {
-    const std::size_t n = solver.particle_count();
-    std::vector<Vector3> displacement_values(n), rotation_values(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      displacement_values[i] = solver.displacement(static_cast<int>(i));
-      rotation_values[i] = solver.rotation(static_cast<int>(i));
-    }
-    std::vector<io::PointField> fields{vector_field("displacement", displacement_values),
-                                       vector_field("velocity", solver.velocities()),
-                                       vector_field("rotation", rotation_values),
-                                       vector_field("director", solver.directors())};
-    if constexpr (Solver::crack_type::enabled) {
-      io::PointField fragment{"fragment", 1, {}};
-      for (std::size_t i = 0; i < n; ++i) fragment.values.push_back(solver.is_fragment(static_cast<int>(i)) ? 1 : 0);
-      fields.push_back(fragment);
-    }
-    return fields;
+  std::string note(const std::string& what, double time) const {
+    std::ostringstream text;
+    text.precision(17);
+    text << "sphshell frame, t = " << time << " s: " << what << "\n     Points: "
+         << (deformed() ? "the deformed (current) positions. The point array displacement (current minus reference "
+                          "position) is for colouring: Warp By Vector would apply it a second time."
+                        : "the reference positions. Warp By Vector with the point array displacement (scale 1) "
+                          "shows the deformed shell.");
+    return text.str();
   }
 
-  // Per stress point: one array per integral-point quantity with a component
-  // per thickness output point (named ip1, ip2, … in ζ order), then the
-  // removed flag (with cracks) and the resultants.
   template <class Solver>
-  static std::vector<io::PointField> stress_point_fields(const Solver& solver) {
+  FramePoints frame_points(const Solver& solver) const {
+    const std::size_t n = solver.particle_count();
+    FramePoints points;
+    points.particle_displacement.resize(n);
+    for (std::size_t i = 0; i < n; ++i) points.particle_displacement[i] = solver.displacement(static_cast<int>(i));
+    points.particles = deformed() ? solver.positions() : solver.model().particle_position;
+    const bool with_cells = !solver.model().cells().empty();
+    for (std::size_t p = 0; p < solver.stress_point_count(); ++p) {
+      const int s = static_cast<int>(p);
+      if (solver.is_removed(s)) continue;
+      (with_cells && is_cut(solver, p) ? points.cut : points.drawn).push_back(s);
+    }
+    return points;
+  }
+
+  // Whether a crack runs through stress point p's cell: p no longer sees one
+  // of its corners (the crack policy's visibility, in the reference
+  // configuration, as for the shape functions). Drawn whole, such a cell
+  // would bridge the crack, a slit between particle rows would not show.
+  template <class Solver>
+  static bool is_cut(const Solver& solver, std::size_t p) {
+    if constexpr (Solver::crack_type::enabled) {
+      const auto& crack = solver.crack();
+      if (crack.segments().empty()) return false;
+      const ShellModel& model = solver.model();
+      const TangentFrame frame = tangent_frame(model.stress_point_normal[p]);
+      for (const int corner : model.cells()[p])
+        if (!crack.visible(model.stress_point_position[p], model.particle_position[std::size_t(corner)], frame))
+          return true;
+    }
+    (void)solver;
+    (void)p;
+    return false;
+  }
+
+  // The drawn stress points' cells (triangles, quads) over the particles.
+  template <class Solver>
+  static void add_drawn_cells(const Solver& solver, const FramePoints& points, io::VtuCells& cells,
+                              std::vector<char>* covered) {
+    const std::vector<Cell>& model_cells = solver.model().cells();
+    for (const int s : points.drawn) {
+      const Cell& cell = model_cells[std::size_t(s)];
+      cells.add_polygon(cell.begin(), cell.end());
+      if (covered)
+        for (const int corner : cell) (*covered)[std::size_t(corner)] = 1;
+    }
+  }
+
+  template <class Solver>
+  io::VtuGrid particle_grid(const Solver& solver, const FramePoints& points) const {
+    const std::size_t n = solver.particle_count();
+    io::VtuGrid grid;
+    grid.time = solver.time();
+    grid.points = points.particles;
+    std::vector<char> covered(n, 0);
+    if (!solver.model().cells().empty()) add_drawn_cells(solver, points, grid.cells, &covered);
+    for (std::size_t i = 0; i < n; ++i)
+      if (!covered[i]) grid.cells.add_vertex(static_cast<int>(i));
+    std::vector<Vector3> rotation_values(n);
+    for (std::size_t i = 0; i < n; ++i) rotation_values[i] = solver.rotation(static_cast<int>(i));
+    grid.point_fields = {vector_field("displacement", points.particle_displacement),
+                         vector_field("velocity", solver.velocities()), vector_field("rotation", rotation_values),
+                         vector_field("director", solver.directors())};
+    if constexpr (Solver::crack_type::enabled) {
+      io::PointField fragment{"fragment", 1, {}, {}, io::FieldValues::integer};
+      for (std::size_t i = 0; i < n; ++i) fragment.values.push_back(solver.is_fragment(static_cast<int>(i)) ? 1 : 0);
+      grid.point_fields.push_back(fragment);
+    }
+    grid.note = note(solver.model().cells().empty()
+                         ? "the particles, one vertex cell each (the model has no cells)."
+                         : "the particles with the cells of the active stress points over them, but for cells a "
+                           "crack cuts (a particle no such cell holds is a vertex cell); particle data as point "
+                           "data.",
+                     solver.time());
+    return grid;
+  }
+
+  // Per active stress point: one array per integral-point quantity with a
+  // component per thickness output point (named by position, ζ ascending),
+  // the resultants, the wall thickness and the stress point's index.
+  template <class Solver>
+  io::VtuGrid stress_point_grid(const Solver& solver, const FramePoints& points) const {
     const std::size_t m = solver.stress_point_count();
-    std::vector<std::string> names;
-    for (int k = 1; k <= output_points; ++k) names.push_back("ip" + std::to_string(k));
-    std::vector<io::PointField> fields;
+    const ShellModel& model = solver.model();
+    const bool with_cells = !model.cells().empty();
+    io::VtuGrid grid;
+    grid.time = solver.time();
+    // Cell data follow the cells: the drawn stress points, then the cut ones.
+    std::vector<int> active = points.drawn;
+    active.insert(active.end(), points.cut.begin(), points.cut.end());
+    const std::vector<Vector3> current = solver.stress_point_positions();
+    if (with_cells) {
+      grid.points = points.particles;
+      add_drawn_cells(solver, points, grid.cells, nullptr);
+      std::vector<Vector3> displacement = points.particle_displacement;
+      for (const int s : points.cut) {
+        grid.cells.add_vertex(static_cast<int>(grid.points.size()));
+        grid.points.push_back(deformed() ? current[std::size_t(s)] : model.stress_point_position[std::size_t(s)]);
+        displacement.push_back(current[std::size_t(s)] - model.stress_point_position[std::size_t(s)]);
+      }
+      grid.point_fields = {vector_field("displacement", displacement)};
+    } else {
+      std::vector<Vector3> displacement(m);
+      for (std::size_t s = 0; s < m; ++s) displacement[s] = current[s] - model.stress_point_position[s];
+      grid.points = deformed() ? current : model.stress_point_position;
+      for (const int s : active) grid.cells.add_vertex(s);
+      grid.point_fields = {vector_field("displacement", displacement)};
+    }
+    const std::vector<std::string> names = thickness_point_names<typename Solver::rule_type>();
     for (const IntegralPointQuantityInfo& info : integral_point_quantities) {
       if (info.needs_damage_law && !Solver::material_type::has_damage) continue;
-      io::PointField field{info.name, output_points, {}, names};
-      field.values.reserve(m * output_points);
-      for (std::size_t s = 0; s < m; ++s)
-        for (int k = 0; k < output_points; ++k)
-          field.values.push_back(solver.integral_point_quantity(info.quantity, static_cast<int>(s), k));
-      fields.push_back(std::move(field));
+      io::CellField field{info.name, output_points, {}, names};
+      field.values.reserve(active.size() * output_points);
+      for (const int s : active)
+        for (int k = 0; k < output_points; ++k) field.values.push_back(solver.integral_point_quantity(info.quantity, s, k));
+      grid.cell_fields.push_back(std::move(field));
     }
-    if constexpr (Solver::crack_type::enabled) {
-      io::PointField removed{"removed", 1, {}};
-      for (std::size_t s = 0; s < m; ++s) removed.values.push_back(solver.is_removed(static_cast<int>(s)) ? 1.0 : 0.0);
-      fields.push_back(removed);
-    }
-    io::PointField membrane{"membrane_force", 3, {}, {"Nxx", "Nyy", "Nxy"}};
-    io::PointField moment{"bending_moment", 3, {}, {"Mxx", "Myy", "Mxy"}};
-    for (std::size_t s = 0; s < m; ++s)
+    io::CellField membrane{"membrane_force", 3, {}, {"Nxx", "Nyy", "Nxy"}};
+    io::CellField moment{"bending_moment", 3, {}, {"Mxx", "Myy", "Mxy"}};
+    io::CellField thickness{"thickness", 1, {}};
+    io::CellField index{"stress_point", 1, {}, {}, io::FieldValues::integer};
+    for (const int s : active) {
       for (int c = 0; c < 3; ++c) {
-        membrane.values.push_back(solver.membrane_force(static_cast<int>(s))[c]);
-        moment.values.push_back(solver.bending_moment(static_cast<int>(s))[c]);
+        membrane.values.push_back(solver.membrane_force(s)[c]);
+        moment.values.push_back(solver.bending_moment(s)[c]);
       }
-    fields.push_back(membrane);
-    fields.push_back(moment);
-    return fields;
+      thickness.values.push_back(model.stress_point_thickness(std::size_t(s)));
+      index.values.push_back(s);
+    }
+    grid.cell_fields.push_back(std::move(membrane));
+    grid.cell_fields.push_back(std::move(moment));
+    grid.cell_fields.push_back(std::move(thickness));
+    grid.cell_fields.push_back(std::move(index));
+    const std::string heights =
+        " Through-thickness points are named by their height zeta along the director as a fraction of the wall "
+        "thickness d: bottom (zeta < 0, the side the director points away from) to top (zeta > 0).";
+    grid.note = note((with_cells ? std::string("one cell per active stress point over its corner particles (the "
+                                               "first points are the particles); a removed stress point has no "
+                                               "cell, so cracks show as gaps; a stress point whose cell a crack "
+                                               "cuts is a vertex cell at its own position (points after the "
+                                               "particles), so slits show too; stress-point data as cell data.")
+                                 : std::string("the stress points, a vertex cell per active one (the model has no "
+                                               "cells); stress-point data as cell data.")) +
+                         heights,
+                     solver.time());
+    return grid;
   }
 
-  // The crack segments as a ParaView line set, in the current configuration:
-  // a damaged stress point's crack point follows the interpolated motion of the
-  // stress point, a pre-crack point the displacement of its nearest particle.
+  // The crack segments as a line set: a damaged stress point's crack point
+  // follows the interpolated motion of the stress point, a pre-crack point the
+  // displacement of its nearest particle.
   template <class Solver>
-  void write_crack_frame(const Solver& solver, const std::string& suffix) {
-    if (!crack_collection_)
-      crack_collection_ = std::make_unique<io::PvdCollection>(options_.output_directory + "/cracks.pvd");
+  io::VtuGrid crack_grid(const Solver& solver) const {
     const auto& crack = solver.crack();
     const std::vector<Vector3>& reference = crack.points();
-    std::vector<Vector3> points(reference.size());
+    std::vector<Vector3> current(reference.size());
     std::vector<char> placed(reference.size(), 0);
     const std::vector<Vector3> stress_positions = solver.stress_point_positions();
     for (std::size_t p = 0; p < solver.stress_point_count(); ++p) {
       const int k = crack.crack_point_of_stress_point(static_cast<int>(p));
       if (k >= 0) {
-        points[k] = stress_positions[p];
+        current[k] = stress_positions[p];
         placed[k] = 1;
       }
     }
-    for (std::size_t k = 0; k < points.size(); ++k)
-      if (!placed[k]) points[k] = reference[k] + solver.displacement(solver.model().nearest_particle(reference[k]));
-    std::vector<std::array<int, 2>> lines;
-    io::CellField crack_id{"crack_id", 1, {}};
+    for (std::size_t k = 0; k < current.size(); ++k)
+      if (!placed[k]) current[k] = reference[k] + solver.displacement(solver.model().nearest_particle(reference[k]));
+    std::vector<Vector3> displacement(reference.size());
+    for (std::size_t k = 0; k < reference.size(); ++k) displacement[k] = current[k] - reference[k];
+    io::VtuGrid grid;
+    grid.time = solver.time();
+    grid.points = deformed() ? current : reference;
+    io::CellField crack_id{"crack_id", 1, {}, {}, io::FieldValues::integer};
     for (const auto& segment : crack.segments()) {
-      lines.push_back({segment.start_point, segment.end_point});
+      grid.cells.add_line(segment.start_point, segment.end_point);
       crack_id.values.push_back(segment.crack_id);
     }
-    const std::string file = options_.output_directory + "/cracks_" + suffix + ".vtu";
-    io::write_vtu_lines(file, points, lines, {}, {crack_id});
-    crack_collection_->add(solver.time(), file);
+    grid.point_fields = {vector_field("displacement", displacement)};
+    grid.cell_fields = {crack_id};
+    grid.note = note("the crack segments as lines (crack_id per segment).", solver.time());
+    return grid;
   }
 
   OutputOptions options_;
   std::vector<OpenProbe> probes_;
   std::unique_ptr<io::PvdCollection> particle_collection_, stress_point_collection_, crack_collection_;
   long frames_written_ = 0;
+  long last_frame_step_ = -1;  // the step of the latest frame; -1 before the first
   double next_frame_time_ = 0.0;
   double next_probe_time_ = 0.0;
 };
