@@ -164,3 +164,25 @@ TEST_CASE("The shape-function shear with the particles' shear term locks the sam
        << locked << " at 21x21 (" << 100 * (locked / kirchhoff_clamped - 1) << " %)");
   CHECK(locked < 0.95 * kirchhoff_clamped);
 }
+
+// The convergence table of the README and docs/method.md §4: w_c D/(q L⁴) at
+// 21, 31 and 51 particles a side for L/d = 10, 50, 100 (against Mindlin, the
+// values of test_solver_plate) and 500 (against Kirchhoff), with the edge-tied
+// shear and with the former shape-function shear (particle shear weight 0.01).
+// Every tied entry is within 3 / 1.5 / 1 % of its reference at 21 / 31 / 51.
+TEST_CASE("Clamped plate convergence table, tied and shape-function shear", "[solver][plate][shear][validation]") {
+  struct Row { double slenderness, reference; };
+  SolverOptions former;
+  former.transverse_shear = TransverseShear::shape_functions;
+  former.particle_shear_weight = 0.01;
+  for (const Row row : {Row{10, 0.0015046}, Row{50, 0.0012754}, Row{100, 0.0012679}, Row{500, kirchhoff_clamped}}) {
+    for (const auto& [n, tolerance] : {std::pair<int, double>{21, 0.03}, {31, 0.015}, {51, 0.01}}) {
+      const double tied = clamped_coefficient(n, row.slenderness);
+      const double shape = clamped_coefficient(n, row.slenderness, former);
+      WARN("L/d = " << row.slenderness << ", " << n << "x" << n << ": tied " << tied << " ("
+                    << 100 * (tied / row.reference - 1) << " %), shape functions " << shape << " ("
+                    << 100 * (shape / row.reference - 1) << " %), reference " << row.reference);
+      CHECK(tied == Approx(row.reference).epsilon(tolerance));
+    }
+  }
+}
