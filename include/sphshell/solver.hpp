@@ -36,6 +36,7 @@
 #include <sphshell/solver/output.hpp>
 #include <sphshell/solver/particles.hpp>
 #include <sphshell/solver/progress.hpp>
+#include <sphshell/solver/run_checks.hpp>
 #include <sphshell/solver/section_states.hpp>
 #include <sphshell/solver/stable_time_step.hpp>
 #include <sphshell/stepper/central_difference.hpp>
@@ -90,7 +91,7 @@ class Solver {
   Solver(ShellModel model, const MaterialParameters& parameters, SolverOptions options = {}) try
       : model_(std::move(model)),
         law_(parameters),
-        options_((validate(options), check_memory(model_, options), std::move(options))),
+        options_((validate(options), solver::check_memory<SectionState>(model_, options), std::move(options))),
         particles_(solver::ParticleState::at_rest(model_.particle_position, model_.particle_normal)),
         inertia_(solver::Inertia::lumped(model_, options_.density, options_.rotary_inertia_scale)),
         forces_(model_.particle_count()),
@@ -105,15 +106,15 @@ class Solver {
     if (options_.time_step > 0.0) {
       if (options_.time_step > stable_time_step_)
         detail::invalid_parameter("time_step", options_.time_step,
-                                  "exceeds the stable bound " + to_string(stable_time_step_) + " s");
+                                  "exceeds the stable bound " + solver::number_text(stable_time_step_) + " s");
       time_step_ = options_.time_step;
     } else {
       time_step_ = options_.safety_factor * stable_time_step_;
     }
-    check_damping();
+    solver::check_damping(options_.damping, time_step_);
   } catch (const std::bad_alloc&) {
     // Members are gone here; the estimate check_memory made is kept for the message.
-    throw Error("sphshell: out of memory building the solver (std::bad_alloc): " + memory_estimate_text());
+    throw Error("sphshell: out of memory building the solver (std::bad_alloc): " + solver::memory_estimate_text());
   }
 
   // Boundary conditions on particle sets (shell/constraints.hpp).
@@ -148,12 +149,12 @@ class Solver {
       // Added mid-run, u(X, t) must continue from where the particle is: a jump
       // would be imposed as one step's velocity (a shock).
       const Vector3 now = particles_.position[i] - model_.particle_position[i];
-      const double allowed = prescribed_jump_tolerance * std::max(now.norm(), model_.minimum_spacing());
+      const double allowed = solver::prescribed_jump_tolerance * std::max(now.norm(), model_.minimum_spacing());
       if (steps_ > 0 && !((start - now).norm() <= allowed))
-        detail::invalid_parameter("prescribed displacement at t = " + to_string(time_) + " s, particle " +
+        detail::invalid_parameter("prescribed displacement at t = " + solver::number_text(time_) + " s, particle " +
                                       std::to_string(i),
                                   start.transpose(),
-                                  "must equal the particle's displacement now (" + vector_text(now) +
+                                  "must equal the particle's displacement now (" + solver::vector_text(now) +
                                       "): a prescribed motion added mid-run continues from the current state");
     }
     add_motion(set, std::make_unique<detail::PrescribedDisplacement<DisplacementFunction>>(std::move(displacement)));
@@ -295,7 +296,7 @@ class Solver {
   // The progress line (MonitoringOptions) then reports the share done and the time left.
   template <class Observer>
   void run_until(double t_end, Observer&& observer) {
-    check_run_end(t_end);
+    solver::check_run_end(t_end, solver::RunPosition{time_, time_step_, steps_}, options_.max_steps_per_run);
     progress_.start_run(now(), t_end);
     while (time_ < t_end - 0.5 * time_step_) {
       step();
@@ -421,6 +422,8 @@ class Solver {
   StepTime now() const { return {steps_, time_}; }
   Parts fracture_parts() { return Parts{model_, particles_, points_, states_, assembler_, forces_}; }
 
+  // A set's indices in range and each listed once (solver/run_checks.hpp).
+  ParticleSet checked(const ParticleSet& set) const { return solver::checked_set(set, model_.particle_count()); }
   void check_particle(int particle) const {
     if (particle < 0 || static_cast<std::size_t>(particle) >= particles_.size())
       detail::invalid_parameter("particle index", particle, "out of range");
@@ -430,103 +433,9 @@ class Solver {
       detail::invalid_parameter("stress point index", stress_point, "out of range");
     if (k < 0 || k >= output_points) detail::invalid_parameter("thickness output point", k, "out of range");
   }
-  // A set's indices in range and each listed once (a duplicate would apply a
-  // load or a motion twice).
-  ParticleSet checked(const ParticleSet& set) const {
-    if (set.empty()) detail::invalid_parameter("particle set size", 0, "must not be empty");
-    std::vector<char> listed(model_.particle_count(), 0);
-    for (int i : set) {
-      if (i < 0 || static_cast<std::size_t>(i) >= model_.particle_count())
-        detail::invalid_parameter("particle index", i,
-                                  "out of range [0, " + std::to_string(model_.particle_count()) + ")");
-      if (listed[i]) detail::invalid_parameter("particle index", i, "listed twice in the set: list each particle once");
-      listed[i] = 1;
-    }
-    return set;
-  }
-
-  // A prescribed displacement added mid-run may differ from the particle's
-  // displacement by this fraction of it (or of the spacing), round-off.
-  static constexpr double prescribed_jump_tolerance = 1e-9;
-  // Mass-proportional damping c with c Δt above this flips the velocity's
-  // sign every step (v ← v (1 − c Δt/2)/(1 + c Δt/2) at zero force).
-  static constexpr double largest_damping_times_step = 2.0;
-
-  void check_damping() const {
-    if (options_.damping * time_step_ > largest_damping_times_step)
-      detail::invalid_parameter("damping", options_.damping,
-                                "with the time step " + to_string(time_step_) + " s, damping × time step = " +
-                                    to_string(options_.damping * time_step_) +
-                                    " must be <= 2 (above, the velocity flips sign every step); at most " +
-                                    to_string(largest_damping_times_step / time_step_) + " 1/s");
-  }
-
-  // run_until's end time: finite, not in the past, and within the step budget.
-  void check_run_end(double t_end) const {
-    detail::require_finite("t_end", t_end);
-    if (t_end < time_ - 0.5 * time_step_)
-      detail::invalid_parameter("t_end", t_end,
-                                "must not lie before the current time " + to_string(time_) + " s (step " +
-                                    std::to_string(steps_) + ")");
-    const double steps = (t_end - time_) / time_step_;
-    if (steps > static_cast<double>(options_.max_steps_per_run))
-      detail::invalid_parameter("t_end", t_end,
-                                "needs " + to_string(steps) + " steps of " + to_string(time_step_) + " s from t = " +
-                                    to_string(time_) + " s, more than SolverOptions::max_steps_per_run = " +
-                                    std::to_string(options_.max_steps_per_run) +
-                                    ": check the time step, the material and the end time, or raise the budget");
-  }
-
-  // What the solver's large arrays will take, against what the machine
-  // offers; refused up front with both figures. Per particle: the state,
-  // forces, inertia and books (about 40 vectors of 3 doubles); per
-  // integration point: its section state and strains, resultants, frame and
-  // reference gradients; per slot (row × neighbour): approx::bytes_per_slot.
-  static constexpr double bytes_per_particle = 40 * 3 * sizeof(double);
-  static constexpr double bytes_per_point = sizeof(SectionState) + 60 * sizeof(double);
-
-  static std::string& memory_estimate_text() {
-    static thread_local std::string text;
-    return text;
-  }
-  static void check_memory(const ShellModel& model, const SolverOptions& options) {
-    double covered = 0.0;
-    for (double area : model.particle_area) covered += area;
-    const double support = options.support_radius_factor * model.maximum_spacing();
-    const bool particles_integrate = options.particle_integration_share > 0.0 || options.particle_shear_weight > 0.0;
-    const double particles = static_cast<double>(model.particle_count());
-    const double points = static_cast<double>(model.stress_point_count()) + (particles_integrate ? particles : 0.0);
-    const double slots = points * approx::expected_row_size(model.particle_count(), covered, support);
-    const double needed = particles * bytes_per_particle + points * bytes_per_point + slots * approx::bytes_per_slot;
-    const double available = approx::available_memory();
-    std::ostringstream text;
-    text.precision(4);
-    text << "the model of " << model.particle_count() << " particles and " << model.stress_point_count()
-         << " stress points needs about " << approx::format_bytes(needed) << " (" << slots
-         << " neighbour slots); " << approx::format_bytes(available) << " available";
-    memory_estimate_text() = text.str();
-    if (needed > available)
-      throw Error("sphshell: model too large for the memory available: " + text.str() +
-                  " (MemAvailable, the cgroup limit and ulimit -v); use fewer particles or a smaller "
-                  "support_radius_factor");
-  }
-  static std::string vector_text(const Vector3& v) {
-    std::ostringstream out;
-    out.precision(6);
-    out << v.transpose();
-    return out.str();
-  }
-
   template <class Motion>
   void add_motion(const ParticleSet& set, std::unique_ptr<Motion> motion) {
     constraints_.add_motion(checked(set), std::move(motion), model_.particle_position, time_, time_step_);
-  }
-
-  static std::string to_string(double value) {
-    std::ostringstream out;
-    out.precision(6);
-    out << value;
-    return out.str();
   }
 
   void apply_loads(const StepTime& at) {
@@ -547,8 +456,8 @@ class Solver {
       if (!particles_.position[i].allFinite() || !particles_.director[i].allFinite() ||
           !particles_.velocity[i].allFinite() || !particles_.angular_velocity[i].allFinite())
         detail::fail_unstable(now(), "non-finite state at particle " + std::to_string(i) + " (external force " +
-                                         to_string(forces_.external[i].norm()) + " N, internal force " +
-                                         to_string(forces_.internal[i].norm()) + " N)");
+                                         solver::number_text(forces_.external[i].norm()) + " N, internal force " +
+                                         solver::number_text(forces_.internal[i].norm()) + " N)");
     });
   }
 

@@ -27,6 +27,7 @@
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
+#include <sphshell/crack/nearest_crack_point.hpp>
 #include <sphshell/crack/segment_intersection.hpp>
 
 #include <algorithm>
@@ -259,7 +260,7 @@ class LineSegments {
     if (ordered.empty()) return {};
 
     std::vector<Segment> created;
-    NearestPointSearch search(*this);
+    NearestCrackPointSearch search(points_, crack_of_point_, linking_distance_, cell_margin);
     for (int stress_point : ordered) {
       const auto slot = static_cast<std::size_t>(stress_point);
       const Vector3& position = stress_point_positions_[slot];
@@ -417,73 +418,6 @@ class LineSegments {
     }
     return true;
   }
-  // Nearest crack points within the linking distance. The cell list over the
-  // crack points is built once per call; points added during the call are
-  // scanned directly until there are enough of them to be worth re-indexing.
-  class NearestPointSearch {
-   public:
-    explicit NearestPointSearch(const LineSegments& owner) : owner_(owner) { reindex(); }
-
-    // One point per crack in reach: the nearest, ties to the lower point index.
-    // Sorted by crack id.
-    std::vector<int> nearest_point_of_each_crack(const Vector3& position) const {
-      const double reach_squared = owner_.linking_distance_ * owner_.linking_distance_;
-      struct Candidate {
-        int crack_id;
-        double distance_squared;
-        int point;
-      };
-      std::vector<Candidate> candidates;
-      auto consider = [&](int point, double distance_squared) {
-        if (distance_squared <= reach_squared)
-          candidates.push_back(
-              {owner_.crack_of_point_[static_cast<std::size_t>(point)], distance_squared, point});
-      };
-      if (indexed_points_)
-        indexed_points_->for_each_within(
-            position, indexed_points_->radius(), [&](int point, double) {
-              consider(point,
-                       (owner_.points_[static_cast<std::size_t>(point)] - position).squaredNorm());
-            });
-      for (int point : unindexed_points_)
-        consider(point, (owner_.points_[static_cast<std::size_t>(point)] - position).squaredNorm());
-      std::sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) {
-        if (x.crack_id != y.crack_id) return x.crack_id < y.crack_id;
-        if (x.distance_squared != y.distance_squared)
-          return x.distance_squared < y.distance_squared;
-        return x.point < y.point;
-      });
-      std::vector<int> nearest;
-      for (std::size_t k = 0; k < candidates.size(); ++k)
-        if (k == 0 || candidates[k].crack_id != candidates[k - 1].crack_id)
-          nearest.push_back(candidates[k].point);
-      return nearest;
-    }
-
-    void note_new_point(int point) {
-      unindexed_points_.push_back(point);
-      if (unindexed_points_.size() >= max_unindexed_points) reindex();
-    }
-
-   private:
-    static constexpr std::size_t max_unindexed_points = 64;
-
-    void reindex() {
-      unindexed_points_.clear();
-      if (owner_.points_.empty()) {
-        indexed_points_.reset();
-        return;
-      }
-      // A little wider than the linking distance: the cell list excludes its
-      // boundary, the linking test includes it.
-      indexed_points_.emplace(owner_.points_, cell_margin * owner_.linking_distance_);
-    }
-
-    const LineSegments& owner_;
-    std::optional<approx::CellList> indexed_points_;
-    std::vector<int> unindexed_points_;
-  };
-
   void require_initialized(const char* operation) const {
     if (!initialized_)
       throw Error(std::string("sphshell: crack::LineSegments::") + operation +

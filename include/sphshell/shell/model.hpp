@@ -7,6 +7,8 @@
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
+#include <sphshell/shell/cell.hpp>
+#include <sphshell/shell/model_checks.hpp>
 
 #include <Eigen/Eigenvalues>
 
@@ -25,43 +27,6 @@
 #include <vector>
 
 namespace sphshell {
-
-using ParticleSet = std::vector<int>;
-
-// Four particle indices of a quadrilateral cell, counter-clockwise seen from the
-// side the normals point to; a stress point sits at each cell's centre.
-using Quad = std::array<int, 4>;
-
-// Corner particle indices of a triangular (3) or quadrilateral (4) cell, in
-// counter-clockwise order seen from the side the normals point to; the cell's
-// stress point sits at its centre.
-class Cell {
- public:
-  Cell(int a, int b, int c) : corners_{a, b, c, -1}, size_(3) {}
-  Cell(int a, int b, int c, int d) : corners_{a, b, c, d}, size_(4) {}
-  explicit Cell(const Quad& quad) : corners_(quad), size_(4) {}
-  std::size_t size() const { return size_; }
-  bool is_triangle() const { return size_ == 3; }
-  int operator[](std::size_t k) const { return corners_[k]; }
-  const int* begin() const { return corners_.data(); }
-  const int* end() const { return corners_.data() + size_; }
-
- private:
-  std::array<int, 4> corners_;
-  std::size_t size_;
-};
-
-// Two cells that share an edge and run along it in the same direction (their
-// normals flip across it), or a third cell on an edge (a junction, which one
-// director per particle cannot represent).
-struct CellEdgeProblem {
-  enum class Kind { flipped, junction };
-  Kind kind;
-  int first_cell;
-  int second_cell;
-  int edge_start;  // particle indices of the shared edge
-  int edge_end;
-};
 
 class ShellModel {
  public:
@@ -98,8 +63,8 @@ class ShellModel {
   // to its stress point and a quarter of it to each of its four particles.
   static ShellModel from_quads(std::vector<Vector3> positions, std::vector<Vector3> normals,
                                const std::vector<Quad>& quads, double thickness) {
-    check_sizes(positions, normals);
-    check_quads(positions, normals, quads);
+    detail::model_checks::check_sizes(positions, normals);
+    detail::model_checks::check_quads(positions, normals, quads);
     std::vector<Vector3> centres;
     std::vector<Vector3> centre_normals;
     for (const Quad& quad : quads) {
@@ -122,8 +87,8 @@ class ShellModel {
                                const std::vector<Quad>& quads,
                                std::vector<Vector3> stress_positions,
                                std::vector<Vector3> stress_normals, double thickness) {
-    check_sizes(positions, normals);
-    check_quads(positions, normals, quads);
+    detail::model_checks::check_sizes(positions, normals);
+    detail::model_checks::check_quads(positions, normals, quads);
     if (stress_positions.size() != quads.size() || stress_normals.size() != quads.size())
       detail::invalid_parameter("stress point count", stress_positions.size(),
                                 "must equal the number of quads (" + std::to_string(quads.size()) + ")");
@@ -162,12 +127,12 @@ class ShellModel {
   static ShellModel from_cells(std::vector<Vector3> positions, const std::vector<Cell>& cells,
                                double thickness) {
     if (cells.empty()) detail::invalid_parameter("cell count", 0, "a shell needs cells");
-    check_finite("particle", "position", positions);
-    for (std::size_t c = 0; c < cells.size(); ++c) check_cell(cells[c], c, positions.size());
-    if (const std::optional<CellEdgeProblem> problem = find_cell_edge_problem(cells))
+    detail::model_checks::check_finite("particle", "position", positions);
+    for (std::size_t c = 0; c < cells.size(); ++c) detail::model_checks::check_cell(cells[c], c, positions.size());
+    if (const std::optional<CellEdgeProblem> problem = detail::model_checks::find_cell_edge_problem(cells))
       detail::invalid_parameter(
           "cells", std::to_string(problem->first_cell) + " and " + std::to_string(problem->second_cell),
-          describe_edge_problem(*problem, "particles"));
+          detail::model_checks::describe_edge_problem(*problem, "particles"));
     std::vector<Vector3> normals(positions.size(), Vector3::Zero());
     std::vector<double> areas(positions.size(), 0.0);
     std::vector<Vector3> centres, cell_normals;
@@ -209,43 +174,9 @@ class ShellModel {
   }
 
   // The first orientation flip or junction among cells in the order given, or
-  // none. Cells' corners must be valid and distinct (from_cells checks them).
+  // none (shell/model_checks.hpp); the mesh readers name it by element.
   static std::optional<CellEdgeProblem> find_cell_edge_problem(const std::vector<Cell>& cells) {
-    struct EdgeUse {
-      int cell;
-      bool ascending;  // the first cell runs from the lower to the higher index
-      int count;
-    };
-    std::unordered_map<std::uint64_t, EdgeUse> uses;
-    for (std::size_t c = 0; c < cells.size(); ++c) {
-      const Cell& cell = cells[c];
-      for (std::size_t k = 0; k < cell.size(); ++k) {
-        const int from = cell[k], to = cell[(k + 1) % cell.size()];
-        const int low = std::min(from, to), high = std::max(from, to);
-        const std::uint64_t key = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(low)) << 32) |
-                                  static_cast<std::uint32_t>(high);
-        const EdgeUse use{static_cast<int>(c), from < to, 1};
-        auto [found, inserted] = uses.try_emplace(key, use);
-        if (inserted) continue;
-        if (found->second.count >= 2)
-          return CellEdgeProblem{CellEdgeProblem::Kind::junction, found->second.cell, use.cell, from, to};
-        if (found->second.ascending == use.ascending)
-          return CellEdgeProblem{CellEdgeProblem::Kind::flipped, found->second.cell, use.cell, from, to};
-        ++found->second.count;
-      }
-    }
-    return std::nullopt;
-  }
-
-  // What went wrong, for a message; `corner_names` says what the edge's ends are
-  // ("particles", "nodes").
-  static std::string describe_edge_problem(const CellEdgeProblem& problem, const std::string& corner_names) {
-    const std::string edge = "the edge between " + corner_names + " " + std::to_string(problem.edge_start) +
-                             " and " + std::to_string(problem.edge_end);
-    if (problem.kind == CellEdgeProblem::Kind::flipped)
-      return "they run along " + edge +
-             " in the same direction, so their normals flip there; reverse the corner order of one side";
-    return "a third cell meets at " + edge + "; a junction of three or more cells is not supported";
+    return detail::model_checks::find_cell_edge_problem(cells);
   }
 
   // Flat rectangular plate in the xy-plane, corner at the origin, normals +z:
@@ -253,62 +184,14 @@ class ShellModel {
   // particles give the paper's 2500 stress points). Named sets: "x_min", "x_max",
   // "y_min", "y_max" (edges), "boundary", "centre" (the particle nearest the centre).
   static ShellModel rectangular_plate(double length_x, double length_y, int nx, int ny,
-                                      double thickness) {
-    detail::require_positive("length_x", length_x);
-    detail::require_positive("length_y", length_y);
-    require_count("nx", nx, 2);
-    require_count("ny", ny, 2);
-    auto surface = [&](double u, double v) {
-      return std::make_pair(Vector3(u * length_x, v * length_y, 0.0), Vector3(0.0, 0.0, 1.0));
-    };
-    ShellModel model = structured(nx, ny, false, surface, thickness);
-    const double tolerance = 1e-9 * std::max(length_x, length_y);
-    model.define_set("x_min", [&](const Vector3& x) { return x.x() < tolerance; });
-    model.define_set("x_max", [&](const Vector3& x) { return x.x() > length_x - tolerance; });
-    model.define_set("y_min", [&](const Vector3& x) { return x.y() < tolerance; });
-    model.define_set("y_max", [&](const Vector3& x) { return x.y() > length_y - tolerance; });
-    model.define_set("boundary", [&](const Vector3& x) {
-      return x.x() < tolerance || x.x() > length_x - tolerance || x.y() < tolerance ||
-             x.y() > length_y - tolerance;
-    });
-    model.sets_["centre"] = {model.nearest_particle(Vector3(length_x / 2, length_y / 2, 0.0))};
-    return model;
-  }
+                                      double thickness);
 
   // Cylindrical panel about the z-axis: radius, axial length (z from 0), opening
   // angle (radians, from the x-axis; 2π makes a closed tube without a seam),
   // n_circumferential × n_axial particles, normals pointing outward. Named sets:
   // "z_min", "z_max" (the ends), and for an open panel "theta_min", "theta_max".
   static ShellModel cylindrical_panel(double radius, double length, double angle,
-                                      int n_circumferential, int n_axial, double thickness) {
-    detail::require_positive("radius", radius);
-    detail::require_positive("length", length);
-    if (!(angle > 0.0 && angle <= 2.0 * kPi + 1e-12))
-      detail::invalid_parameter("angle", angle, "must lie in (0, 2π]");
-    const bool closed = angle > 2.0 * kPi - 1e-12;
-    require_count("n_circumferential", n_circumferential, closed ? 3 : 2);
-    require_count("n_axial", n_axial, 2);
-    auto surface = [&](double u, double v) {
-      const double theta = u * angle;
-      const Vector3 normal(std::cos(theta), std::sin(theta), 0.0);
-      return std::make_pair(Vector3(radius * normal.x(), radius * normal.y(), v * length), normal);
-    };
-    ShellModel model = structured(n_circumferential, n_axial, closed, surface, thickness);
-    const double tolerance = 1e-9 * std::max(radius, length);
-    model.define_set("z_min", [&](const Vector3& x) { return x.z() < tolerance; });
-    model.define_set("z_max", [&](const Vector3& x) { return x.z() > length - tolerance; });
-    if (!closed) {
-      const int n = n_circumferential;
-      ParticleSet first, last;
-      for (int j = 0; j < n_axial; ++j) {
-        first.push_back(j * n);
-        last.push_back(j * n + n - 1);
-      }
-      model.sets_["theta_min"] = first;
-      model.sets_["theta_max"] = last;
-    }
-    return model;
-  }
+                                      int n_circumferential, int n_axial, double thickness);
 
   // Spherical cap of a sphere of the given radius centred on the z-axis, apex at
   // (0, 0, radius), opening half-angle (radians). A square grid of n × n
@@ -317,42 +200,17 @@ class ShellModel {
   // singularity, but the cells near the four rim corners are distorted (interior
   // angles up to ≈ 175°, areas up to ≈ 6× the smallest at n = 21).
   // Normals point outward. Named sets: "boundary" (the rim), "apex".
-  static ShellModel spherical_cap(double radius, double half_angle, int n, double thickness) {
-    detail::require_positive("radius", radius);
-    if (!(half_angle > 0.0 && half_angle < kPi / 2))
-      detail::invalid_parameter("half_angle", half_angle, "must lie in (0, π/2)");
-    require_count("n", n, 3);
-    auto surface = [&](double u, double v) {
-      const double s = 2.0 * u - 1.0;
-      const double t = 2.0 * v - 1.0;
-      const double disc_x = s * std::sqrt(1.0 - t * t / 2.0);
-      const double disc_y = t * std::sqrt(1.0 - s * s / 2.0);
-      const double disc_radius = std::min(1.0, std::hypot(disc_x, disc_y));
-      const double polar = disc_radius * half_angle;
-      const double azimuth = std::atan2(disc_y, disc_x);
-      const Vector3 normal(std::sin(polar) * std::cos(azimuth), std::sin(polar) * std::sin(azimuth),
-                           std::cos(polar));
-      return std::make_pair(Vector3(radius * normal), normal);
-    };
-    ShellModel model = structured(n, n, false, surface, thickness);
-    ParticleSet rim;
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i)
-        if (i == 0 || j == 0 || i == n - 1 || j == n - 1) rim.push_back(j * n + i);
-    model.sets_["boundary"] = rim;
-    model.sets_["apex"] = {model.nearest_particle(Vector3(0.0, 0.0, radius))};
-    return model;
-  }
+  static ShellModel spherical_cap(double radius, double half_angle, int n, double thickness);
 
   // The thickness the model was built with; set_thickness can change it in regions.
   double thickness() const { return thickness_; }
   // Wall thickness at a particle and at a stress point (m).
   double particle_thickness(std::size_t i) const {
-    check_index("particle", i, particle_count());
+    detail::model_checks::check_index("particle", i, particle_count());
     return particle_thickness_[i];
   }
   double stress_point_thickness(std::size_t p) const {
-    check_index("stress point", p, stress_point_count());
+    detail::model_checks::check_index("stress point", p, stress_point_count());
     return stress_point_thickness_[p];
   }
   double minimum_thickness() const {
@@ -365,7 +223,7 @@ class ShellModel {
   // many points changed; a region that holds no point is an Error.
   template <class Predicate>
   std::size_t set_thickness(Predicate&& where, double d) {
-    require_thin("thickness", d, extent());
+    detail::model_checks::require_thin("thickness", d, extent());
     std::size_t count = 0;
     for (std::size_t i = 0; i < particle_position.size(); ++i)
       if (where(particle_position[i])) particle_thickness_[i] = d, ++count;
@@ -378,13 +236,13 @@ class ShellModel {
   // The wall thickness of one particle or one stress point (m), e.g. from a
   // mesh file's shell sections; the mid-surface stays where it is.
   void set_particle_thickness(std::size_t i, double d) {
-    check_index("particle", i, particle_count());
-    require_thin("particle " + std::to_string(i) + " thickness", d, extent());
+    detail::model_checks::check_index("particle", i, particle_count());
+    detail::model_checks::require_thin("particle " + std::to_string(i) + " thickness", d, extent());
     particle_thickness_[i] = d;
   }
   void set_stress_point_thickness(std::size_t p, double d) {
-    check_index("stress point", p, stress_point_count());
-    require_thin("stress point " + std::to_string(p) + " thickness", d, extent());
+    detail::model_checks::check_index("stress point", p, stress_point_count());
+    detail::model_checks::require_thin("stress point " + std::to_string(p) + " thickness", d, extent());
     stress_point_thickness_[p] = d;
   }
   std::size_t particle_count() const { return particle_position.size(); }
@@ -474,262 +332,10 @@ class ShellModel {
   // Particles at the nodes of an nu × nv parametric grid on [0,1]², stress points
   // at the cell centres; `periodic_u` closes the grid in u (a full tube).
   template <class Surface>
-  static ShellModel structured(int nu, int nv, bool periodic_u, Surface&& surface, double thickness) {
-    std::vector<Vector3> positions, normals;
-    const int columns = periodic_u ? nu : nu - 1;
-    auto u_of = [&](double i) { return i / columns; };
-    for (int j = 0; j < nv; ++j)
-      for (int i = 0; i < nu; ++i) {
-        auto point = surface(u_of(i), static_cast<double>(j) / (nv - 1));
-        positions.push_back(point.first);
-        normals.push_back(point.second);
-      }
-    std::vector<Quad> quads;
-    std::vector<Vector3> centres, centre_normals;
-    for (int j = 0; j + 1 < nv; ++j)
-      for (int i = 0; i < columns; ++i) {
-        const int next = (i + 1) % nu;
-        quads.push_back({j * nu + i, j * nu + next, (j + 1) * nu + next, (j + 1) * nu + i});
-        auto centre = surface(u_of(i + 0.5), (j + 0.5) / (nv - 1));
-        centres.push_back(centre.first);
-        centre_normals.push_back(centre.second);
-      }
-    return from_quads(std::move(positions), std::move(normals), quads, std::move(centres),
-                      std::move(centre_normals), thickness);
-  }
+  static ShellModel structured(int nu, int nv, bool periodic_u, Surface&& surface, double thickness);
 
-  // Geometry checks (docs/method.md §1; the limits are named so a message can state them).
-  // A quad whose area is below this fraction of its longest side squared is degenerate.
-  static constexpr double degenerate_area_fraction = 1e-12;
-  // A normal closer than this to a cell's plane (cosine of the angle to the
-  // cell normal, cos 80°) lies "in the sheet's plane".
-  static constexpr double in_plane_cosine = 0.17364817766693033;
-  // Particles closer than this fraction of the local spacing √A_i are near-coincident
-  // (small enough for cells a thousand times longer than wide).
-  static constexpr double coincident_spacing_fraction = 1e-3;
-  // The two area sets (particles, stress points) cover the same surface: their
-  // sums may differ by at most this fraction.
-  static constexpr double area_sum_tolerance = 0.02;
-  // One area this many times the median of its set is an outlier: the support
-  // radius follows the largest spacing, so it would widen every row.
-  static constexpr double area_outlier_ratio = 64.0;
-  // Particles whose spread across their main line is below this fraction of
-  // their extent lie on one line; a sheet flat to this fraction is planar.
-  static constexpr double collinear_fraction = 1e-6;
-  static constexpr double planar_fraction = 1e-9;
-
-  static void check_finite(const char* what, const char* quantity, const std::vector<Vector3>& values) {
-    for (std::size_t i = 0; i < values.size(); ++i)
-      if (!values[i].allFinite())
-        detail::invalid_parameter(std::string(what) + " " + std::to_string(i) + " " + quantity,
-                                  values[i].transpose(), "must be finite");
-  }
-  static std::string corners_text(const Quad& quad) {
-    return "{" + std::to_string(quad[0]) + ", " + std::to_string(quad[1]) + ", " + std::to_string(quad[2]) + ", " +
-           std::to_string(quad[3]) + "}";
-  }
-  // Every quad by index: corners in range and distinct, not degenerate, not
-  // self-intersecting, and counter-clockwise seen from its corners' normals.
-  static void check_quads(const std::vector<Vector3>& positions, const std::vector<Vector3>& normals,
-                          const std::vector<Quad>& quads) {
-    if (quads.empty()) detail::invalid_parameter("quad count", 0, "a shell needs quads");
-    check_finite("particle", "position", positions);
-    check_finite("particle", "normal", normals);
-    for (std::size_t q = 0; q < quads.size(); ++q) {
-      const Quad& quad = quads[q];
-      const auto quad_name = [q] { return "quad " + std::to_string(q); };
-      for (std::size_t k = 0; k < 4; ++k) {
-        if (quad[k] < 0 || static_cast<std::size_t>(quad[k]) >= positions.size())
-          detail::invalid_parameter(quad_name() + " corner " + std::to_string(k), quad[k],
-                                    "must lie in [0, " + std::to_string(positions.size()) + ")");
-        for (std::size_t l = 0; l < k; ++l)
-          if (quad[l] == quad[k])
-            detail::invalid_parameter(quad_name() + " corners", corners_text(quad),
-                                      "particle " + std::to_string(quad[k]) +
-                                          " is listed twice: four distinct corners (a degenerate quad)");
-      }
-      const Vector3 doubled_area = (positions[quad[2]] - positions[quad[0]]).cross(positions[quad[3]] - positions[quad[1]]);
-      double longest_squared = 0.0;
-      for (std::size_t k = 0; k < 4; ++k)
-        longest_squared = std::max(longest_squared, (positions[quad[(k + 1) % 4]] - positions[quad[k]]).squaredNorm());
-      // The largest corner triangle: zero only when all four corners lie on one line.
-      Vector3 largest_corner = Vector3::Zero();
-      for (std::size_t k = 0; k < 4; ++k) {
-        const Vector3& here = positions[quad[k]];
-        const Vector3 corner = (positions[quad[(k + 1) % 4]] - here).cross(positions[quad[(k + 3) % 4]] - here);
-        if (corner.norm() > largest_corner.norm()) largest_corner = corner;
-      }
-      const double area = 0.5 * doubled_area.norm();
-      if (!(0.5 * largest_corner.norm() > degenerate_area_fraction * longest_squared))
-        detail::invalid_parameter(quad_name() + " area", area,
-                                  "must be > 0: corners " + corners_text(quad) +
-                                      " are collinear or coincident (a degenerate quad)");
-      // A bow-tie's diagonals may have a zero cross product: then its largest corner gives the axis.
-      const bool diagonals_span = area > degenerate_area_fraction * longest_squared;
-      const Vector3 axis = diagonals_span ? doubled_area.normalized() : largest_corner.normalized();
-      // Turning direction at each corner about the quad's own normal: a simple
-      // quad turns one way at three or four corners, a bow-tie at two only.
-      int reversed_turns = 0;
-      for (std::size_t k = 0; k < 4; ++k) {
-        const Vector3& here = positions[quad[k]];
-        const Vector3 next = positions[quad[(k + 1) % 4]] - here, previous = positions[quad[(k + 3) % 4]] - here;
-        if (next.cross(previous).dot(axis) < 0.0) ++reversed_turns;
-      }
-      if (reversed_turns >= 2 || !diagonals_span)
-        detail::invalid_parameter(quad_name() + " corners", corners_text(quad),
-                                  "its edges cross (a bow-tie quad): list the corners in order around the quad");
-      int against = 0;
-      for (int corner : quad)
-        if (normals[corner].dot(axis) < 0.0) ++against;
-      if (against == 4)
-        detail::invalid_parameter(quad_name() + " corners", corners_text(quad),
-                                  "run clockwise seen from the side the normals point to (an inverted quad): list "
-                                  "them counter-clockwise");
-      for (int corner : quad) {
-        const double length = normals[corner].norm();
-        const double cosine = length > 0.0 ? normals[corner].dot(axis) / length : 0.0;
-        if (cosine < 0.0)
-          detail::invalid_parameter("particle " + std::to_string(corner) + " normal", normals[corner].transpose(),
-                                    "points against " + quad_name() + " (corners " + corners_text(quad) +
-                                        ") while its other corners' normals agree with it: neighbouring normals "
-                                        "must share one orientation");
-        if (length > 0.0 && cosine < in_plane_cosine)
-          detail::invalid_parameter("particle " + std::to_string(corner) + " normal", normals[corner].transpose(),
-                                    "lies (within 10°) in the plane of " + quad_name() +
-                                        ": a normal must point out of the sheet");
-      }
-    }
-  }
   // The bounding-box diagonal of the particles: a shell's thickness lies below it.
-  double extent() const {
-    Vector3 lower = particle_position.front(), upper = lower;
-    for (const Vector3& x : particle_position) lower = lower.cwiseMin(x), upper = upper.cwiseMax(x);
-    return (upper - lower).norm();
-  }
-  static void require_thin(const std::string& name, double d, double extent) {
-    detail::require_positive(name, d);
-    if (!(d < extent))
-      detail::invalid_parameter(name, d,
-                                "must be below the shell's extent " + std::to_string(extent) +
-                                    " m (the diagonal of its particles' bounding box): a shell is thin");
-  }
-  static double median(std::vector<double> values) {
-    const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-    std::nth_element(values.begin(), middle, values.end());
-    return *middle;
-  }
-  static void check_outliers(const std::vector<double>& areas, const std::string& what) {
-    const double typical = median(areas);
-    for (std::size_t i = 0; i < areas.size(); ++i)
-      if (areas[i] > area_outlier_ratio * typical)
-        detail::invalid_parameter(what + " " + std::to_string(i) + " area", areas[i],
-                                  "is " + std::to_string(areas[i] / typical) + " times the median " +
-                                      std::to_string(typical) + " m²; at most " + std::to_string(area_outlier_ratio) +
-                                      " times: the support radius follows the largest spacing, so one large area "
-                                      "widens every row");
-  }
-  // The sheet spans a surface: not one line; a flat sheet's normals point out of its plane.
-  void check_spans_a_surface() const {
-    Vector3 mean = Vector3::Zero();
-    for (const Vector3& x : particle_position) mean += x;
-    mean /= static_cast<double>(particle_position.size());
-    Matrix3 scatter = Matrix3::Zero();
-    for (const Vector3& x : particle_position) scatter += (x - mean) * (x - mean).transpose();
-    const Eigen::SelfAdjointEigenSolver<Matrix3> principal(scatter);
-    const Vector3 spread = principal.eigenvalues().cwiseMax(0.0).cwiseSqrt();  // ascending
-    if (!(spread[1] > collinear_fraction * spread[2]))
-      detail::invalid_parameter("particle positions", "(all on one line)",
-                                "a shell needs particles spanning a surface, at least 3 not on one line");
-    if (spread[0] > planar_fraction * spread[2]) return;
-    const Vector3 plane_normal = principal.eigenvectors().col(0);
-    auto check = [&](const std::vector<Vector3>& normals, const std::string& what) {
-      for (std::size_t i = 0; i < normals.size(); ++i)
-        if (std::abs(normals[i].dot(plane_normal)) < in_plane_cosine)
-          detail::invalid_parameter(what + " " + std::to_string(i) + " normal", normals[i].transpose(),
-                                    "lies (within 10°) in the plane of the flat sheet: a normal must point out of "
-                                    "the sheet");
-    };
-    check(particle_normal, "particle");
-    check(stress_point_normal, "stress point");
-  }
-  // Each particle's normal agrees in orientation with its nearest stress point's.
-  void check_orientation() const {
-    // The nearest stress point of a grid lies within 0.71 spacings; a particle
-    // with none within one spacing is not checked.
-    const double reach = std::sqrt(*std::max_element(stress_point_area.begin(), stress_point_area.end()));
-    const approx::CellList stress_points(stress_point_position, reach);
-    for (std::size_t i = 0; i < particle_count(); ++i) {
-      int nearest_point = -1;
-      double nearest_distance = std::numeric_limits<double>::infinity();
-      stress_points.for_each_within(particle_position[i], reach, [&](int p, double distance_squared) {
-        if (distance_squared < nearest_distance) nearest_distance = distance_squared, nearest_point = p;
-      });
-      if (nearest_point >= 0 && particle_normal[i].dot(stress_point_normal[nearest_point]) < 0.0)
-        detail::invalid_parameter("particle " + std::to_string(i) + " normal", particle_normal[i].transpose(),
-                                  "points against the normal (" +
-                                      vector_text(stress_point_normal[nearest_point]) + ") of the nearest stress point " +
-                                      std::to_string(nearest_point) +
-                                      ": neighbouring normals must share one orientation");
-    }
-  }
-  static std::string vector_text(const Vector3& v) {
-    std::ostringstream text;
-    text << v.transpose();
-    return text.str();
-  }
-  // No two particles closer than coincident_spacing_fraction × √A_i.
-  void check_separation() const {
-    // Cells about one spacing wide: a few particles each (cells as narrow as
-    // the tolerance would be mostly empty and slow to search).
-    double reach = 0.0;
-    for (double area : particle_area) reach = std::max(reach, std::sqrt(area));
-    const approx::CellList particles(particle_position, reach);
-    for (std::size_t i = 0; i < particle_count(); ++i) {
-      const double limit = coincident_spacing_fraction * std::sqrt(particle_area[i]);
-      particles.for_each_within(particle_position[i], limit, [&](int j, double distance_squared) {
-        if (static_cast<std::size_t>(j) <= i) return;
-        detail::invalid_parameter(
-            "distance between particles " + std::to_string(i) + " and " + std::to_string(j),
-            std::sqrt(distance_squared),
-            "must be at least " + std::to_string(coincident_spacing_fraction) + " of the local spacing √A = " +
-                std::to_string(std::sqrt(particle_area[i])) + " m: near-coincident particles (merge them)");
-      });
-    }
-  }
-  void check_area_sums() const {
-    double particles = 0.0, stress_points = 0.0;
-    for (double area : particle_area) particles += area;
-    for (double area : stress_point_area) stress_points += area;
-    if (std::abs(particles - stress_points) > area_sum_tolerance * std::max(particles, stress_points))
-      detail::invalid_parameter("sum of the particle areas", particles,
-                                "must equal the sum of the stress point areas " + std::to_string(stress_points) +
-                                    " m² within " + std::to_string(100.0 * area_sum_tolerance) +
-                                    " %: each set of areas covers the mid-surface once");
-  }
-
-  static void require_count(const char* name, int value, int minimum) {
-    if (value < minimum)
-      detail::invalid_parameter(name, value, "must be at least " + std::to_string(minimum));
-  }
-  static void check_sizes(const std::vector<Vector3>& positions, const std::vector<Vector3>& normals) {
-    if (normals.size() != positions.size())
-      detail::invalid_parameter("normal count", normals.size(),
-                                "must equal the particle count (" + std::to_string(positions.size()) + ")");
-  }
-  static void check_cell(const Cell& cell, std::size_t index, std::size_t particle_count) {
-    const std::string name = "cell " + std::to_string(index) + " corner index";
-    for (std::size_t k = 0; k < cell.size(); ++k) {
-      if (cell[k] < 0 || static_cast<std::size_t>(cell[k]) >= particle_count)
-        detail::invalid_parameter(name, cell[k], "must lie in [0, " + std::to_string(particle_count) + ")");
-      for (std::size_t l = 0; l < k; ++l)
-        if (cell[l] == cell[k]) detail::invalid_parameter(name, cell[k], "listed twice (a degenerate cell)");
-    }
-  }
-  static void check_index(const char* what, std::size_t index, std::size_t count) {
-    if (index >= count)
-      detail::invalid_parameter(std::string(what) + " index", index,
-                                "must be below the count (" + std::to_string(count) + ")");
-  }
+  double extent() const { return detail::model_checks::extent(particle_position); }
   double area_per_particle(std::size_t p) const {
     const bool triangle = !cells_.empty() && cells_[p].is_triangle();
     return triangle ? 2.0 * stress_point_area[p] : stress_point_area[p];
@@ -768,13 +374,14 @@ class ShellModel {
       detail::invalid_parameter("particle count", n, "a shell needs at least 3 particles, not on one line");
     normalize_all(particle_position, particle_normal, particle_area, "particle");
     normalize_all(stress_point_position, stress_point_normal, stress_point_area, "stress point");
-    check_spans_a_surface();
-    require_thin("thickness", thickness_, extent());
-    check_outliers(stress_point_area, "stress point");
-    check_outliers(particle_area, "particle");
-    check_area_sums();
-    check_orientation();
-    check_separation();
+    detail::model_checks::check_spans_a_surface(particle_position, particle_normal, stress_point_normal);
+    detail::model_checks::require_thin("thickness", thickness_, extent());
+    detail::model_checks::check_outliers(stress_point_area, "stress point");
+    detail::model_checks::check_outliers(particle_area, "particle");
+    detail::model_checks::check_area_sums(particle_area, stress_point_area);
+    detail::model_checks::check_orientation(particle_position, particle_normal, stress_point_position,
+                                            stress_point_normal, stress_point_area);
+    detail::model_checks::check_separation(particle_position, particle_area);
   }
   static void normalize_all(const std::vector<Vector3>& positions, std::vector<Vector3>& normals,
                             const std::vector<double>& areas, const std::string& what) {
@@ -799,3 +406,5 @@ class ShellModel {
 };
 
 }  // namespace sphshell
+
+#include <sphshell/shell/model_builders.hpp>

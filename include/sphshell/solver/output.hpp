@@ -38,6 +38,7 @@
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/io/csv_probe.hpp>
+#include <sphshell/io/output_directory.hpp>
 #include <sphshell/io/pvd_collection.hpp>
 #include <sphshell/io/vtu_writer.hpp>
 #include <sphshell/solver/options.hpp>
@@ -143,12 +144,12 @@ class SolverOutput {
   // Creates the output directory at once, so that a path that cannot be one
   // fails before the run rather than at its first frame.
   explicit SolverOutput(const OutputOptions& options) : options_(options) {
-    if (!options_.output_directory.empty()) make_directory(options_.output_directory, "", "output_directory");
+    if (!options_.output_directory.empty()) io::make_directory(options_.output_directory, "", "output_directory");
   }
 
   template <class Probe, class Solver>
   void add_probe(const std::string& csv_path, Probe probe, const Solver& solver) {
-    const std::string key = identity_of(csv_path);
+    const std::string key = io::identity_of(csv_path);
     for (const OpenProbe& open : probes_)
       if (open.key == key)
         throw Error("sphshell: probe file '" + csv_path + "' is already the file of another probe (added as '" +
@@ -229,7 +230,7 @@ class SolverOutput {
 
   static void create_parent_directory(const std::string& path) {
     const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-    if (!parent.empty()) make_directory(parent.string(), "probe file '" + path + "': ", "its folder");
+    if (!parent.empty()) io::make_directory(parent.string(), "probe file '" + path + "': ", "its folder");
   }
 
  private:
@@ -260,62 +261,14 @@ class SolverOutput {
 
   std::string series_path(const std::string& name) const { return options_.output_directory + "/" + name; }
 
-  // A folder that exists, or is created; anything else is an Error naming it
-  // and the system's reason (not a folder, under a file, on a read-only or
-  // virtual file system such as /proc). lead starts the message, noun names
-  // the folder: ("", "output_directory") or ("probe file 'p.csv': ", "its folder").
-  static void make_directory(const std::string& directory, const std::string& lead, const std::string& noun) {
-    namespace fs = std::filesystem;
-    std::error_code error;
-    const fs::file_status status = fs::status(directory, error);
-    if (fs::is_directory(status)) return;
-    if (fs::exists(status))
-      throw Error("sphshell: " + lead + noun + " '" + directory + "' is a file, not a folder");
-    error.clear();
-    fs::create_directories(directory, error);
-    if (error || !fs::is_directory(fs::status(directory, error)))
-      throw Error("sphshell: " + lead + "cannot create " + noun + " '" + directory + "' (" +
-                  (error ? error.message() : std::string("not created")) + ")");
-  }
-
-  static std::string identity_of(const std::string& path) {
-    namespace fs = std::filesystem;
-    std::error_code error;
-    fs::path absolute = fs::absolute(path, error);
-    if (error) absolute = path;
-    const fs::path canonical = fs::weakly_canonical(absolute, error);
-    return (error ? absolute.lexically_normal() : canonical).string();
-  }
-
-  // A frame file of this library's series: particles, stress_points or
-  // cracks, then "_<digits>.vtu" or ".pvd", optionally ".tmp" (a write cut
-  // short by a kill).
-  static bool is_frame_file(std::string name) {
-    const std::string temporary = ".tmp";
-    if (name.size() > temporary.size() && name.compare(name.size() - temporary.size(), temporary.size(), temporary) == 0)
-      name.resize(name.size() - temporary.size());
-    for (const std::string series : {"particles", "stress_points", "cracks"}) {
-      if (name.compare(0, series.size(), series) != 0) continue;
-      const std::string rest = name.substr(series.size());
-      if (rest == ".pvd") return true;
-      const std::string extension = ".vtu";
-      if (rest.size() > 1 + extension.size() && rest[0] == '_' &&
-          rest.compare(rest.size() - extension.size(), extension.size(), extension) == 0) {
-        const std::string digits = rest.substr(1, rest.size() - 1 - extension.size());
-        if (std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; })) return true;
-      }
-    }
-    return false;
-  }
-
   // The collections of this run, empty, in place of an earlier run's: first
   // a stale cracks.pvd of a run with cracks when this one has none, then the
   // collections are replaced together (so that at no moment do they list
   // different frames, or frames that are gone), then the earlier frames and
   // the temporaries of a killed run are removed. Other files stay.
   void start_series(bool with_cracks) {
-    make_directory(options_.output_directory, "", "output_directory");
-    if (!with_cracks) remove_file(series_path("cracks.pvd"));
+    io::make_directory(options_.output_directory, "", "output_directory");
+    if (!with_cracks) io::remove_file(series_path("cracks.pvd"));
     particle_collection_ = std::make_unique<io::PvdCollection>(series_path("particles.pvd"), false);
     stress_point_collection_ = std::make_unique<io::PvdCollection>(series_path("stress_points.pvd"), false);
     std::vector<const io::PvdCollection*> collections{particle_collection_.get(), stress_point_collection_.get()};
@@ -330,18 +283,12 @@ class SolverOutput {
     for (fs::directory_iterator entry(options_.output_directory, error), end; !error && entry != end;
          entry.increment(error)) {
       const std::string name = entry->path().filename().string();
-      if (is_frame_file(name) && name.compare(name.size() - 4, 4, ".pvd") != 0) stale.push_back(entry->path());
+      if (io::is_frame_file(name) && name.compare(name.size() - 4, 4, ".pvd") != 0) stale.push_back(entry->path());
     }
     if (error)
       throw Error("sphshell: cannot list output_directory '" + options_.output_directory + "' (" + error.message() +
                   ")");
-    for (const fs::path& file : stale) remove_file(file.string());
-  }
-
-  static void remove_file(const std::string& path) {
-    std::error_code error;
-    std::filesystem::remove(path, error);
-    if (error) throw Error("sphshell: cannot remove the earlier frame file '" + path + "' (" + error.message() + ")");
+    for (const fs::path& file : stale) io::remove_file(file.string());
   }
 
   template <class Solver>

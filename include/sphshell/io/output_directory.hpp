@@ -1,0 +1,69 @@
+#pragma once
+// The output folder and the files of the frame series in it: creating the
+// folder (or an Error with the system's reason), a file's identity, which
+// files belong to the library's series, and removing an earlier run's frames.
+
+#include <algorithm>
+#include <filesystem>
+#include <sphshell/core/error.hpp>
+#include <string>
+#include <system_error>
+
+namespace sphshell::io {
+
+// A folder that exists, or is created; anything else is an Error naming it
+// and the system's reason (not a folder, under a file, on a read-only or
+// virtual file system such as /proc). lead starts the message, noun names
+// the folder: ("", "output_directory") or ("probe file 'p.csv': ", "its folder").
+inline void make_directory(const std::string& directory, const std::string& lead, const std::string& noun) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  const fs::file_status status = fs::status(directory, error);
+  if (fs::is_directory(status)) return;
+  if (fs::exists(status)) throw Error("sphshell: " + lead + noun + " '" + directory + "' is a file, not a folder");
+  error.clear();
+  fs::create_directories(directory, error);
+  if (error || !fs::is_directory(fs::status(directory, error)))
+    throw Error("sphshell: " + lead + "cannot create " + noun + " '" + directory + "' (" +
+                (error ? error.message() : std::string("not created")) + ")");
+}
+
+// A file's identity: its absolute, normalized path (two names of one file agree).
+inline std::string identity_of(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  fs::path absolute = fs::absolute(path, error);
+  if (error) absolute = path;
+  const fs::path canonical = fs::weakly_canonical(absolute, error);
+  return (error ? absolute.lexically_normal() : canonical).string();
+}
+
+// A frame file of this library's series: particles, stress_points or
+// cracks, then "_<digits>.vtu" or ".pvd", optionally ".tmp" (a write cut
+// short by a kill).
+inline bool is_frame_file(std::string name) {
+  const std::string temporary = ".tmp";
+  if (name.size() > temporary.size() && name.compare(name.size() - temporary.size(), temporary.size(), temporary) == 0)
+    name.resize(name.size() - temporary.size());
+  for (const std::string series : {"particles", "stress_points", "cracks"}) {
+    if (name.compare(0, series.size(), series) != 0) continue;
+    const std::string rest = name.substr(series.size());
+    if (rest == ".pvd") return true;
+    const std::string extension = ".vtu";
+    if (rest.size() > 1 + extension.size() && rest[0] == '_' &&
+        rest.compare(rest.size() - extension.size(), extension.size(), extension) == 0) {
+      const std::string digits = rest.substr(1, rest.size() - 1 - extension.size());
+      if (std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; })) return true;
+    }
+  }
+  return false;
+}
+
+// Removes an earlier run's frame file; a failure is an Error with the reason.
+inline void remove_file(const std::string& path) {
+  std::error_code error;
+  std::filesystem::remove(path, error);
+  if (error) throw Error("sphshell: cannot remove the earlier frame file '" + path + "' (" + error.message() + ")");
+}
+
+}  // namespace sphshell::io
