@@ -266,6 +266,14 @@ int run(const Arguments& a) {
   }
   options.rotary_inertia_scale = rotary_scale;
   options.particle_integration_share = a.particle_share;
+  // The transverse shear of the figures above: from the shape functions, with
+  // the particles' shear term (docs/method.md §4). With the library's default,
+  // the shear tied to the cell edges, the crack's axial growth by 400 µs at
+  // 2.5 mm is 20.8 mm at the rear end but 10.8 mm at the front (measured with
+  // ctest -R detonation_tube_axial_running): the path of this crack depends on
+  // the shear form, and it has not been re-validated with the tied one.
+  options.transverse_shear = TransverseShear::shape_functions;
+  options.particle_shear_weight = 0.01;
   options.output_directory = a.frames ? a.output : "";
   options.output_interval = a.frames ? 1e-5 : 0.0;
   const double notch_centre = 0.5 * a.length;

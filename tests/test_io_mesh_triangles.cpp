@@ -193,16 +193,15 @@ TEST_CASE("A free triangle plate has exactly six zero-energy modes", "[io][mesh]
   }
 }
 
-// Known miss, kept at the full criterion: with the diagonals alternating (a
-// union-flag pattern) the stress points sit at (1/3, 1/3) and (2/3, 2/3) of
-// the cells in a checkerboard, and the free plate's first elastic mode comes
-// out stiff: 1070 rad/s against Leissa's 843 (+26.9 %) at 11 × 11, L/d = 50,
-// while uniform diagonals give 826 (−2.0 %) and quads 820 (−2.8 %). The excess
-// grows with slenderness (+46 % at L/d = 100) and shrinks with refinement
-// (+9.1 % at 21 × 21, L/d = 50): transverse-shear over-constraint, as in the
-// thin clamped plate below.
+// With the diagonals alternating (a union-flag pattern) the stress points sit
+// at (1/3, 1/3) and (2/3, 2/3) of the cells in a checkerboard. With the
+// shape-function shear the free plate's first elastic mode came out stiff:
+// 1070 rad/s against Leissa's 843 (+26.9 %) at 11 × 11, L/d = 50 (transverse
+// shear over-constrained). With the shear tied to the cell edges
+// (docs/method.md §4) it is 826 rad/s (−2.0 %); uniform diagonals give 834
+// (−1.0 %) and quads 827 (−1.9 %).
 TEST_CASE("Free triangle plate, alternating diagonals: first elastic frequency within 5 % of Leissa's",
-          "[io][mesh][triangles][stability][!shouldfail]") {
+          "[io][mesh][triangles][stability]") {
   const Eigen::VectorXd eigenvalues = free_spectrum(triangle_plate(0.5, 0.5, 11, 11, 0.01, Diagonals::alternating));
   WARN("alternating diagonals: seventh frequency " << std::sqrt(eigenvalues[6]) << " rad/s, Leissa "
                                                    << leissa_first_frequency(0.5, 0.01));
@@ -210,14 +209,15 @@ TEST_CASE("Free triangle plate, alternating diagonals: first elastic frequency w
 }
 
 // Known miss, kept at the full criterion: the triangles lock in transverse
-// shear. A triangle mesh has two stress points per node against the quad
-// grid's one, so about four shear constraints per node act on three bending
-// unknowns (w and two rotations); the plate is too stiff, the more so the
-// thinner it is. Measured at 21 × 21 (w D/(q L⁴), triangles vs quads):
-// L/d = 10: −0.55 %, L/d = 50: −5.75 %, L/d = 100: −12.6 %; at L/d = 50 the gap
-// closes with refinement (−2.17 % at 31 × 31, −1.03 % at 41 × 41) as both
-// converge on Mindlin's value from either side. Tagged [!shouldfail] so the
-// suite reports the day a reduced shear integration for triangles fixes it.
+// shear. The shear is tied to the cell edges (docs/method.md §4), and a
+// triangle mesh has about three edges per node against the quad grid's two,
+// as many shear constraints as bending unknowns (w and two rotations); the
+// plate is too stiff, the more so the thinner it is. Measured at 21 × 21
+// (w D/(q L⁴), triangles vs quads, static solutions equal to this relaxation's):
+// L/d = 10: −0.42 %, L/d = 50: −1.96 %, L/d = 100: −6.1 % (with the former
+// shape-function shear: −0.55, −5.75, −12.6 %); at L/d = 50 the gap closes with
+// refinement (−0.50 % at 31 × 31, −0.22 % at 41 × 41). Tagged [!shouldfail] so
+// the suite reports the day a triangle shear that does not lock fixes it.
 TEST_CASE("Clamped triangle plate, L/d = 50: centre deflection within 1 % of the quad plate's",
           "[io][mesh][triangles][plate][validation][!shouldfail]") {
   const double d = 1.0 / 50, mindlin = 0.0012754;

@@ -248,16 +248,19 @@ class FractureManager<Crack, true> {
       if (parts.points.count(group) == 0) continue;
       const std::vector<std::size_t> rows = rows_near(group, segments, new_fragments, parts);
       std::vector<Rebuild> outcome(rows.size(), Rebuild::skipped);
+      std::vector<double> dropped(rows.size(), 0.0);  // tied shear energy a hidden cell corner lets go
       parallel::for_each(std::size_t{0}, rows.size(),
-                         [&](std::size_t k) { outcome[k] = rebuild_row(group, rows[k], parts); });
+                         [&](std::size_t k) { outcome[k] = rebuild_row(group, rows[k], parts, dropped[k]); });
       // Released energies are booked in row order, whatever the thread count.
-      for (std::size_t k = 0; k < rows.size(); ++k)
+      for (std::size_t k = 0; k < rows.size(); ++k) {
+        released_energy_ += dropped[k];
         if (outcome[k] == Rebuild::cut_loose) {
           const std::size_t p = parts.points.point(group, rows[k]);
           released_energy_ += stored_energy(p, parts);
           parts.states.deactivate(p);
           parts.assembler.clear_slots(group, rows[k], parts.points);
         }
+      }
     }
     parts.points.build_slot_transpose(parts.model.particle_count());
     parts.assembler.sum_particle_forces(parts.points, parts.forces);
@@ -284,7 +287,7 @@ class FractureManager<Crack, true> {
   }
 
   template <class Parts>
-  Rebuild rebuild_row(PointGroup group, std::size_t row, const Parts& parts) const {
+  Rebuild rebuild_row(PointGroup group, std::size_t row, const Parts& parts, double& dropped_tied_energy) const {
     const std::size_t p = parts.points.point(group, row);
     if (!parts.states.active(p)) return Rebuild::skipped;
     const Vector3& x = parts.points.positions(parts.model, group)[row];
@@ -302,7 +305,12 @@ class FractureManager<Crack, true> {
         parts.points.gather(group, row, parts.particles.position, parts.particles.director);
     parts.states.restart_strains(p, parts.assembler.strains_of(current, parts.points.reference(p)));
     parts.assembler.clear_slots(group, row, parts.points);
-    parts.assembler.scatter_point(group, row, current, parts.points, parts.states);
+    // The edge-tied shear does not depend on the shape functions; it lets its
+    // energy go only when a corner of the cell is hidden (docs/method.md §6).
+    const double tied_energy =
+        parts.assembler.scatter_point(group, row, current, parts.particles, parts.points, parts.states);
+    dropped_tied_energy = parts.states.tied_shear_energy(p) - tied_energy;
+    parts.states.tied_shear_energy(p) = tied_energy;
     return Rebuild::rebuilt;
   }
 

@@ -14,6 +14,7 @@
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
+#include <sphshell/shell/cell_shear.hpp>
 #include <sphshell/shell/kinematics.hpp>
 #include <sphshell/shell/model.hpp>
 #include <sphshell/solver/options.hpp>
@@ -66,6 +67,7 @@ class IntegrationPoints {
     const std::size_t stress_points = model.stress_point_count();
     const std::size_t particle_points = particles_integrate ? model.particle_count() : 0;
     offset_ = {0, stress_points};
+    tie_shear(model, physics, shear_modulus);
     compute_weights(model, physics, particle_integration, shear_modulus, stress_points, particle_points);
     reference_.resize(size());
     for (PointGroup group : point_groups)
@@ -97,6 +99,12 @@ class IntegrationPoints {
   // at particles) for transverse shear.
   double membrane_bending_weight(std::size_t p) const { return membrane_bending_weight_[p]; }
   double shear_weight(std::size_t p) const { return shear_weight_[p]; }
+  // The edge-tied shear of a stress point's cell (TransverseShear::cell_edges);
+  // its `corners` is 0 for a point whose shear comes from the shape functions.
+  bool shear_tied(PointGroup group, std::size_t row) const {
+    return group == PointGroup::stress_points && !shear_tying_.empty() && shear_tying_[row].corners > 0;
+  }
+  const shell::CellShearTying& shear_tying(std::size_t row) const { return shear_tying_[row]; }
   const shell::SurfaceGradients& reference(std::size_t p) const { return reference_[p]; }
 
   // Interpolated a1, a2, n, n1, n2 of one row from particle positions x and directors d.
@@ -236,7 +244,10 @@ class IntegrationPoints {
     for (std::size_t p = 0; p < stress_points; ++p) {
       const double d = model.stress_point_thickness(p);
       membrane_bending_weight_[p] = (1.0 - share) * model.stress_point_area[p];
-      shear_weight_[p] = model.stress_point_area[p] * physics.shear_correction * shear_modulus * d;
+      // A tied point's shear is the cell's (shear_tying); none from the shape functions.
+      shear_weight_[p] = shear_tied(PointGroup::stress_points, p)
+                             ? 0.0
+                             : model.stress_point_area[p] * physics.shear_correction * shear_modulus * d;
     }
     // The particles' shear term is softened by d² / (d² + s Δ²) with the local
     // spacing Δ = √A (docs/method.md, "Quadrature and the particle share").
@@ -252,7 +263,34 @@ class IntegrationPoints {
     }
   }
 
+  // Ties every stress point's shear to its cell's edges (TransverseShear::cell_edges,
+  // a model with cells). A corner outside the point's row would leave its forces
+  // nowhere to go: the support is too small for the cell.
+  void tie_shear(const ShellModel& model, const PhysicsOptions& physics, double shear_modulus) {
+    shear_tying_.clear();
+    if (physics.transverse_shear != TransverseShear::cell_edges || model.cells().empty()) return;
+    const approx::ShapeFunctions& sf = shape(PointGroup::stress_points);
+    shear_tying_.resize(model.stress_point_count());
+    for (std::size_t row = 0; row < shear_tying_.size(); ++row) {
+      const Cell& cell = model.cells()[row];
+      for (int corner : cell) {
+        bool found = false;
+        for (std::size_t s = sf.row_begin[row]; s < sf.row_begin[row] + sf.row_size[row]; ++s)
+          found = found || sf.neighbour[s] == corner;
+        if (!found)
+          detail::invalid_parameter("support_radius_factor", physics.support_radius_factor,
+                                    "too small: corner particle " + std::to_string(corner) + " of cell " +
+                                        std::to_string(row) + " lies outside its stress point's support");
+      }
+      const double stiffness = physics.shear_correction * shear_modulus * model.stress_point_thickness(row);
+      shear_tying_[row] = shell::tie_cell_shear(cell.begin(), static_cast<int>(cell.size()), model.particle_position,
+                                                model.particle_normal, frame(PointGroup::stress_points, row),
+                                                stiffness, model.stress_point_area[row]);
+    }
+  }
+
   double smoothing_length_ = 0.0;
+  std::vector<shell::CellShearTying> shear_tying_;  // per stress point, or empty
   std::array<approx::ShapeFunctions, 2> shape_;
   std::array<std::vector<TangentFrame>, 2> frames_;  // evaluation frames, kept for rebuilds
   std::array<std::size_t, 2> offset_{};

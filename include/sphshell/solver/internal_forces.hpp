@@ -11,12 +11,14 @@
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/parallel.hpp>
 #include <sphshell/core/types.hpp>
+#include <sphshell/shell/cell_shear.hpp>
 #include <sphshell/shell/kinematics.hpp>
 #include <sphshell/solver/integration_points.hpp>
 #include <sphshell/solver/particles.hpp>
 #include <sphshell/solver/section_states.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -50,10 +52,13 @@ class InternalForceAssembler {
   }
 
   // Forces of one point's stored resultants on the slots of its row (no
-  // material update), from the current surface gradients.
+  // material update), from the current surface gradients, plus the forces of
+  // its edge-tied shear from the particles' configuration. Returns the tied
+  // shear's elastic energy (0 for a point whose shear is not tied).
   template <class Approx, class Rule, class Law>
-  void scatter_point(PointGroup group, std::size_t row, const shell::SurfaceGradients& current,
-                     const IntegrationPoints<Approx>& points, const SectionStates<Rule, Law>& states) {
+  double scatter_point(PointGroup group, std::size_t row, const shell::SurfaceGradients& current,
+                       const ParticleState& particles, const IntegrationPoints<Approx>& points,
+                       const SectionStates<Rule, Law>& states) {
     const std::size_t p = points.point(group, row);
     const double w = points.membrane_bending_weight(p);
     const shell::WeightedStresses weighted{w * states.membrane_force(p), w * states.bending_moment(p),
@@ -66,6 +71,7 @@ class InternalForceAssembler {
       slot_force_[slot] = shape.dphi_d1[s] * f.a1 + shape.dphi_d2[s] * f.a2;
       slot_director_force_[slot] = shape.phi[s] * f.n + shape.dphi_d1[s] * f.n1 + shape.dphi_d2[s] * f.n2;
     }
+    return points.shear_tied(group, row) ? scatter_tied_shear(row, particles, points) : 0.0;
   }
 
   // Zeroes the forces a point left on the slots of its row (a removed point).
@@ -139,7 +145,34 @@ class InternalForceAssembler {
     states.membrane_force(p) = resultants.membrane;
     states.bending_moment(p) = resultants.moment;
     states.shear_force(p) = shear_force;
-    scatter_point(group, row, current, points, states);
+    const double tied_energy = scatter_point(group, row, current, particles, points, states);
+    // The tied shear is elastic and quadratic: its work over the step is
+    // exactly the change of its energy.
+    work_increment_[p] += tied_energy - states.tied_shear_energy(p);
+    states.tied_shear_energy(p) = tied_energy;
+  }
+
+  // Adds the forces of a stress point's edge-tied shear (shell/cell_shear.hpp)
+  // to the slots of its cell's corners in its row; returns its energy. A corner
+  // hidden from the point by a crack leaves the cell's shear out (energy 0).
+  template <class Approx>
+  double scatter_tied_shear(std::size_t row, const ParticleState& particles, const IntegrationPoints<Approx>& points) {
+    const shell::CellShearTying& tying = points.shear_tying(row);
+    const approx::ShapeFunctions& shape = points.shape(PointGroup::stress_points);
+    const std::size_t begin = shape.row_begin[row], end = begin + shape.row_size[row];
+    std::array<std::size_t, shell::max_cell_corners> corner_slot{};
+    for (int k = 0; k < tying.corners; ++k) {
+      std::size_t s = begin;
+      while (s < end && shape.neighbour[s] != tying.particle[k]) ++s;
+      if (s == end) return 0.0;
+      corner_slot[k] = points.slot(PointGroup::stress_points, s);
+    }
+    const shell::CellShearForces f = shell::cell_shear_forces(tying, particles.position, particles.director, nonlinear_);
+    for (int k = 0; k < tying.corners; ++k) {
+      slot_force_[corner_slot[k]] += f.force[k];
+      slot_director_force_[corner_slot[k]] += f.director_force[k];
+    }
+    return f.energy;
   }
 
   bool nonlinear_;

@@ -14,6 +14,22 @@
 
 namespace sphshell {
 
+// How the stress points form the transverse shear (docs/method.md §4,
+// "Transverse shear tied to the cell edges").
+enum class TransverseShear {
+  // Tied to the tangential shear strains of the stress point's cell edges and
+  // integrated at the cell's corners (an assumed strain, as MITC shell
+  // elements do): free of thin-plate locking. Needs the model's cells; a model
+  // made without cells (the general ShellModel constructor) uses
+  // shape_functions.
+  cell_edges,
+  // From the approximation's gradients at the stress point (one point per
+  // cell). It leaves a checkerboard deflection mode that only the particles'
+  // shear term (particle_shear_weight, e.g. 0.01) controls, and that term
+  // locks thin plates (clamped, L/d = 500: −8.6 % at 21 × 21 particles).
+  shape_functions,
+};
+
 // The shell's physics and its discretization.
 struct PhysicsOptions {
   double density = 7850.0;  // ρ, kg/m³
@@ -25,19 +41,24 @@ struct PhysicsOptions {
   // codes do to lift the shear–rotation frequency limit on thin shells.
   double rotary_inertia_scale = 1.0;
   double shear_correction = 5.0 / 6.0;  // κs of the elastic transverse shear
+  TransverseShear transverse_shear = TransverseShear::cell_edges;
 };
 
 // Particle integration (docs/method.md, "Quadrature and the particle share"):
 // the share of the membrane and bending work carried by the particles (the
 // stress points carry the rest), in [0, 1); the particles' transverse-shear
 // weight (a fraction of their area) and the softening d² / (d² + s Δ²) of its
-// stiffness. Any share > 0 removes the stress points' spurious zero-energy
-// modes. Fracture runs whose crack path matters want a small share such as
-// 0.02: only stress points become crack points (see the method document and
-// the README's measurements).
+// stiffness. Any share > 0 removes the stress points' spurious bending modes.
+// The particles' shear term is off by default: the edge-tied shear
+// (TransverseShear::cell_edges) needs no help, and the term locks thin plates.
+// With TransverseShear::shape_functions (or a model without cells) set it to
+// 0.01, the former default, to control the checkerboard deflection mode.
+// Fracture runs whose crack path matters want a small share such as 0.02:
+// only stress points become crack points (see the method document and the
+// README's measurements).
 struct ParticleIntegrationOptions {
   double particle_integration_share = 0.5;
-  double particle_shear_weight = 0.01;
+  double particle_shear_weight = 0.0;
   double particle_shear_softening = 0.01;
 };
 

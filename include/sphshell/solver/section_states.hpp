@@ -57,6 +57,7 @@ class SectionStates {
     curvature_.assign(total, StrainVoigt::Zero());
     shear_.assign(total, Vector2::Zero());
     shear_force_.assign(total, Vector2::Zero());
+    tied_shear_energy_.assign(total, 0.0);
     membrane_.assign(total, StressVoigt::Zero());
     moment_.assign(total, StressVoigt::Zero());
     active_.assign(total, 1);
@@ -79,6 +80,10 @@ class SectionStates {
   const StressVoigt& bending_moment(std::size_t p) const { return moment_[p]; }
   Vector2& shear_force(std::size_t p) { return shear_force_[p]; }
   const Vector2& shear_force(std::size_t p) const { return shear_force_[p]; }
+  // Elastic energy of a stress point's edge-tied shear at its last update
+  // (shell/cell_shear.hpp; 0 for points whose shear is not tied).
+  double& tied_shear_energy(std::size_t p) { return tied_shear_energy_[p]; }
+  double tied_shear_energy(std::size_t p) const { return tied_shear_energy_[p]; }
 
   // Restarts the strain bookkeeping of a point from new strains (after its
   // shape functions changed, so the change itself creates no strain).
@@ -95,7 +100,7 @@ class SectionStates {
   // Elastic energy held by one point (membrane, bending, shear), given its weights.
   double stored_energy(std::size_t p, double membrane_bending_weight, double shear_weight) const {
     const double shear = shear_weight > 0.0 ? 0.5 * shear_force_[p].squaredNorm() / shear_weight : 0.0;
-    return membrane_bending_weight * section(p).elastic_energy(state_[p]) + shear;
+    return membrane_bending_weight * section(p).elastic_energy(state_[p]) + shear + tied_shear_energy_[p];
   }
 
   double quantity(IntegralPointQuantity q, std::size_t p, int k) const {
@@ -144,6 +149,7 @@ class SectionStates {
   std::vector<State> state_;
   std::vector<StrainVoigt> membrane_strain_, curvature_;
   std::vector<Vector2> shear_, shear_force_;
+  std::vector<double> tied_shear_energy_;
   std::vector<StressVoigt> membrane_, moment_;
   std::vector<unsigned char> active_;
 };

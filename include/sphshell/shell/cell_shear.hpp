@@ -1,0 +1,156 @@
+#pragma once
+// Transverse shear of a cell tied to its edges (an assumed natural strain, as
+// in the MITC4 / MITC3 shell elements; docs/method.md §4, "Transverse shear
+// tied to the cell edges").
+//
+// On each edge a → b of a stress point's cell the tangential shear strain is
+//   e_ab = (x_b − x_a)·(d_a + d_b) / (2 ℓ_ab) − (the same in the reference),
+// ℓ_ab the reference edge length: the component γ·t of γ_α = a_α·n − A_α·N
+// (shell/kinematics.hpp) along the edge, with a_t the chord and n the mean of
+// the two directors. Both are second-order accurate at the edge midpoint, so a
+// smooth Kirchhoff motion (γ = 0) gives e = O(Δ²) on every edge, boundary
+// edges included: the thin-plate constraint is met without locking. A rigid
+// motion leaves every dot product unchanged, so it strains nothing.
+//
+// The cell's shear energy is integrated at its corners (the nodal rule of the
+// bilinear field MITC4 interpolates): at corner k the two edges meeting there
+// give the Cartesian shear γ_k = T_k⁻¹ (e_{k−1}, e_k), T_k the unit edge
+// tangents in the stress point's tangent plane, and each corner carries
+// κs G d A / m of the cell's area A (m = 3 or 4 corners):
+//   Π_s = ½ Σ_k (κs G d A / m) |γ_k|² = ½ eᵀ C e,  C = Σ_k (κs G d A / m) P_kᵀ (T_k T_kᵀ)⁻¹ P_k.
+// A uniform shear field is recovered exactly at every corner (the patch test),
+// and every edge strain is penalised, so the checkerboard deflection that a
+// one-point (cell-centre) shear cannot see has stiffness.
+
+#include <sphshell/core/error.hpp>
+#include <sphshell/core/frame.hpp>
+#include <sphshell/core/types.hpp>
+
+#include <Eigen/Dense>
+
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace sphshell::shell {
+
+inline constexpr int max_cell_corners = 4;
+using CellShearMatrix = Eigen::Matrix<double, max_cell_corners, max_cell_corners>;
+
+// What is fixed about one cell's tied shear (reference configuration). Edge e
+// runs from corner e to corner (e + 1) mod corners.
+struct CellShearTying {
+  CellShearTying() {
+    chord.fill(Vector3::Zero());  // Eigen vectors are not zeroed by {}
+    normal_sum.fill(Vector3::Zero());
+  }
+  int corners = 0;                                          // 3 or 4; 0: the cell is not tied
+  std::array<int, max_cell_corners> particle{};             // corner particle indices
+  std::array<Vector3, max_cell_corners> chord;              // X_b − X_a
+  std::array<Vector3, max_cell_corners> normal_sum;         // N_a + N_b
+  std::array<double, max_cell_corners> inverse_length{};    // 1 / ℓ_ab
+  std::array<double, max_cell_corners> reference_strain{};  // chord·normal_sum / (2ℓ)
+  CellShearMatrix stiffness = CellShearMatrix::Zero();      // C (N/m × m²: κs G d A per unit strain²)
+};
+
+// Below this |sin| of the angle between a corner's two edges the cell is
+// degenerate there (the corner cannot recover a Cartesian shear).
+inline constexpr double degenerate_corner_sine = 1e-6;
+
+// Ties the shear of a cell with the given corners (counter-clockwise), in the
+// tangent frame of its stress point, with the shear stiffness per unit area
+// κs G d (N/m) and the cell area A (m²).
+inline CellShearTying tie_cell_shear(const int* corners, int corner_count, const std::vector<Vector3>& positions,
+                                     const std::vector<Vector3>& normals, const TangentFrame& frame,
+                                     double shear_stiffness, double area) {
+  if (corner_count != 3 && corner_count != 4)
+    detail::invalid_parameter("cell corner count", corner_count, "a tied shear needs 3 or 4 corners");
+  CellShearTying tying;
+  tying.corners = corner_count;
+  std::array<Vector2, max_cell_corners> tangent;
+  for (int e = 0; e < corner_count; ++e) {
+    const int a = corners[e], b = corners[(e + 1) % corner_count];
+    tying.particle[e] = a;
+    tying.chord[e] = positions[b] - positions[a];
+    tying.normal_sum[e] = normals[a] + normals[b];
+    const double length = tying.chord[e].norm();
+    tying.inverse_length[e] = 1.0 / length;
+    tying.reference_strain[e] = tying.chord[e].dot(tying.normal_sum[e]) * 0.5 * tying.inverse_length[e];
+    tangent[e] = Vector2(frame.e1.dot(tying.chord[e]), frame.e2.dot(tying.chord[e])).normalized();
+  }
+  const double corner_weight = shear_stiffness * area / corner_count;
+  for (int k = 0; k < corner_count; ++k) {
+    const int before = (k + corner_count - 1) % corner_count;
+    const double cosine = tangent[before].dot(tangent[k]);
+    const double sine_squared = 1.0 - cosine * cosine;
+    if (!(sine_squared > degenerate_corner_sine * degenerate_corner_sine))
+      detail::invalid_parameter("cell corner at particle " + std::to_string(corners[k]) + " edge angle sine",
+                                std::sqrt(std::max(0.0, sine_squared)), "must not vanish (a degenerate cell)");
+    // (T Tᵀ)⁻¹ for the unit tangents of the two edges: the inverse Gram matrix.
+    const double scale = corner_weight / sine_squared;
+    tying.stiffness(before, before) += scale;
+    tying.stiffness(k, k) += scale;
+    tying.stiffness(before, k) -= scale * cosine;
+    tying.stiffness(k, before) -= scale * cosine;
+  }
+  return tying;
+}
+
+// The energy ½ eᵀ C e of a tied cell and its forces on the corner particles:
+// force[k] = ∂Π/∂x and director_force[k] = ∂Π/∂d of corner particle[k].
+struct CellShearForces {
+  CellShearForces() {
+    force.fill(Vector3::Zero());
+    director_force.fill(Vector3::Zero());
+  }
+  double energy = 0.0;
+  std::array<Vector3, max_cell_corners> force;
+  std::array<Vector3, max_cell_corners> director_force;
+};
+
+// Edge strains from positions x and directors d. The nonlinear form is the
+// exact dot product; the linear one (paper §3.1) its first-order part about
+// the reference configuration (X_b − X_a, N_a + N_b).
+inline Eigen::Matrix<double, max_cell_corners, 1> cell_edge_shear_strains(const CellShearTying& t,
+                                                                         const std::vector<Vector3>& x,
+                                                                         const std::vector<Vector3>& d,
+                                                                         bool nonlinear) {
+  Eigen::Matrix<double, max_cell_corners, 1> strain = Eigen::Matrix<double, max_cell_corners, 1>::Zero();
+  for (int e = 0; e < t.corners; ++e) {
+    const int a = t.particle[e], b = t.particle[(e + 1) % t.corners];
+    const Vector3 chord = x[b] - x[a], director_sum = d[a] + d[b];
+    const double value = nonlinear ? chord.dot(director_sum)
+                                   : (chord - t.chord[e]).dot(t.normal_sum[e]) +
+                                         t.chord[e].dot(director_sum - t.normal_sum[e]) +
+                                         t.chord[e].dot(t.normal_sum[e]);
+    strain[e] = value * 0.5 * t.inverse_length[e] - t.reference_strain[e];
+  }
+  return strain;
+}
+
+inline CellShearForces cell_shear_forces(const CellShearTying& t, const std::vector<Vector3>& x,
+                                         const std::vector<Vector3>& d, bool nonlinear) {
+  CellShearForces out;
+  if (t.corners == 0) return out;
+  const Eigen::Matrix<double, max_cell_corners, 1> strain = cell_edge_shear_strains(t, x, d, nonlinear);
+  const Eigen::Matrix<double, max_cell_corners, 1> edge_force = t.stiffness * strain;  // ∂Π/∂e
+  out.energy = 0.5 * strain.dot(edge_force);
+  for (int e = 0; e < t.corners; ++e) {
+    const int b_corner = (e + 1) % t.corners;
+    const int a = t.particle[e], b = t.particle[b_corner];
+    // ∂e/∂x_b = −∂e/∂x_a = (d_a + d_b)/(2ℓ), ∂e/∂d_a = ∂e/∂d_b = (x_b − x_a)/(2ℓ),
+    // at the current vectors (nonlinear) or the reference ones (linear).
+    const double factor = edge_force[e] * 0.5 * t.inverse_length[e];
+    const Vector3 along_normal = factor * (nonlinear ? Vector3(d[a] + d[b]) : t.normal_sum[e]);
+    const Vector3 along_chord = factor * (nonlinear ? Vector3(x[b] - x[a]) : t.chord[e]);
+    out.force[b_corner] += along_normal;
+    out.force[e] -= along_normal;
+    out.director_force[e] += along_chord;
+    out.director_force[b_corner] += along_chord;
+  }
+  return out;
+}
+
+}  // namespace sphshell::shell
