@@ -115,11 +115,12 @@ class SectionStates {
 
   // Checkpoints (solver/checkpoint.hpp): every point's material state (each
   // law's State, for_each_field; Section<Rule, Law>::State per rule), the
-  // strains of its last update, its resultants and whether it is active.
+  // strains of its last update, its resultants, the energy of its edge-tied
+  // shear and whether it is active.
   // The sections themselves follow from the model and the law.
   template <class Writer>
   void save(Writer& out) const {
-    out(state_, membrane_strain_, curvature_, shear_, shear_force_, membrane_, moment_, active_);
+    out(state_, membrane_strain_, curvature_, shear_, shear_force_, membrane_, moment_, tied_shear_energy_, active_);
   }
   template <class Reader>
   void load(Reader& in) {
@@ -130,6 +131,7 @@ class SectionStates {
     in.read_exact(shear_force_, "transverse shear forces");
     in.read_exact(membrane_, "membrane forces");
     in.read_exact(moment_, "bending moments");
+    in.read_exact(tied_shear_energy_, "edge-tied shear energies");
     in.read_exact(active_, "active flags");
   }
 
