@@ -232,6 +232,22 @@ TEST_CASE("Clamped triangle plate, L/d = 50: centre deflection within 1 % of the
   CHECK(triangles.first == Approx(quad.first).epsilon(0.01));
 }
 
+// The same plate one refinement up: the triangles' shear constraint relaxes
+// with the spacing and the two meshes agree within 1 % (measured −0.50 %).
+TEST_CASE("Clamped triangle plate, L/d = 50, 31 x 31: centre deflection within 1 % of the quad plate's",
+          "[io][mesh][triangles][plate][validation]") {
+  const double d = 1.0 / 50, mindlin = 0.0012754;
+  const auto quad = clamped_coefficient(ShellModel::rectangular_plate(1.0, 1.0, 31, 31, d), d);
+  const auto triangles = clamped_coefficient(triangle_plate(1.0, 1.0, 31, 31, d, Diagonals::uniform), d);
+  WARN("clamped 31x31 L/d=50: quads w D/(q L^4) = " << quad.first << " (" << 100 * (quad.first / mindlin - 1)
+                                                    << " % vs Mindlin), triangles " << triangles.first << " ("
+                                                    << 100 * (triangles.first / mindlin - 1) << " % vs Mindlin, "
+                                                    << 100 * (triangles.first / quad.first - 1) << " % vs quads)");
+  CHECK(quad.second < 1e-4);
+  CHECK(triangles.second < 1e-4);
+  CHECK(triangles.first == Approx(quad.first).epsilon(0.01));
+}
+
 // Where shear does not constrain much, the triangles bend like the quads.
 TEST_CASE("Clamped thick triangle plate, L/d = 10: centre deflection within 1 % of the quad plate's",
           "[io][mesh][triangles][plate][validation]") {
