@@ -115,6 +115,22 @@ std::pair<double, double> clamped_coefficient(const ShellModel& model, double d)
   return {coefficient(), std::abs(coefficient() - before) / coefficient()};
 }
 
+// The clamped plate at n × n particles and L/d = slenderness, as quads and as
+// triangles (uniform diagonals): both relaxations settled, and the triangles'
+// centre deflection within 1 % of the quads'. `mindlin` is printed beside them.
+void check_triangles_against_quads(int n, double slenderness, double mindlin) {
+  const double d = 1.0 / slenderness;
+  const auto quad = clamped_coefficient(ShellModel::rectangular_plate(1.0, 1.0, n, n, d), d);
+  const auto triangles = clamped_coefficient(triangle_plate(1.0, 1.0, n, n, d, Diagonals::uniform), d);
+  WARN("clamped " << n << "x" << n << " L/d=" << slenderness << ": quads w D/(q L^4) = " << quad.first << " ("
+                  << 100 * (quad.first / mindlin - 1) << " % vs Mindlin), triangles " << triangles.first << " ("
+                  << 100 * (triangles.first / mindlin - 1) << " % vs Mindlin, "
+                  << 100 * (triangles.first / quad.first - 1) << " % vs quads)");
+  CHECK(quad.second < 1e-4);
+  CHECK(triangles.second < 1e-4);
+  CHECK(triangles.first == Approx(quad.first).epsilon(0.01));
+}
+
 }  // namespace
 
 TEST_CASE("Triangle plate: a linear displacement field gives uniform exact strains and no interior force",
@@ -220,45 +236,18 @@ TEST_CASE("Free triangle plate, alternating diagonals: first elastic frequency w
 // the suite reports the day a triangle shear that does not lock fixes it.
 TEST_CASE("Clamped triangle plate, L/d = 50: centre deflection within 1 % of the quad plate's",
           "[io][mesh][triangles][plate][validation][!shouldfail]") {
-  const double d = 1.0 / 50, mindlin = 0.0012754;
-  const auto quad = clamped_coefficient(ShellModel::rectangular_plate(1.0, 1.0, 21, 21, d), d);
-  const auto triangles = clamped_coefficient(triangle_plate(1.0, 1.0, 21, 21, d, Diagonals::uniform), d);
-  WARN("clamped 21x21 L/d=50: quads w D/(q L^4) = " << quad.first << " (" << 100 * (quad.first / mindlin - 1)
-                                                    << " % vs Mindlin), triangles " << triangles.first << " ("
-                                                    << 100 * (triangles.first / mindlin - 1) << " % vs Mindlin, "
-                                                    << 100 * (triangles.first / quad.first - 1) << " % vs quads)");
-  CHECK(quad.second < 1e-4);
-  CHECK(triangles.second < 1e-4);
-  CHECK(triangles.first == Approx(quad.first).epsilon(0.01));
+  check_triangles_against_quads(21, 50, 0.0012754);
 }
 
 // The same plate one refinement up: the triangles' shear constraint relaxes
 // with the spacing and the two meshes agree within 1 % (measured −0.50 %).
 TEST_CASE("Clamped triangle plate, L/d = 50, 31 x 31: centre deflection within 1 % of the quad plate's",
           "[io][mesh][triangles][plate][validation]") {
-  const double d = 1.0 / 50, mindlin = 0.0012754;
-  const auto quad = clamped_coefficient(ShellModel::rectangular_plate(1.0, 1.0, 31, 31, d), d);
-  const auto triangles = clamped_coefficient(triangle_plate(1.0, 1.0, 31, 31, d, Diagonals::uniform), d);
-  WARN("clamped 31x31 L/d=50: quads w D/(q L^4) = " << quad.first << " (" << 100 * (quad.first / mindlin - 1)
-                                                    << " % vs Mindlin), triangles " << triangles.first << " ("
-                                                    << 100 * (triangles.first / mindlin - 1) << " % vs Mindlin, "
-                                                    << 100 * (triangles.first / quad.first - 1) << " % vs quads)");
-  CHECK(quad.second < 1e-4);
-  CHECK(triangles.second < 1e-4);
-  CHECK(triangles.first == Approx(quad.first).epsilon(0.01));
+  check_triangles_against_quads(31, 50, 0.0012754);
 }
 
 // Where shear does not constrain much, the triangles bend like the quads.
 TEST_CASE("Clamped thick triangle plate, L/d = 10: centre deflection within 1 % of the quad plate's",
           "[io][mesh][triangles][plate][validation]") {
-  const double d = 1.0 / 10, mindlin = 0.0015046;
-  const auto quad = clamped_coefficient(ShellModel::rectangular_plate(1.0, 1.0, 21, 21, d), d);
-  const auto triangles = clamped_coefficient(triangle_plate(1.0, 1.0, 21, 21, d, Diagonals::uniform), d);
-  WARN("clamped 21x21 L/d=10: quads w D/(q L^4) = " << quad.first << " (" << 100 * (quad.first / mindlin - 1)
-                                                    << " % vs Mindlin), triangles " << triangles.first << " ("
-                                                    << 100 * (triangles.first / mindlin - 1) << " % vs Mindlin, "
-                                                    << 100 * (triangles.first / quad.first - 1) << " % vs quads)");
-  CHECK(quad.second < 1e-4);
-  CHECK(triangles.second < 1e-4);
-  CHECK(triangles.first == Approx(quad.first).epsilon(0.01));
+  check_triangles_against_quads(21, 10, 0.0015046);
 }
