@@ -102,10 +102,13 @@ TEST_CASE("Area sets that do not cover the surface once are refused", "[bad_inpu
 
 TEST_CASE("One stress-point area far above the others without the surface to match is refused",
           "[bad_input][geometry]") {
-  // The areas no longer cover the surface once: refused by the area sums.
+  // The areas no longer cover the surface once: refused by the area sums,
+  // naming the largest area.
   GeneralPlate plate;
   plate.stress_areas[7] *= 1e4;
-  require_error([&] { plate.build(); }, {"sum of the particle areas", "covers the mid-surface once"});
+  require_error([&] { plate.build(); },
+                {"sum of the particle areas", "covers the mid-surface once", "stress point 7 area = 0.25",
+                 "10000.000000 times the median"});
 }
 
 // A legal model with one stress point of 10⁴ times the others' area: a

@@ -223,11 +223,20 @@ inline void check_area_sums(const std::vector<double>& particle_area, const std:
   double particles = 0.0, stress_points = 0.0;
   for (double area : particle_area) particles += area;
   for (double area : stress_point_area) stress_points += area;
-  if (std::abs(particles - stress_points) > area_sum_tolerance * std::max(particles, stress_points))
+  if (std::abs(particles - stress_points) > area_sum_tolerance * std::max(particles, stress_points)) {
+    // The largest area of the set that covers too much, which is the fault
+    // when one area alone is far off.
+    const bool stress_larger = stress_points > particles;
+    const std::vector<double>& larger = stress_larger ? stress_point_area : particle_area;
+    const auto largest = static_cast<std::size_t>(std::max_element(larger.begin(), larger.end()) - larger.begin());
     detail::invalid_parameter("sum of the particle areas", particles,
                               "must equal the sum of the stress point areas " + std::to_string(stress_points) +
                                   " m² within " + std::to_string(100.0 * area_sum_tolerance) +
-                                  " %: each set of areas covers the mid-surface once");
+                                  " %: each set of areas covers the mid-surface once; the largest is " +
+                                  (stress_larger ? "stress point " : "particle ") + std::to_string(largest) +
+                                  " area = " + std::to_string(larger[largest]) + " m², " +
+                                  std::to_string(larger[largest] / median(larger)) + " times the median of its set");
+  }
 }
 
 inline void require_count(const char* name, int value, int minimum) {
