@@ -107,7 +107,7 @@ TEST_CASE("One stress-point area far above the others without the surface to mat
   GeneralPlate plate;
   plate.stress_areas[7] *= 1e4;
   require_error([&] { plate.build(); },
-                {"sum of the particle areas", "covers the mid-surface once", "stress point 7 area = 0.25",
+                {"sum of the particle areas", "covers the mid-surface once", "stress point 7 area = 4.000000",
                  "10000.000000 times the median"});
 }
 
