@@ -37,6 +37,7 @@
 #include <sphshell/crack/none.hpp>
 #include <sphshell/material/material.hpp>
 #include <sphshell/mpi/communicator.hpp>
+#include <sphshell/mpi/distributed_fracture.hpp>
 #include <sphshell/mpi/distributed_ledger.hpp>
 #include <sphshell/mpi/error_agreement.hpp>
 #include <sphshell/mpi/exact_sum.hpp>
@@ -69,10 +70,6 @@ struct CommunicationCounters {
 template <class Approx, class Rule, class Material, class Crack = crack::None,
           class Stepper = stepper::CentralDifference>
 class DistributedSolver {
-  static_assert(!Crack::enabled,
-                "mpi::DistributedSolver: fracture across ranks is not wired yet; use crack::None "
-                "(docs/distributed.md lists what is left)");
-
  public:
   using MaterialParameters = typename Material::Parameters;
   using Points = solver::IntegrationPoints<Approx>;
@@ -219,6 +216,19 @@ class DistributedSolver {
     });
   }
 
+  // A pre-crack (Solver::add_precrack), on every rank alike (collective).
+  void add_precrack(const std::vector<Vector3>& polyline) {
+    static_assert(Crack::enabled, "add_precrack needs a crack policy: a solver with crack::None has no cracks; "
+                                  "use crack::LineSegments as the fourth parameter");
+    fracture_.add_precrack(polyline, fracture_parts());
+  }
+  // The crack topology, whole on every rank, and the fracture counters.
+  const Crack& crack() const { return fracture_.crack(); }
+  std::size_t damaged_stress_point_count() const { return fracture_.damaged_stress_point_count(); }
+  std::size_t precrack_stress_point_count() const { return fracture_.precrack_stress_point_count(); }
+  bool is_fragment(int particle) const { return fracture_.is_fragment(static_cast<std::size_t>(particle)); }
+  std::size_t fragment_count() const { return fracture_.fragment_count(); }
+
   // One step on every rank (collective). A step that stopped with an Error
   // leaves a half-updated state: later steps refuse with that error.
   void step() {
@@ -282,7 +292,7 @@ class DistributedSolver {
     for (std::size_t p = 0; p < states_->size(); ++p)
       if (point_owned_[p] && states_->active(p))
         elastic.add(states_->stored_energy(p, points_->membrane_bending_weight(p), points_->shear_weight(p)));
-    const EnergyReport report = ledger_->report(comm_, elastic, 0.0);
+    const EnergyReport report = ledger_->report(comm_, elastic, fracture_.released_energy());
     counters_.agreement_seconds += seconds_since(started);
     return report;
   }
@@ -346,6 +356,9 @@ class DistributedSolver {
     particles_.ranges = {0, owned, owned, local};
     forces_ = solver::ParticleForces(local);
     assembler_.emplace(options_.nonlinear, *points_);
+    fracture_.initialize(model_, all_points, layout_);
+    // Crack rebuilds run on the whole model's rows (fracture): kept only then.
+    if constexpr (Crack::enabled) all_points_.emplace(all_points);
     ledger_.emplace(options_.monitoring(), law_.youngs_modulus(), solver::shell_volume(model_));
   }
 
@@ -377,6 +390,11 @@ class DistributedSolver {
   }
 
   StepTime now() const { return {steps_, time_}; }
+  using FractureParts = DistributedFractureParts<Approx, Rule, Material>;
+  FractureParts fracture_parts() {
+    return FractureParts{comm_,      model_,     layout_, particles_, *all_points_, *points_,
+                         *states_,   *assembler_, forces_, point_owned_};
+  }
 
   void advance() {
     if (!forces_current_) compute_internal_forces();
@@ -396,6 +414,7 @@ class DistributedSolver {
     check_configuration(failure);
     agree(failure);
     compute_internal_forces();
+    if constexpr (Crack::enabled) fracture_.update(fracture_parts());
     if (solver::EnergyLedger::is_check_step(steps_)) {
       const EnergyReport report = energy();
       ledger_->check_balance(comm_, now(), report, [&](std::size_t i) { return layout_.global_of(i); });
@@ -506,12 +525,14 @@ class DistributedSolver {
   solver::ParticleState particles_;
   solver::Inertia inertia_;
   solver::ParticleForces forces_;
+  std::optional<Points> all_points_;  // the whole model's rows, with cracks only
   std::optional<Points> points_;
   std::optional<States> states_;
   std::vector<std::size_t> global_point_;  // per local point: its index in the whole model's numbering
   std::vector<char> point_owned_;          // per local point: owned here (books its work)
   std::optional<solver::InternalForceAssembler> assembler_;
   std::optional<DistributedLedger> ledger_;
+  DistributedFracture<Crack> fracture_;
   Stepper stepper_;
   sphshell::detail::Constraints constraints_;  // owned particles, local indices
   sphshell::detail::Constraints checker_;      // the whole sets, global ids: the Solver's checks and messages
