@@ -51,6 +51,7 @@
 #include <sphshell/solver.hpp>
 
 #include <chrono>
+#include <ctime>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -69,6 +70,7 @@ struct CommunicationCounters {
   std::size_t bytes_sent = 0;        // by this rank, all exchanges
   double exchange_seconds = 0.0;     // wall time inside the halo exchange
   double agreement_seconds = 0.0;    // wall time inside agreement points and reductions
+  double communication_cpu_seconds = 0.0;  // process CPU time inside both (MPI polls while it waits)
 };
 
 template <class Approx, class Rule, class Material, class Crack = crack::None,
@@ -328,12 +330,13 @@ class DistributedSolver {
   // The energy books over all ranks (collective).
   EnergyReport energy() {
     const auto started = std::chrono::steady_clock::now();
+    const std::clock_t cpu = std::clock();
     ExactSum elastic;
     for (std::size_t p = 0; p < states_->size(); ++p)
       if (point_owned_[p] && states_->active(p))
         elastic.add(states_->stored_energy(p, points_->membrane_bending_weight(p), points_->shear_weight(p)));
     const EnergyReport report = ledger_->report(comm_, elastic, fracture_.released_energy());
-    counters_.agreement_seconds += seconds_since(started);
+    count_agreement(started, cpu);
     return report;
   }
 
@@ -515,8 +518,18 @@ class DistributedSolver {
 
   void agree(const std::optional<Failure>& failure) {
     const auto started = std::chrono::steady_clock::now();
-    agree_on_failure(comm_, failure);
+    const std::clock_t cpu = std::clock();
+    try {
+      agree_on_failure(comm_, failure);
+    } catch (...) {
+      count_agreement(started, cpu);
+      throw;
+    }
+    count_agreement(started, cpu);
+  }
+  void count_agreement(std::chrono::steady_clock::time_point started, std::clock_t cpu) {
     counters_.agreement_seconds += seconds_since(started);
+    counters_.communication_cpu_seconds += static_cast<double>(std::clock() - cpu) / CLOCKS_PER_SEC;
   }
   long key(Phase phase, std::size_t global) const {
     return static_cast<long>(phase) * static_cast<long>(model_.particle_count() + 1) + static_cast<long>(global);
@@ -589,8 +602,10 @@ class DistributedSolver {
   // failing point stops every rank with its global index.
   void compute_internal_forces() {
     const auto started = std::chrono::steady_clock::now();
+    const std::clock_t cpu = std::clock();
     exchange_.exchange(comm_, halo_, {&particles_.position, &particles_.director});
     counters_.exchange_seconds += seconds_since(started);
+    counters_.communication_cpu_seconds += static_cast<double>(std::clock() - cpu) / CLOCKS_PER_SEC;
     ++counters_.exchanges;
     counters_.bytes_sent += halo_.bytes_sent(2);
     std::optional<Failure> failure;
