@@ -272,3 +272,77 @@ TEST_CASE("A checkpoint carries the model's cuts", "[cuts][checkpoint]") {
   CHECK_NOTHROW(with.load_checkpoint(path));
   CHECK(with.steps() == 5);
 }
+
+TEST_CASE("An annular plate slit along a radius: from_quads with duplicated particles and a cut", "[cuts][solver]") {
+  // The slit annular plate's mesh: an (r, θ) grid over θ ∈ [0, 2π] whose
+  // last column repeats the first at θ = 2π, joined by no cell.
+  const double inner = 6.0, outer = 10.0, thickness = 0.03;
+  const int radial = 5, angular = 40;
+  std::vector<Vector3> positions;
+  std::vector<double> angle;  // the unwrapped angle of each particle's own face
+  for (int j = 0; j <= angular; ++j)
+    for (int i = 0; i < radial; ++i) {
+      const double theta = 2.0 * M_PI * j / angular, r = inner + (outer - inner) * i / (radial - 1);
+      positions.emplace_back(r * std::cos(theta), r * std::sin(theta), 0.0);
+      angle.push_back(theta);
+    }
+  std::vector<Quad> quads;
+  for (int j = 0; j < angular; ++j)
+    for (int i = 0; i + 1 < radial; ++i) {
+      const int a = j * radial + i;
+      quads.push_back({a, a + 1, a + radial + 1, a + radial});
+    }
+  const std::vector<Vector3> normals(positions.size(), Vector3::UnitZ());
+  ShellModel model = ShellModel::from_quads(positions, normals, quads, thickness);
+  CHECK(model.coincident_particles().size() == static_cast<std::size_t>(radial));
+  const material::Elastic::Parameters steel{21e6, 0.0};
+  CHECK_THROWS_WITH(ElasticSolver(model, steel), Catch::Contains("no cut separates them"));
+  // Rows whose visible neighbours lie on the other side of the slit: an
+  // angular distance above π on the unwrapped angle, where a strip bent into
+  // the ring has none; and the rows that see a particle of a slit face.
+  struct Reach {
+    int across = 0, beside_the_slit = 0;
+  };
+  auto reach_of = [&](const ShellModel& cut_model) {
+    const SolverOptions options;
+    const solver::IntegrationPoints<approx::MLS<kernel::CubicSpline>> points(
+        cut_model, options.physics(), options.particle_integration(), 10.5e6);
+    Reach reach;
+    for (solver::PointGroup group : solver::point_groups) {
+      const approx::ShapeFunctions& shape = points.shape(group);
+      for (std::size_t row = 0; row < shape.rows(); ++row) {
+        double row_angle = 0.0;
+        if (group == solver::PointGroup::particles) {
+          row_angle = angle[row];
+        } else {
+          const Vector3& x = cut_model.stress_point_position[row];
+          row_angle = std::atan2(x.y(), x.x()) + (x.y() < 0.0 ? 2.0 * M_PI : 0.0);
+        }
+        bool beside = false;
+        for (std::size_t s = shape.row_begin[row]; s < shape.row_begin[row] + shape.row_size[row]; ++s) {
+          const double neighbour_angle = angle[static_cast<std::size_t>(shape.neighbour[s])];
+          if (std::abs(neighbour_angle - row_angle) > M_PI) ++reach.across;
+          beside = beside || neighbour_angle == 0.0 || neighbour_angle == 2.0 * M_PI;
+        }
+        if (beside) ++reach.beside_the_slit;
+      }
+    }
+    return reach;
+  };
+  // A cut from rim to rim: near the concave inner rim a pair's segment can
+  // pass through the hole around the cut's end, as pairs see across any hole.
+  ShellModel rim_to_rim = model;
+  rim_to_rim.add_cut({Vector3(inner, 0.0, 0.0), Vector3(outer, 0.0, 0.0)});
+  CHECK_NOTHROW(ElasticSolver(rim_to_rim, steel));
+  const Reach short_cut = reach_of(rim_to_rim);
+  WARN("slit annulus, cut from rim to rim: " << short_cut.across << " neighbours across the slit in "
+                                              << short_cut.beside_the_slit << " rows beside it");
+  CHECK(short_cut.across > 0);
+  // Drawn half a spacing on into the hole (and beyond the outer rim), the cut
+  // hides them: no row reaches across the slit.
+  model.add_cut({Vector3(inner - 0.5, 0.0, 0.0), Vector3(outer + 0.5, 0.0, 0.0)});
+  CHECK_NOTHROW(ElasticSolver(model, steel));
+  const Reach reach = reach_of(model);
+  CHECK(reach.beside_the_slit > 4 * radial);
+  CHECK(reach.across == 0);
+}

@@ -269,7 +269,9 @@ class ShellModel {
   // e.g. from_quads with a slit), a cut-out, a seam left open. A polyline of
   // fewer than 2 points or with a zero-length piece, a point off the shell, a
   // cut through a stress point, through a particle that is neither duplicated
-  // nor at its end, or across a cell is an Error naming it.
+  // nor at its end, or across a cell is an Error naming it. A cut that ends on
+  // an edge should go on half a spacing past it: near a concave edge a pair
+  // can otherwise see around its end through the hole.
   void add_cut(std::vector<Vector3> polyline) {
     shell::check_cut(polyline, cuts_.size(), cut_geometry());
     cuts_.push_back(std::move(polyline));
