@@ -79,6 +79,68 @@ class IntegrationPoints {
     for (PointGroup group : point_groups) rebuilt_[index_of(group)].assign(count(group), 0);
   }
 
+  // The rows one rank of a distributed run computes (include/sphshell/mpi/):
+  // rows[group] lists global rows ascending, local_of maps a global particle
+  // to its local index (−1: not on this rank). Every slot of a row's capacity
+  // is kept in its place with the neighbour renumbered, and so are the frames,
+  // weights, reference gradients and the edge-tied shear (its corners
+  // renumbered too), so a local row computes bit for bit what the global one
+  // does. A neighbour or tied corner that is not local is an Error.
+  IntegrationPoints subset(const std::array<std::vector<std::size_t>, 2>& rows, const std::vector<int>& local_of,
+                           std::size_t local_count) const {
+    auto local = [&](int global, PointGroup group, std::size_t row) {
+      const int j = local_of.at(static_cast<std::size_t>(global));
+      if (j < 0)
+        detail::invalid_parameter(std::string("particle of ") + name_of(group) + " " + std::to_string(row), global,
+                                  "is not local to the subset (its rows need it)");
+      return j;
+    };
+    IntegrationPoints part;
+    part.smoothing_length_ = smoothing_length_;
+    for (PointGroup group : point_groups) {
+      const std::size_t g = index_of(group);
+      const approx::ShapeFunctions& from = shape_[g];
+      approx::ShapeFunctions& to = part.shape_[g];
+      to.row_begin.push_back(0);
+      for (std::size_t row : rows[g]) {
+        for (std::size_t s = from.row_begin[row]; s < from.row_begin[row + 1]; ++s) {
+          to.neighbour.push_back(local(from.neighbour[s], group, row));
+          to.phi.push_back(from.phi[s]);
+          to.dphi_d1.push_back(from.dphi_d1[s]);
+          to.dphi_d2.push_back(from.dphi_d2[s]);
+        }
+        to.row_begin.push_back(to.neighbour.size());
+        to.row_size.push_back(from.row_size[row]);
+        to.shepard.push_back(from.shepard[row]);
+        part.frames_[g].push_back(frames_[g][row]);
+        part.rebuilt_[g].push_back(rebuilt_[g][row]);
+      }
+      part.global_row_[g] = rows[g];
+    }
+    part.offset_ = {0, rows[0].size()};
+    for (PointGroup group : point_groups)
+      for (std::size_t row : rows[index_of(group)]) {
+        const std::size_t p = point(group, row);
+        part.membrane_bending_weight_.push_back(membrane_bending_weight_[p]);
+        part.shear_weight_.push_back(shear_weight_[p]);
+        part.reference_.push_back(reference_[p]);
+      }
+    if (!shear_tying_.empty())
+      for (std::size_t row : rows[0]) {
+        part.shear_tying_.push_back(shear_tying_[row]);
+        shell::CellShearTying& tying = part.shear_tying_.back();
+        for (int k = 0; k < tying.corners; ++k)
+          tying.particle[k] = local(tying.particle[k], PointGroup::stress_points, row);
+      }
+    part.build_slot_transpose(local_count);
+    return part;
+  }
+  // The row of the whole model a row stands for (itself but in a subset).
+  std::size_t global_row(PointGroup group, std::size_t row) const {
+    const std::vector<std::size_t>& rows = global_row_[index_of(group)];
+    return rows.empty() ? row : rows[row];
+  }
+
   // Points of a group, all points, and the global index of a group's row.
   std::size_t count(PointGroup group) const { return shape(group).rows(); }
   std::size_t size() const { return count(PointGroup::stress_points) + count(PointGroup::particles); }
@@ -237,6 +299,8 @@ class IntegrationPoints {
   }
 
  private:
+  IntegrationPoints() = default;  // subset() fills it
+
   // The cuts' visibility predicate of a group's rows (shell/cuts.hpp): a
   // particle evaluation point stands where its particle does in the cut test.
   auto cut_visibility(const ShellModel& model, PointGroup group) const {
@@ -316,6 +380,7 @@ class IntegrationPoints {
   std::vector<shell::SurfaceGradients> reference_;
   std::vector<std::size_t> particle_slot_begin_, particle_slots_;
   std::array<std::vector<unsigned char>, 2> rebuilt_;  // per row: changed by a crack since construction
+  std::array<std::vector<std::size_t>, 2> global_row_;  // a subset's global rows (empty: the whole model)
 };
 
 }  // namespace sphshell::solver
