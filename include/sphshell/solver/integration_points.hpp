@@ -15,6 +15,7 @@
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/shell/cell_shear.hpp>
+#include <sphshell/shell/cuts.hpp>
 #include <sphshell/shell/kinematics.hpp>
 #include <sphshell/shell/model.hpp>
 #include <sphshell/solver/options.hpp>
@@ -48,13 +49,14 @@ class IntegrationPoints {
     smoothing_length_ = physics.support_radius_factor * spacing / Approx::kernel_type::support_radius_factor;
     for (const Vector3& normal : model.stress_point_normal) frames_[0].push_back(tangent_frame(normal));
     for (const Vector3& normal : model.particle_normal) frames_[1].push_back(tangent_frame(normal));
+    cuts_ = shell::CutVisibility(model.cut_geometry(), model.cuts(), support_radius());
     shape_[0] = Approx::build(model.particle_position, model.particle_area, model.stress_point_position,
-                              frames_[0], smoothing_length_);
+                              frames_[0], smoothing_length_, cut_visibility(model, PointGroup::stress_points));
     const bool particles_integrate = particle_integration.particle_integration_share > 0.0 ||
                                      particle_integration.particle_shear_weight > 0.0;
     if (particles_integrate)
       shape_[1] = Approx::build(model.particle_position, model.particle_area, model.particle_position,
-                                frames_[1], smoothing_length_);
+                                frames_[1], smoothing_length_, cut_visibility(model, PointGroup::particles));
 
     // A row that fell back to the constant approximation has no gradient: the
     // support is too small for the spacing.
@@ -183,6 +185,8 @@ class IntegrationPoints {
     return group == PointGroup::stress_points ? model.stress_point_position : model.particle_position;
   }
   double smoothing_length() const { return smoothing_length_; }
+  // The model's cuts, as the rows see them.
+  const shell::CutVisibility& cuts() const { return cuts_; }
   double support_radius() const { return smoothing_length_ * Approx::kernel_type::support_radius_factor; }
 
   // Weights: the area share for membrane and bending; area × κs G d (softened
@@ -215,14 +219,16 @@ class IntegrationPoints {
   }
 
   // Recomputes one row with a visibility predicate visible(row, particle)
-  // (after a crack), and its reference gradients. Throws Error when nothing
-  // stays visible.
+  // (after a crack), and its reference gradients; the model's cuts keep
+  // hiding what they hide. Throws Error when nothing stays visible.
   template <class Visible>
   void rebuild_row(const ShellModel& model, PointGroup group, std::size_t row, Visible&& visible) {
     // Flagged first: a rebuild that throws (nothing visible) leaves its row changed too.
     mark_rebuilt(group, row);
+    const auto cut_visible = cut_visibility(model, group);
+    const auto both = [&](std::size_t r, std::size_t j) { return cut_visible(r, j) && visible(r, j); };
     Approx::rebuild_row(shape_[index_of(group)], row, model.particle_position, model.particle_area,
-                        positions(model, group)[row], frame(group, row), smoothing_length_, visible);
+                        positions(model, group)[row], frame(group, row), smoothing_length_, both);
     reference_[point(group, row)] = gather(group, row, model.particle_position, model.particle_normal);
   }
 
@@ -323,6 +329,16 @@ class IntegrationPoints {
  private:
   IntegrationPoints() = default;  // subset() fills it
 
+  // The cuts' visibility predicate of a group's rows (shell/cuts.hpp): a
+  // particle evaluation point stands where its particle does in the cut test.
+  auto cut_visibility(const ShellModel& model, PointGroup group) const {
+    return [this, &model, group](std::size_t row, std::size_t j) {
+      if (cuts_.empty()) return true;
+      const Vector3& x = group == PointGroup::particles ? cuts_.side_point(row) : model.stress_point_position[row];
+      return cuts_.visible(x, cuts_.side_point(j), frame(group, row));
+    };
+  }
+
   // Rows are rebuilt in parallel: each sets its own flag, in an array sized
   // by the constructor (never resized here).
   void mark_rebuilt(PointGroup group, std::size_t row) { rebuilt_[index_of(group)][row] = 1; }
@@ -382,6 +398,7 @@ class IntegrationPoints {
   }
 
   double smoothing_length_ = 0.0;
+  shell::CutVisibility cuts_;  // the model's cuts
   std::vector<shell::CellShearTying> shear_tying_;  // per stress point, or empty
   std::array<approx::ShapeFunctions, 2> shape_;
   std::array<std::vector<TangentFrame>, 2> frames_;  // evaluation frames, kept for rebuilds
