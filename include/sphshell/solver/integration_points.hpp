@@ -15,6 +15,7 @@
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/shell/cell_shear.hpp>
+#include <sphshell/shell/cuts.hpp>
 #include <sphshell/shell/kinematics.hpp>
 #include <sphshell/shell/model.hpp>
 #include <sphshell/solver/options.hpp>
@@ -49,13 +50,14 @@ class IntegrationPoints {
     smoothing_length_ = physics.support_radius_factor * spacing / Approx::kernel_type::support_radius_factor;
     for (const Vector3& normal : model.stress_point_normal) frames_[0].push_back(tangent_frame(normal));
     for (const Vector3& normal : model.particle_normal) frames_[1].push_back(tangent_frame(normal));
+    cuts_ = shell::CutVisibility(model.cut_geometry(), model.cuts(), support_radius());
     shape_[0] = Approx::build(model.particle_position, model.particle_area, model.stress_point_position,
-                              frames_[0], smoothing_length_);
+                              frames_[0], smoothing_length_, cut_visibility(model, PointGroup::stress_points));
     const bool particles_integrate = particle_integration.particle_integration_share > 0.0 ||
                                      particle_integration.particle_shear_weight > 0.0;
     if (particles_integrate)
       shape_[1] = Approx::build(model.particle_position, model.particle_area, model.particle_position,
-                                frames_[1], smoothing_length_);
+                                frames_[1], smoothing_length_, cut_visibility(model, PointGroup::particles));
 
     // A row that fell back to the constant approximation has no gradient: the
     // support is too small for the spacing.
@@ -136,6 +138,35 @@ class IntegrationPoints {
     part.build_slot_transpose(local_count);
     return part;
   }
+  // A subset's row set to a row of the whole model's points after a crack
+  // rebuilt it there (rebuilds sort by global particle index, so they run on
+  // the whole model's rows): every slot, the reference gradients and the flag,
+  // neighbours renumbered by local_of. The capacities must agree.
+  void copy_row(PointGroup group, std::size_t row, const IntegrationPoints& from, std::size_t from_row,
+                const std::vector<int>& local_of) {
+    const std::size_t g = index_of(group);
+    approx::ShapeFunctions& to = shape_[g];
+    const approx::ShapeFunctions& source = from.shape_[g];
+    if (to.capacity(row) != source.capacity(from_row))
+      detail::invalid_parameter(std::string("capacity of ") + name_of(group) + " row " + std::to_string(from_row),
+                                to.capacity(row), "must equal the source row's " + std::to_string(source.capacity(from_row)));
+    for (std::size_t k = 0; k < to.capacity(row); ++k) {
+      const std::size_t s = to.row_begin[row] + k, t = source.row_begin[from_row] + k;
+      to.neighbour[s] = local_of.at(static_cast<std::size_t>(source.neighbour[t]));
+      if (to.neighbour[s] < 0)
+        detail::invalid_parameter(std::string("particle of ") + name_of(group) + " row " + std::to_string(from_row),
+                                  source.neighbour[t], "is not local to the subset (its rows need it)");
+      to.phi[s] = source.phi[t];
+      to.dphi_d1[s] = source.dphi_d1[t];
+      to.dphi_d2[s] = source.dphi_d2[t];
+    }
+    to.row_size[row] = source.row_size[from_row];
+    to.shepard[row] = source.shepard[from_row];
+    reference_[point(group, row)] = from.reference_[from.point(group, from_row)];
+    reference_products_[point(group, row)] = from.reference_products_[from.point(group, from_row)];
+    mark_rebuilt(group, row);
+  }
+
   // The row of the whole model a row stands for (itself but in a subset).
   std::size_t global_row(PointGroup group, std::size_t row) const {
     const std::vector<std::size_t>& rows = global_row_[index_of(group)];
@@ -158,6 +189,8 @@ class IntegrationPoints {
     return group == PointGroup::stress_points ? model.stress_point_position : model.particle_position;
   }
   double smoothing_length() const { return smoothing_length_; }
+  // The model's cuts, as the rows see them.
+  const shell::CutVisibility& cuts() const { return cuts_; }
   double support_radius() const { return smoothing_length_ * Approx::kernel_type::support_radius_factor; }
 
   // Weights: the area share for membrane and bending; area × κs G d (softened
@@ -208,14 +241,16 @@ class IntegrationPoints {
   }
 
   // Recomputes one row with a visibility predicate visible(row, particle)
-  // (after a crack), and its reference gradients. Throws Error when nothing
-  // stays visible.
+  // (after a crack), and its reference gradients; the model's cuts keep
+  // hiding what they hide. Throws Error when nothing stays visible.
   template <class Visible>
   void rebuild_row(const ShellModel& model, PointGroup group, std::size_t row, Visible&& visible) {
     // Flagged first: a rebuild that throws (nothing visible) leaves its row changed too.
     mark_rebuilt(group, row);
+    const auto cut_visible = cut_visibility(model, group);
+    const auto both = [&](std::size_t r, std::size_t j) { return cut_visible(r, j) && visible(r, j); };
     Approx::rebuild_row(shape_[index_of(group)], row, model.particle_position, model.particle_area,
-                        positions(model, group)[row], frame(group, row), smoothing_length_, visible);
+                        positions(model, group)[row], frame(group, row), smoothing_length_, both);
     set_reference(point(group, row), gather(group, row, model.particle_position, model.particle_normal));
   }
 
@@ -347,6 +382,16 @@ class IntegrationPoints {
     reference_products_[p] = shell::reference_products(g);
   }
 
+  // The cuts' visibility predicate of a group's rows (shell/cuts.hpp): a
+  // particle evaluation point stands where its particle does in the cut test.
+  auto cut_visibility(const ShellModel& model, PointGroup group) const {
+    return [this, &model, group](std::size_t row, std::size_t j) {
+      if (cuts_.empty()) return true;
+      const Vector3& x = group == PointGroup::particles ? cuts_.side_point(row) : model.stress_point_position[row];
+      return cuts_.visible(x, cuts_.side_point(j), frame(group, row));
+    };
+  }
+
   // Rows are rebuilt in parallel: each sets its own flag, in an array sized
   // by the constructor (never resized here).
   void mark_rebuilt(PointGroup group, std::size_t row) { rebuilt_[index_of(group)][row] = 1; }
@@ -406,6 +451,7 @@ class IntegrationPoints {
   }
 
   double smoothing_length_ = 0.0;
+  shell::CutVisibility cuts_;  // the model's cuts
   std::vector<shell::CellShearTying> shear_tying_;  // per stress point, or empty
   std::array<approx::ShapeFunctions, 2> shape_;
   std::array<std::vector<TangentFrame>, 2> frames_;  // evaluation frames, kept for rebuilds
