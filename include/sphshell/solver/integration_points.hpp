@@ -19,6 +19,7 @@
 #include <sphshell/shell/kinematics.hpp>
 #include <sphshell/shell/model.hpp>
 #include <sphshell/solver/options.hpp>
+#include <sphshell/solver/particles.hpp>
 
 #include <array>
 #include <cmath>
@@ -72,9 +73,10 @@ class IntegrationPoints {
     tie_shear(model, physics, shear_modulus);
     compute_weights(model, physics, particle_integration, shear_modulus, stress_points, particle_points);
     reference_.resize(size());
+    reference_products_.resize(size());
     for (PointGroup group : point_groups)
       for (std::size_t row = 0; row < count(group); ++row)
-        reference_[point(group, row)] = gather(group, row, model.particle_position, model.particle_normal);
+        set_reference(point(group, row), gather(group, row, model.particle_position, model.particle_normal));
     build_slot_transpose(model.particle_count());
     for (PointGroup group : point_groups) rebuilt_[index_of(group)].assign(count(group), 0);
   }
@@ -124,6 +126,7 @@ class IntegrationPoints {
         part.membrane_bending_weight_.push_back(membrane_bending_weight_[p]);
         part.shear_weight_.push_back(shear_weight_[p]);
         part.reference_.push_back(reference_[p]);
+        part.reference_products_.push_back(reference_products_[p]);
       }
     if (!shear_tying_.empty())
       for (std::size_t row : rows[0]) {
@@ -160,6 +163,7 @@ class IntegrationPoints {
     to.row_size[row] = source.row_size[from_row];
     to.shepard[row] = source.shepard[from_row];
     reference_[point(group, row)] = from.reference_[from.point(group, from_row)];
+    reference_products_[point(group, row)] = from.reference_products_[from.point(group, from_row)];
     mark_rebuilt(group, row);
   }
 
@@ -200,6 +204,8 @@ class IntegrationPoints {
   }
   const shell::CellShearTying& shear_tying(std::size_t row) const { return shear_tying_[row]; }
   const shell::SurfaceGradients& reference(std::size_t p) const { return reference_[p]; }
+  // Its dot products in the Green strains (shell::green_strains).
+  const shell::ReferenceProducts& reference_products(std::size_t p) const { return reference_products_[p]; }
 
   // Interpolated a1, a2, n, n1, n2 of one row from particle positions x and directors d.
   shell::SurfaceGradients gather(PointGroup group, std::size_t row, const std::vector<Vector3>& x,
@@ -218,6 +224,22 @@ class IntegrationPoints {
     return g;
   }
 
+  // The same from the packed positions and directors (solver/particles.hpp).
+  shell::SurfaceGradients gather(PointGroup group, std::size_t row, const std::vector<PackedKinematics>& packed) const {
+    const approx::ShapeFunctions& sf = shape(group);
+    shell::SurfaceGradients g;
+    const std::size_t end = sf.row_begin[row] + sf.row_size[row];
+    for (std::size_t s = sf.row_begin[row]; s < end; ++s) {
+      const PackedKinematics& particle = packed[std::size_t(sf.neighbour[s])];
+      g.a1 += sf.dphi_d1[s] * particle.position;
+      g.a2 += sf.dphi_d2[s] * particle.position;
+      g.n += sf.phi[s] * particle.director;
+      g.n1 += sf.dphi_d1[s] * particle.director;
+      g.n2 += sf.dphi_d2[s] * particle.director;
+    }
+    return g;
+  }
+
   // Recomputes one row with a visibility predicate visible(row, particle)
   // (after a crack), and its reference gradients; the model's cuts keep
   // hiding what they hide. Throws Error when nothing stays visible.
@@ -229,7 +251,7 @@ class IntegrationPoints {
     const auto both = [&](std::size_t r, std::size_t j) { return cut_visible(r, j) && visible(r, j); };
     Approx::rebuild_row(shape_[index_of(group)], row, model.particle_position, model.particle_area,
                         positions(model, group)[row], frame(group, row), smoothing_length_, both);
-    reference_[point(group, row)] = gather(group, row, model.particle_position, model.particle_normal);
+    set_reference(point(group, row), gather(group, row, model.particle_position, model.particle_normal));
   }
 
   // Checkpoints (solver/checkpoint.hpp): the rows cracks rebuilt, whole (all
@@ -288,8 +310,9 @@ class IntegrationPoints {
             in.fail(std::string(name_of(group)) + " row " + std::to_string(row) + " names particle " +
                     std::to_string(sf.neighbour[s]));
         }
-        shell::SurfaceGradients& g = reference_[point(group, row)];
+        shell::SurfaceGradients g;
         in(g.a1, g.a2, g.n, g.n1, g.n2);
+        set_reference(point(group, row), g);
         rebuilt[row] = 1;
       }
     }
@@ -304,6 +327,18 @@ class IntegrationPoints {
   const std::vector<std::size_t>& particle_slot_begin() const { return particle_slot_begin_; }
   const std::vector<std::size_t>& particle_slots() const { return particle_slots_; }
 
+  // The same slots in the same order, each with what a particle needs to add
+  // its force from the point's conjugate forces (InternalForceAssembler): the
+  // point, the slot's shape-function values, and which corner of the point's
+  // edge-tied cell the particle is (−1: none). Contiguous per particle, so the
+  // per-particle sum streams through them.
+  struct ForceEntry {
+    std::uint32_t point;
+    std::int32_t corner;
+    double phi, dphi_d1, dphi_d2;
+  };
+  const std::vector<ForceEntry>& force_entries() const { return force_entries_; }
+
   // Maps every particle to the shape-function slots that reference it, so the
   // force gather is a deterministic per-particle sum (no atomics, identical
   // results for any thread count). Rows keep their capacity when cracks shrink
@@ -311,23 +346,41 @@ class IntegrationPoints {
   void build_slot_transpose(std::size_t particle_count) {
     slot_offset_ = {0, shape_[0].neighbour.size()};
     std::vector<std::size_t> count_of(particle_count + 1, 0);
-    auto for_each_slot = [&](auto&& visit) {
-      for (PointGroup group : point_groups) {
-        const approx::ShapeFunctions& sf = shape(group);
-        for (std::size_t row = 0; row < count(group); ++row)
-          for (std::size_t s = sf.row_begin[row]; s < sf.row_begin[row] + sf.row_size[row]; ++s)
-            visit(sf.neighbour[s], slot(group, s));
-      }
-    };
-    for_each_slot([&](int particle, std::size_t) { ++count_of[particle + 1]; });
+    for (PointGroup group : point_groups) {
+      const approx::ShapeFunctions& sf = shape(group);
+      for (std::size_t row = 0; row < count(group); ++row)
+        for (std::size_t s = sf.row_begin[row]; s < sf.row_begin[row] + sf.row_size[row]; ++s)
+          ++count_of[std::size_t(sf.neighbour[s]) + 1];
+    }
     for (std::size_t i = 1; i < count_of.size(); ++i) count_of[i] += count_of[i - 1];
     particle_slot_begin_ = count_of;
     particle_slots_.resize(count_of.back());
-    for_each_slot([&](int particle, std::size_t s) { particle_slots_[count_of[particle]++] = s; });
+    force_entries_.resize(count_of.back());
+    for (PointGroup group : point_groups) {
+      const approx::ShapeFunctions& sf = shape(group);
+      for (std::size_t row = 0; row < count(group); ++row) {
+        const bool tied = shear_tied(group, row);
+        for (std::size_t s = sf.row_begin[row]; s < sf.row_begin[row] + sf.row_size[row]; ++s) {
+          const int particle = sf.neighbour[s];
+          std::int32_t corner = -1;
+          for (int k = 0; tied && k < shear_tying_[row].corners; ++k)
+            if (shear_tying_[row].particle[std::size_t(k)] == particle) corner = k;
+          const std::size_t k = count_of[particle]++;
+          particle_slots_[k] = slot(group, s);
+          force_entries_[k] = ForceEntry{static_cast<std::uint32_t>(point(group, row)), corner, sf.phi[s],
+                                         sf.dphi_d1[s], sf.dphi_d2[s]};
+        }
+      }
+    }
   }
 
  private:
   IntegrationPoints() = default;  // subset() fills it
+
+  void set_reference(std::size_t p, const shell::SurfaceGradients& g) {
+    reference_[p] = g;
+    reference_products_[p] = shell::reference_products(g);
+  }
 
   // The cuts' visibility predicate of a group's rows (shell/cuts.hpp): a
   // particle evaluation point stands where its particle does in the cut test.
@@ -406,7 +459,9 @@ class IntegrationPoints {
   std::array<std::size_t, 2> slot_offset_{};
   std::vector<double> membrane_bending_weight_, shear_weight_;
   std::vector<shell::SurfaceGradients> reference_;
+  std::vector<shell::ReferenceProducts> reference_products_;
   std::vector<std::size_t> particle_slot_begin_, particle_slots_;
+  std::vector<ForceEntry> force_entries_;  // per particle, in particle_slots_ order
   std::array<std::vector<unsigned char>, 2> rebuilt_;  // per row: changed by a crack since construction
   std::array<std::vector<std::size_t>, 2> global_row_;  // a subset's global rows (empty: the whole model)
 };
