@@ -1,0 +1,103 @@
+// The standard shell benchmarks (issue 11), solved statically by Newton's
+// method on the solver's own forces (tests/support/static_shell.hpp; the cases
+// in tests/support/shell_benchmarks.hpp). The README's table and charts come
+// from the shell_benchmarks example, which runs the same cases one refinement
+// finer. Tolerances are the error measured at each case's finest resolution
+// here plus a small margin (the README lists the measurements).
+#include "support/shell_benchmarks.hpp"
+
+#include <sphshell/material/elastic.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/gauss.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdio>
+
+using namespace sphshell;
+using namespace sphshell::test_support;
+
+namespace {
+
+// Gauss<2> integrates the linear theory's stresses (linear through the
+// thickness) exactly; the nonlinear strains are quadratic in ζ, so Gauss<3>.
+using LinearSolver = Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<2>, material::Elastic>;
+using NonlinearSolver = Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<3>, material::Elastic>;
+
+double linear_benchmark(const StaticBenchmark& benchmark, NewtonOptions newton = {}) {
+  SolverOptions options;
+  options.nonlinear = false;
+  LinearSolver solver(benchmark.model, {benchmark.E, benchmark.nu}, options);
+  StaticShell<LinearSolver> statics(solver, benchmark.conditions, newton);
+  statics.linear_solve(1.0);
+  return reported_displacement(benchmark, solver);
+}
+
+double error_percent(double value, double reference) { return 100.0 * (value / reference - 1.0); }
+
+// Runs a linear benchmark at each resolution, prints the errors, and returns
+// the error at the last (finest) one.
+template <class Build>
+double linear_convergence(const char* name, Build&& build, std::initializer_list<int> resolutions) {
+  double error = 0.0;
+  for (int n : resolutions) {
+    const StaticBenchmark benchmark = build(n);
+    const double value = linear_benchmark(benchmark);
+    error = error_percent(value, benchmark.reference);
+    std::printf("%s, %d x %d particles: %.6g (reference %.6g, %+.2f %%)\n", name, n, n, value, benchmark.reference,
+                error);
+  }
+  return error;
+}
+
+}  // namespace
+
+TEST_CASE("Static shell: the coloured stiffness assembly equals one particle at a time", "[static][benchmarks]") {
+  // A coarse pinched hemisphere (curved, symmetry planes, point loads): the
+  // colouring perturbs many particles at once and credits each response to
+  // the one in reach; it must give the same solution as perturbing each
+  // particle alone.
+  const StaticBenchmark benchmark = pinched_hemisphere(9, PointLoad::shape_functions);
+  NewtonOptions alone;
+  alone.one_particle_per_colour = true;
+  const double coloured = linear_benchmark(benchmark);
+  const double reference = linear_benchmark(benchmark, alone);
+  CHECK(coloured == Approx(reference).epsilon(1e-6));
+}
+
+TEST_CASE("Static shell: the elastica by shooting matches the tabulated cantilever", "[static][benchmarks]") {
+  // Sze, Liu & Lo (2004), §3.1, the cantilever under end shear (L = 10,
+  // EI = 100, P_max = 4), their Table 1 at P = P_max: W = 6.698, −U = 3.286
+  // (a converged S4R mesh). The elastica here is the exact beam answer.
+  const TipDisplacement tip = elastica_tip(4.0, 100.0, 10.0);
+  CHECK(tip.w == Approx(6.698).epsilon(5e-4));
+  CHECK(tip.u == Approx(3.286).epsilon(2e-3));
+  // Small loads: the linear tip deflection P L³ / (3 EI).
+  const TipDisplacement small = elastica_tip(1e-4, 100.0, 10.0);
+  CHECK(small.w == Approx(1e-4 * 1000.0 / 300.0).epsilon(1e-6));
+}
+
+TEST_CASE("Benchmark: Scordelis-Lo roof (linear)", "[validation][benchmarks]") {
+  // Reference 0.3024 (MacNeal & Harder 1985). Measured −0.50 % at 33 x 33
+  // (+0.11 % at 17, −0.34 % at 25; −0.54 % at 41 in the example).
+  const double error = linear_convergence("Scordelis-Lo roof", scordelis_lo_roof, {17, 25, 33});
+  CHECK(std::abs(error) < 0.75);
+}
+
+TEST_CASE("Benchmark: pinched hemisphere with an 18 degree hole (linear)", "[validation][benchmarks]") {
+  // Reference 0.094 (MacNeal & Harder 1985); point loads applied consistently
+  // through the shape functions. Measured −0.34 % at 33 x 33 (−1.87 % at 25).
+  const double error = linear_convergence(
+      "Pinched hemisphere", [](int n) { return pinched_hemisphere(n, PointLoad::shape_functions); }, {25, 33});
+  CHECK(std::abs(error) < 0.6);
+}
+
+TEST_CASE("Benchmark: pinched cylinder with rigid diaphragms (linear, a known miss)", "[validation][benchmarks]") {
+  // Reference 1.8248e-5 (MacNeal & Harder 1985). Measured +3.98 % at 33 x 33
+  // (+3.61 % at 25; +3.70 / +3.37 % at 41 / 49 in the example): above the
+  // 2 % target, converging slowly from above (README, "Benchmarks").
+  const double error = linear_convergence(
+      "Pinched cylinder", [](int n) { return pinched_cylinder(n, PointLoad::shape_functions); }, {25, 33});
+  CHECK(std::abs(error) < 4.5);
+}
