@@ -249,4 +249,66 @@ inline TipDisplacement elastica_tip(double P, double EI, double L) {
   return {L - x, w};
 }
 
+// The tip of a cantilever (EI, length L) bent by an end moment M: a circular
+// arc of radius EI/M; the tip's shortening u and deflection w. M = 2πEI/L
+// closes the circle (u = L, w = 0).
+inline TipDisplacement circle_tip(double M, double EI, double L) {
+  if (M == 0.0) return {0.0, 0.0};
+  const double radius = EI / M;
+  return {L - radius * std::sin(L / radius), radius * (1.0 - std::cos(L / radius))};
+}
+
+// Sze, Liu & Lo (2004), §3.1, cantilever under end shear (L = 10, b = 1,
+// t = 0.1, E = 1.2e6, ν = 0, P_max = 4): the paper's tabulated tip W and −U
+// at P/P_max = 0.05, 0.10, …, 1 (a converged ABAQUS S4R mesh).
+struct TabulatedPoint {
+  double load_factor;  // P / P_max
+  double first, second;
+};
+inline std::vector<TabulatedPoint> sze_end_shear_table() {
+  const double w[] = {0.663, 1.309, 1.922, 2.493, 3.015, 3.488, 3.912, 4.292, 4.631, 4.933,
+                      5.202, 5.444, 5.660, 5.855, 6.031, 6.190, 6.335, 6.467, 6.588, 6.698};
+  const double u[] = {0.026, 0.103, 0.224, 0.381, 0.563, 0.763, 0.971, 1.184, 1.396, 1.604,
+                      1.807, 2.002, 2.190, 2.370, 2.541, 2.705, 2.861, 3.010, 3.151, 3.286};
+  std::vector<TabulatedPoint> table;
+  for (int k = 0; k < 20; ++k) table.push_back({0.05 * (k + 1), w[k], u[k]});
+  return table;
+}
+
+// A cantilever strip (tests' Sze cases) solved at the given load factors: the
+// tip's centre-line shortening −u and deflection |w| at each.
+struct CantileverPoint {
+  double load_factor, u, w;
+};
+enum class EndLoad { shear, moment };
+struct CantileverRun {
+  std::vector<CantileverPoint> points;
+  NewtonReport report;
+  double L, EI, full_load;  // P_max = 4, or M_max = 2πEI/L
+};
+// End shear: L = 10, P_max = 4 along +z. End moment: L = 12, M_max = 2πEI/L
+// about −y (the strip rolls up toward +z). Load steps of at most `step`.
+template <class NonlinearSolver>
+CantileverRun run_cantilever(EndLoad load, int nx, int ny, const std::vector<double>& factors, double step) {
+  CantileverStrip strip = cantilever_strip(load == EndLoad::shear ? 10.0 : 12.0, nx, ny);
+  const std::vector<double> share = edge_shares(ny);
+  const double full = load == EndLoad::shear ? 4.0 : 2.0 * benchmark_pi * strip.EI / strip.L;
+  for (int k = 0; k < ny; ++k) {
+    if (load == EndLoad::shear)
+      strip.conditions.add_force({strip.tip[k]}, Vector3(0.0, 0.0, full * share[k]));
+    else
+      strip.conditions.add_moment({strip.tip[k]}, Vector3(0.0, -full * share[k], 0.0));
+  }
+  NonlinearSolver solver(strip.model, {1.2e6, 0.0});
+  StaticShell<NonlinearSolver> statics(solver, strip.conditions);
+  CantileverRun run{{}, {}, strip.L, strip.EI, full};
+  for (double factor : factors) {
+    statics.solve_to(factor, step);
+    const Vector3 u = statics.displacement(strip.tip_mid);
+    run.points.push_back({factor, -u.x(), std::abs(u.z())});
+  }
+  run.report = statics.report();
+  return run;
+}
+
 }  // namespace sphshell::test_support
