@@ -284,7 +284,7 @@ enum class EndLoad { shear, moment };
 struct CantileverRun {
   std::vector<CantileverPoint> points;
   NewtonReport report;
-  double L, EI, full_load;  // P_max = 4, or M_max = 2πEI/L
+  double L = 0.0, EI = 0.0, full_load = 0.0;  // P_max = 4, or M_max = 2πEI/L
 };
 // End shear: L = 10, P_max = 4 along +z. End moment: L = 12, M_max = 2πEI/L
 // about −y (the strip rolls up toward +z). Load steps of at most `step`.
