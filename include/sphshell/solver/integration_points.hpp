@@ -15,6 +15,7 @@
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/shell/cell_shear.hpp>
+#include <sphshell/shell/cuts.hpp>
 #include <sphshell/shell/kinematics.hpp>
 #include <sphshell/shell/model.hpp>
 #include <sphshell/solver/options.hpp>
@@ -48,13 +49,14 @@ class IntegrationPoints {
     smoothing_length_ = physics.support_radius_factor * spacing / Approx::kernel_type::support_radius_factor;
     for (const Vector3& normal : model.stress_point_normal) frames_[0].push_back(tangent_frame(normal));
     for (const Vector3& normal : model.particle_normal) frames_[1].push_back(tangent_frame(normal));
+    cuts_ = shell::CutVisibility(model.cut_geometry(), model.cuts(), support_radius());
     shape_[0] = Approx::build(model.particle_position, model.particle_area, model.stress_point_position,
-                              frames_[0], smoothing_length_);
+                              frames_[0], smoothing_length_, cut_visibility(model, PointGroup::stress_points));
     const bool particles_integrate = particle_integration.particle_integration_share > 0.0 ||
                                      particle_integration.particle_shear_weight > 0.0;
     if (particles_integrate)
       shape_[1] = Approx::build(model.particle_position, model.particle_area, model.particle_position,
-                                frames_[1], smoothing_length_);
+                                frames_[1], smoothing_length_, cut_visibility(model, PointGroup::particles));
 
     // A row that fell back to the constant approximation has no gradient: the
     // support is too small for the spacing.
@@ -77,6 +79,68 @@ class IntegrationPoints {
     for (PointGroup group : point_groups) rebuilt_[index_of(group)].assign(count(group), 0);
   }
 
+  // The rows one rank of a distributed run computes (include/sphshell/mpi/):
+  // rows[group] lists global rows ascending, local_of maps a global particle
+  // to its local index (−1: not on this rank). Every slot of a row's capacity
+  // is kept in its place with the neighbour renumbered, and so are the frames,
+  // weights, reference gradients and the edge-tied shear (its corners
+  // renumbered too), so a local row computes bit for bit what the global one
+  // does. A neighbour or tied corner that is not local is an Error.
+  IntegrationPoints subset(const std::array<std::vector<std::size_t>, 2>& rows, const std::vector<int>& local_of,
+                           std::size_t local_count) const {
+    auto local = [&](int global, PointGroup group, std::size_t row) {
+      const int j = local_of.at(static_cast<std::size_t>(global));
+      if (j < 0)
+        detail::invalid_parameter(std::string("particle of ") + name_of(group) + " " + std::to_string(row), global,
+                                  "is not local to the subset (its rows need it)");
+      return j;
+    };
+    IntegrationPoints part;
+    part.smoothing_length_ = smoothing_length_;
+    for (PointGroup group : point_groups) {
+      const std::size_t g = index_of(group);
+      const approx::ShapeFunctions& from = shape_[g];
+      approx::ShapeFunctions& to = part.shape_[g];
+      to.row_begin.push_back(0);
+      for (std::size_t row : rows[g]) {
+        for (std::size_t s = from.row_begin[row]; s < from.row_begin[row + 1]; ++s) {
+          to.neighbour.push_back(local(from.neighbour[s], group, row));
+          to.phi.push_back(from.phi[s]);
+          to.dphi_d1.push_back(from.dphi_d1[s]);
+          to.dphi_d2.push_back(from.dphi_d2[s]);
+        }
+        to.row_begin.push_back(to.neighbour.size());
+        to.row_size.push_back(from.row_size[row]);
+        to.shepard.push_back(from.shepard[row]);
+        part.frames_[g].push_back(frames_[g][row]);
+        part.rebuilt_[g].push_back(rebuilt_[g][row]);
+      }
+      part.global_row_[g] = rows[g];
+    }
+    part.offset_ = {0, rows[0].size()};
+    for (PointGroup group : point_groups)
+      for (std::size_t row : rows[index_of(group)]) {
+        const std::size_t p = point(group, row);
+        part.membrane_bending_weight_.push_back(membrane_bending_weight_[p]);
+        part.shear_weight_.push_back(shear_weight_[p]);
+        part.reference_.push_back(reference_[p]);
+      }
+    if (!shear_tying_.empty())
+      for (std::size_t row : rows[0]) {
+        part.shear_tying_.push_back(shear_tying_[row]);
+        shell::CellShearTying& tying = part.shear_tying_.back();
+        for (int k = 0; k < tying.corners; ++k)
+          tying.particle[k] = local(tying.particle[k], PointGroup::stress_points, row);
+      }
+    part.build_slot_transpose(local_count);
+    return part;
+  }
+  // The row of the whole model a row stands for (itself but in a subset).
+  std::size_t global_row(PointGroup group, std::size_t row) const {
+    const std::vector<std::size_t>& rows = global_row_[index_of(group)];
+    return rows.empty() ? row : rows[row];
+  }
+
   // Points of a group, all points, and the global index of a group's row.
   std::size_t count(PointGroup group) const { return shape(group).rows(); }
   std::size_t size() const { return count(PointGroup::stress_points) + count(PointGroup::particles); }
@@ -93,6 +157,8 @@ class IntegrationPoints {
     return group == PointGroup::stress_points ? model.stress_point_position : model.particle_position;
   }
   double smoothing_length() const { return smoothing_length_; }
+  // The model's cuts, as the rows see them.
+  const shell::CutVisibility& cuts() const { return cuts_; }
   double support_radius() const { return smoothing_length_ * Approx::kernel_type::support_radius_factor; }
 
   // Weights: the area share for membrane and bending; area × κs G d (softened
@@ -125,14 +191,16 @@ class IntegrationPoints {
   }
 
   // Recomputes one row with a visibility predicate visible(row, particle)
-  // (after a crack), and its reference gradients. Throws Error when nothing
-  // stays visible.
+  // (after a crack), and its reference gradients; the model's cuts keep
+  // hiding what they hide. Throws Error when nothing stays visible.
   template <class Visible>
   void rebuild_row(const ShellModel& model, PointGroup group, std::size_t row, Visible&& visible) {
     // Flagged first: a rebuild that throws (nothing visible) leaves its row changed too.
     mark_rebuilt(group, row);
+    const auto cut_visible = cut_visibility(model, group);
+    const auto both = [&](std::size_t r, std::size_t j) { return cut_visible(r, j) && visible(r, j); };
     Approx::rebuild_row(shape_[index_of(group)], row, model.particle_position, model.particle_area,
-                        positions(model, group)[row], frame(group, row), smoothing_length_, visible);
+                        positions(model, group)[row], frame(group, row), smoothing_length_, both);
     reference_[point(group, row)] = gather(group, row, model.particle_position, model.particle_normal);
   }
 
@@ -231,6 +299,18 @@ class IntegrationPoints {
   }
 
  private:
+  IntegrationPoints() = default;  // subset() fills it
+
+  // The cuts' visibility predicate of a group's rows (shell/cuts.hpp): a
+  // particle evaluation point stands where its particle does in the cut test.
+  auto cut_visibility(const ShellModel& model, PointGroup group) const {
+    return [this, &model, group](std::size_t row, std::size_t j) {
+      if (cuts_.empty()) return true;
+      const Vector3& x = group == PointGroup::particles ? cuts_.side_point(row) : model.stress_point_position[row];
+      return cuts_.visible(x, cuts_.side_point(j), frame(group, row));
+    };
+  }
+
   // Rows are rebuilt in parallel: each sets its own flag, in an array sized
   // by the constructor (never resized here).
   void mark_rebuilt(PointGroup group, std::size_t row) { rebuilt_[index_of(group)][row] = 1; }
@@ -290,6 +370,7 @@ class IntegrationPoints {
   }
 
   double smoothing_length_ = 0.0;
+  shell::CutVisibility cuts_;  // the model's cuts
   std::vector<shell::CellShearTying> shear_tying_;  // per stress point, or empty
   std::array<approx::ShapeFunctions, 2> shape_;
   std::array<std::vector<TangentFrame>, 2> frames_;  // evaluation frames, kept for rebuilds
@@ -299,6 +380,7 @@ class IntegrationPoints {
   std::vector<shell::SurfaceGradients> reference_;
   std::vector<std::size_t> particle_slot_begin_, particle_slots_;
   std::array<std::vector<unsigned char>, 2> rebuilt_;  // per row: changed by a crack since construction
+  std::array<std::vector<std::size_t>, 2> global_row_;  // a subset's global rows (empty: the whole model)
 };
 
 }  // namespace sphshell::solver

@@ -45,7 +45,9 @@ class InternalForceAssembler {
           std::size_t{0}, points.count(group),
           [&](std::size_t row) { integrate_point(group, row, particles, points, states); },
           [&](std::size_t row, const std::exception_ptr& error) {
-            detail::fail_unstable(at, std::string(name_of(group)) + " " + std::to_string(row) + ": " +
+            failed_point_ = points.point(group, row);
+            detail::fail_unstable(at, std::string(name_of(group)) + " " +
+                                          std::to_string(points.global_row(group, row)) + ": " +
                                           parallel::what(error));
           });
     sum_particle_forces(points, forces);
@@ -99,6 +101,10 @@ class InternalForceAssembler {
       forces.internal_director[i] = director_force;
     });
   }
+
+  // The point whose failure stopped the last compute() (the lowest failing
+  // index of its group).
+  std::size_t failed_point() const { return failed_point_; }
 
   // Work of the generalized stresses over the last update, per point (zero
   // for inactive points), for the energy ledger.
@@ -176,6 +182,7 @@ class InternalForceAssembler {
   }
 
   bool nonlinear_;
+  std::size_t failed_point_ = 0;
   std::vector<Vector3> slot_force_, slot_director_force_;
   std::vector<double> work_increment_;
 };

@@ -63,6 +63,27 @@ class SectionStates {
     active_.assign(total, 1);
   }
 
+  // The states of the given points (ascending indices), in that order: the
+  // points one rank of a distributed run computes (include/sphshell/mpi/).
+  SectionStates subset(const std::vector<std::size_t>& points) const {
+    SectionStates part(*this);
+    auto pick = [&](auto& to, const auto& from) {
+      to.clear();
+      for (std::size_t p : points) to.push_back(from.at(p));
+    };
+    pick(part.section_index_, section_index_);
+    pick(part.state_, state_);
+    pick(part.membrane_strain_, membrane_strain_);
+    pick(part.curvature_, curvature_);
+    pick(part.shear_, shear_);
+    pick(part.shear_force_, shear_force_);
+    pick(part.tied_shear_energy_, tied_shear_energy_);
+    pick(part.membrane_, membrane_);
+    pick(part.moment_, moment_);
+    pick(part.active_, active_);
+    return part;
+  }
+
   std::size_t size() const { return state_.size(); }
   const Section& section(std::size_t p) const { return sections_[section_index_[p]]; }
 

@@ -1,0 +1,166 @@
+#pragma once
+// The energy books of a distributed run (docs/distributed.md, "The energy
+// ledger"): the serial ledger's terms (solver/energy_ledger.hpp, the same
+// expressions per particle and per point), each rank adding those of the
+// particles and points it owns into exact accumulators (mpi/exact_sum.hpp).
+//
+// Why exact sums: a sum split between ranks rounds differently from the serial
+// loop and differently again for each rank count. The accumulators hold every
+// term of the run exactly and round once when a report is due, so the books
+// are the same for any rank count, and they differ from the serial ledger
+// only by that ledger's own rounding (its running totals round once per
+// step). Energies do not feed back into the motion, so the trajectories stay
+// bitwise the serial ones whatever the books do.
+//
+// Communication: none per step. A report (the balance check every
+// solver::EnergyLedger::check_interval steps, energy()) adds the ranks'
+// accumulators in one all-reduce of 64-bit integers.
+
+#include <sphshell/core/error.hpp>
+#include <sphshell/core/parallel.hpp>
+#include <sphshell/core/types.hpp>
+#include <sphshell/mpi/communicator.hpp>
+#include <sphshell/mpi/exact_sum.hpp>
+#include <sphshell/solver/energy_ledger.hpp>
+#include <sphshell/solver/options.hpp>
+#include <sphshell/solver/particles.hpp>
+#include <sphshell/stepper/stepper.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <sstream>
+#include <vector>
+
+namespace sphshell::mpi {
+
+// The correctly rounded totals of several accumulators over all ranks, in one
+// all-reduce (the limbs of each, side by side).
+template <std::size_t N>
+std::array<double, N> sum_each(const Communicator& comm, const std::array<const ExactSum*, N>& local) {
+  std::vector<std::int64_t> raw;
+  raw.reserve(N * ExactSum::raw_size);
+  for (const ExactSum* accumulator : local) {
+    ExactSum normalised = *accumulator;
+    normalised.normalize();
+    raw.insert(raw.end(), normalised.raw().begin(), normalised.raw().end());
+  }
+  comm.sum_in_place(raw);
+  std::array<double, N> totals{};
+  for (std::size_t k = 0; k < N; ++k) {
+    ExactSum::Raw part{};
+    std::copy_n(raw.begin() + static_cast<std::ptrdiff_t>(k * ExactSum::raw_size), ExactSum::raw_size, part.begin());
+    totals[k] = ExactSum::from_raw(part).value();
+  }
+  return totals;
+}
+
+class DistributedLedger {
+ public:
+  // volume: Σ d_i A_i of the whole shell; youngs_modulus sets the round-off scale.
+  DistributedLedger(const MonitoringOptions& monitoring, double youngs_modulus, double volume)
+      : monitoring_(monitoring),
+        round_off_energy_(youngs_modulus * volume * solver::EnergyLedger::round_off_strain_squared) {}
+
+  void remember_velocities(const solver::ParticleState& state) {
+    old_velocity_ = state.velocity;
+    old_angular_velocity_ = state.angular_velocity;
+  }
+  void remember_free_velocities(const solver::ParticleState& state) { free_velocity_ = state.velocity; }
+
+  // The serial book_step's terms, owned particles only.
+  void book_step(const stepper::StepContext& context, const solver::ParticleState& state,
+                 const solver::Inertia& inertia, const solver::ParticleForces& forces) {
+    const double dt = context.velocity_step;
+    const double c = context.damping;
+    const std::size_t owned = state.ranges.owned_end;
+    external_term_.resize(owned);
+    damping_term_.resize(owned);
+    kinetic_term_.resize(owned);
+    parallel::for_each(state.ranges.owned_begin, owned, [&](std::size_t i) noexcept {
+      const Vector3 average = 0.5 * (old_velocity_[i] + state.velocity[i]);
+      const Vector3 average_angular = 0.5 * (old_angular_velocity_[i] + state.angular_velocity[i]);
+      const Vector3 reaction = inertia.mass[i] * (state.velocity[i] - free_velocity_[i]) / dt;
+      external_term_[i] = dt * (forces.external[i] + reaction).dot(average) +
+                          dt * forces.external_moment[i].dot(average_angular);
+      damping_term_[i] = dt * c * inertia.mass[i] * average.squaredNorm() +
+                         dt * c * inertia.rotary_inertia[i] * average_angular.squaredNorm();
+      kinetic_term_[i] = 0.5 * inertia.mass[i] * state.velocity[i].squaredNorm() +
+                         0.5 * inertia.rotary_inertia[i] * state.angular_velocity[i].squaredNorm();
+    });
+    kinetic_ = ExactSum();
+    for (std::size_t i = state.ranges.owned_begin; i < owned; ++i) {
+      external_work_.add(external_term_[i]);
+      damping_work_.add(damping_term_[i]);
+      kinetic_.add(kinetic_term_[i]);
+    }
+  }
+
+  // The internal work of one force evaluation: the points this rank owns
+  // (owned[p] != 0; a redundant copy's work is booked by its owner).
+  void book_internal_work(const std::vector<double>& work_increments, const std::vector<char>& owned) {
+    previous_internal_ = internal_;
+    for (std::size_t p = 0; p < work_increments.size(); ++p)
+      if (owned[p]) internal_.add(work_increments[p]);
+  }
+
+  // The books over all ranks, with the elastic energy held by this rank's
+  // owned points and the energy the fracture released (already global).
+  // Collective.
+  EnergyReport report(const Communicator& comm, const ExactSum& elastic, double released_by_fracture) const {
+    const std::array<double, 6> total =
+        sum_each<6>(comm, {&kinetic_, &internal_, &previous_internal_, &external_work_, &damping_work_, &elastic});
+    EnergyReport report;
+    report.kinetic = total[0];
+    report.internal = total[1];
+    report.elastic = total[5];
+    report.plastic_dissipation = total[1] - total[5];
+    report.external_work = total[3];
+    report.damping_work = total[4];
+    report.released_by_fracture = released_by_fracture;
+    report.balance_ = total[0] + 0.5 * (total[2] + total[1]) + total[4] - total[3];
+    return report;
+  }
+
+  // The serial check (solver::EnergyLedger::check_balance) on the reduced
+  // books: every rank decides alike, and when the balance is lost they find
+  // the particle of largest kinetic energy together (ties: the lowest global
+  // id, as the serial max_element) and throw the same Error. Collective.
+  template <class GlobalId>
+  void check_balance(const Communicator& comm, const StepTime& at, const EnergyReport& e, GlobalId&& global_id) const {
+    const double scale = std::max({std::abs(e.external_work), e.kinetic, std::abs(e.internal)});
+    if (!(at.step >= solver::EnergyLedger::first_checked_step && scale > round_off_energy_ &&
+          std::abs(e.balance()) > monitoring_.energy_tolerance * scale))
+      return;
+    struct Largest {
+      double energy;
+      std::int64_t particle;
+    } mine{-1.0, -1};
+    for (std::size_t i = 0; i < kinetic_term_.size(); ++i)
+      if (kinetic_term_[i] > mine.energy) mine = {kinetic_term_[i], global_id(i)};
+    Largest largest{-1.0, -1};
+    for (const Largest& candidate : comm.all_gather(mine))
+      if (candidate.particle >= 0 &&
+          (candidate.energy > largest.energy ||
+           (candidate.energy == largest.energy && candidate.particle < largest.particle)))
+        largest = candidate;
+    std::ostringstream message;
+    message << "energy balance lost (kinetic " << e.kinetic << " J, internal " << e.internal << " J, external work "
+            << e.external_work << " J, balance " << e.balance() << " J); reduce the time step or check the loads";
+    if (largest.particle >= 0)
+      message << "; the largest kinetic energy is at particle " << largest.particle << " (" << largest.energy
+              << " J)";
+    sphshell::detail::fail_unstable(at, message.str());
+  }
+
+ private:
+  MonitoringOptions monitoring_;
+  double round_off_energy_;
+  ExactSum internal_, previous_internal_, external_work_, damping_work_, kinetic_;
+  std::vector<Vector3> old_velocity_, old_angular_velocity_, free_velocity_;
+  std::vector<double> external_term_, damping_term_, kinetic_term_;
+};
+
+}  // namespace sphshell::mpi

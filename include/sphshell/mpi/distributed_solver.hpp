@@ -1,0 +1,529 @@
+#pragma once
+// mpi::DistributedSolver<Approx, Rule, Material, Crack, Stepper>: the
+// Solver's step (solver.hpp) over the same parts, each rank on its share of
+// the shell (docs/distributed.md).
+//
+// Set-up, on every rank from the same (replicated) model: the whole model's
+// integration points and section states (as the Solver builds them), the
+// stable step from them (so it is the serial value on every rank), the
+// recursive-coordinate-bisection partition in the reference configuration,
+// this rank's layout (owned particles, computed points, ghosts) and the halo
+// plan. Then the rank keeps only its share: particles in the local numbering
+// (owned first, then ghosts), the rows it computes (IntegrationPoints::subset,
+// the edge-tied shear's corners renumbered) and their states.
+//
+// Ghost integration points are computed redundantly (mpi/layout.hpp says why):
+// a rank computes every point whose row reaches a particle it owns, so every
+// slot force on an owned particle is computed here and summed in the serial
+// order; one halo exchange of positions and directors per step, nothing sent
+// back. The owned particles' forces, and so positions, directors and
+// velocities, are bitwise those of the serial Solver for any rank count and
+// any thread count.
+//
+// The step is the Solver's script with two agreement points
+// (mpi/error_agreement.hpp): loads → velocities → conditions → books →
+// configuration → finite-state check ★ agreement (a load, a prescribed motion
+// or a particle that is not finite; global ids) → halo exchange → internal
+// forces ★ agreement (the failing point's global index) → books → balance
+// check (reduced books, decided alike on every rank). An Error on any rank
+// therefore stops every rank with the same message.
+//
+// Particles, sets, loads and conditions are addressed by global ids or by the
+// model's set names; a rank applies them to the members it owns.
+
+#include <sphshell/core/error.hpp>
+#include <sphshell/core/parallel.hpp>
+#include <sphshell/core/types.hpp>
+#include <sphshell/crack/none.hpp>
+#include <sphshell/material/material.hpp>
+#include <sphshell/mpi/communicator.hpp>
+#include <sphshell/mpi/distributed_ledger.hpp>
+#include <sphshell/mpi/error_agreement.hpp>
+#include <sphshell/mpi/exact_sum.hpp>
+#include <sphshell/mpi/halo.hpp>
+#include <sphshell/mpi/layout.hpp>
+#include <sphshell/mpi/partition.hpp>
+#include <sphshell/solver.hpp>
+
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+namespace sphshell::mpi {
+
+// What a rank measured of its own steps (the bench, docs/distributed.md).
+struct CommunicationCounters {
+  long exchanges = 0;                // halo exchanges
+  std::size_t bytes_sent = 0;        // by this rank, all exchanges
+  double exchange_seconds = 0.0;     // wall time inside the halo exchange
+  double agreement_seconds = 0.0;    // wall time inside agreement points and reductions
+};
+
+template <class Approx, class Rule, class Material, class Crack = crack::None,
+          class Stepper = stepper::CentralDifference>
+class DistributedSolver {
+  static_assert(!Crack::enabled,
+                "mpi::DistributedSolver: fracture across ranks is not wired yet; use crack::None "
+                "(docs/distributed.md lists what is left)");
+
+ public:
+  using MaterialParameters = typename Material::Parameters;
+  using Points = solver::IntegrationPoints<Approx>;
+  using States = solver::SectionStates<Rule, Material>;
+
+  // Collective: every rank of comm passes the same model, parameters and
+  // options. comm must outlive the solver.
+  DistributedSolver(const Communicator& comm, ShellModel model, const MaterialParameters& parameters,
+                    SolverOptions options = {}, const PartitionWeights& weights = {})
+      : comm_(comm), model_(std::move(model)), law_(parameters), options_(std::move(options)) {
+    collectively(comm_, [&] { set_up(weights); });
+    halo_ = HaloPlan(comm_, layout_);
+  }
+
+  // Conditions (shell/constraints.hpp) on a set of global particle ids or on a
+  // named set of the model. Every rank checks the whole set as the Solver
+  // does (the same Error everywhere), then applies it to the members it owns.
+  void clamp(const ParticleSet& set) {
+    on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
+      checker_.clamp(global);
+      constraints_.clamp(local);
+    });
+  }
+  void clamp(const std::string& set_name) { clamp(named(set_name)); }
+  void simply_support(const ParticleSet& set) {
+    on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
+      checker_.simply_support(global);
+      constraints_.simply_support(local);
+    });
+  }
+  void simply_support(const std::string& set_name) { simply_support(named(set_name)); }
+  void simply_support_hard(const ParticleSet& set, const Vector3& edge_tangent) {
+    on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
+      checker_.simply_support_hard(global, model_.particle_normal, edge_tangent);
+      constraints_.simply_support_hard(local, reference_normal_, edge_tangent);
+    });
+  }
+  void simply_support_hard(const std::string& set_name, const Vector3& edge_tangent) {
+    simply_support_hard(named(set_name), edge_tangent);
+  }
+  void symmetry_plane(const ParticleSet& set, const Vector3& plane_normal) {
+    on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
+      checker_.symmetry_plane(global, model_.particle_normal, plane_normal);
+      constraints_.symmetry_plane(local, reference_normal_, plane_normal);
+    });
+  }
+  void symmetry_plane(const std::string& set_name, const Vector3& plane_normal) {
+    symmetry_plane(named(set_name), plane_normal);
+  }
+  void fix_translation(const ParticleSet& set, const Vector3& direction) {
+    on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
+      checker_.fix_translation(global, direction);
+      constraints_.fix_translation(local, direction);
+    });
+  }
+  void fix_rotation(const ParticleSet& set, const Vector3& axis) {
+    on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
+      checker_.fix_rotation(global, axis);
+      constraints_.fix_rotation(local, axis);
+    });
+  }
+  // Prescribed velocity v(X, t) on all three translations (before the first
+  // step; the function is copied, once for the check of the whole set).
+  template <class VelocityFunction>
+  void prescribe_velocity(const ParticleSet& set, VelocityFunction velocity) {
+    static_assert(std::is_invocable_r_v<Vector3, VelocityFunction, const Vector3&, double>,
+                  "prescribe_velocity: the function must be callable as Vector3 v(const Vector3& X, double t)");
+    on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
+      require_start("prescribe_velocity");
+      checker_.add_motion(global, std::make_unique<sphshell::detail::PrescribedVelocity<VelocityFunction>>(velocity),
+                          model_.particle_position, time_, time_step_);
+      constraints_.add_motion(local, std::make_unique<sphshell::detail::PrescribedVelocity<VelocityFunction>>(velocity),
+                              reference_position_, time_, time_step_);
+    });
+  }
+  template <class DisplacementFunction>
+  void prescribe_displacement(const ParticleSet& set, DisplacementFunction displacement) {
+    static_assert(std::is_invocable_r_v<Vector3, DisplacementFunction, const Vector3&, double>,
+                  "prescribe_displacement: the function must be callable as Vector3 u(const Vector3& X, double t)");
+    on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
+      require_start("prescribe_displacement");
+      for (int i : global) {
+        const Vector3 start = displacement(model_.particle_position[i], time_);
+        if (start.norm() > 0.0)
+          sphshell::detail::invalid_parameter("prescribed displacement at t = 0, particle " + std::to_string(i),
+                                              start.transpose(),
+                                              "must be zero: the run starts from the reference configuration");
+      }
+      using Motion = sphshell::detail::PrescribedDisplacement<DisplacementFunction>;
+      checker_.add_motion(global, std::make_unique<Motion>(displacement), model_.particle_position, time_, time_step_);
+      constraints_.add_motion(local, std::make_unique<Motion>(displacement), reference_position_, time_, time_step_);
+    });
+  }
+
+  // Loads on a set of global ids or a named set (shell/loads.hpp).
+  template <class PressureFunction>
+  void add_pressure(const ParticleSet& set, PressureFunction pressure,
+                    PressureDirection direction = PressureDirection::follower) {
+    static_assert(std::is_invocable_r_v<double, PressureFunction, const Vector3&, double>,
+                  "add_pressure: the pressure must be callable as double p(const Vector3& X, double t)");
+    on_set(set, [&](const ParticleSet&, const ParticleSet& local) {
+      loads_.add(std::make_unique<sphshell::detail::PressureLoad<PressureFunction>>(local, std::move(pressure), direction));
+    });
+  }
+  template <class TimeFunction = time_function::Step>
+  void add_uniform_pressure(const ParticleSet& set, double pressure, TimeFunction time = {},
+                            PressureDirection direction = PressureDirection::follower) {
+    collectively(comm_, [&] {
+      sphshell::detail::require_finite("pressure", pressure);
+      sphshell::detail::check_time_function(time);
+    });
+    add_pressure(set, [pressure, time](const Vector3&, double t) { return pressure * time(t); }, direction);
+  }
+  template <class TimeFunction = time_function::Step>
+  void add_uniform_pressure(const std::string& set_name, double pressure, TimeFunction time = {},
+                            PressureDirection direction = PressureDirection::follower) {
+    add_uniform_pressure(named(set_name), pressure, time, direction);
+  }
+  template <class TimeFunction = time_function::Step>
+  void add_point_force(const ParticleSet& set, const Vector3& force, TimeFunction time = {}) {
+    on_set(set, [&](const ParticleSet&, const ParticleSet& local) {
+      if (!force.allFinite()) sphshell::detail::invalid_parameter("point force", force.transpose(), "must be finite");
+      loads_.add(std::make_unique<sphshell::detail::PointForceLoad<TimeFunction>>(local, force, time));
+    });
+  }
+  template <class TimeFunction = time_function::Step>
+  void add_point_force(const std::string& set_name, const Vector3& force, TimeFunction time = {}) {
+    add_point_force(named(set_name), force, time);
+  }
+  template <class TimeFunction = time_function::Step>
+  void add_point_moment(const ParticleSet& set, const Vector3& moment, TimeFunction time = {}) {
+    on_set(set, [&](const ParticleSet&, const ParticleSet& local) {
+      if (!moment.allFinite())
+        sphshell::detail::invalid_parameter("point moment", moment.transpose(), "must be finite");
+      loads_.add(std::make_unique<sphshell::detail::PointMomentLoad<TimeFunction>>(local, moment, time));
+    });
+  }
+  template <class TimeFunction = time_function::Step>
+  void add_gravity(const ParticleSet& set, const Vector3& acceleration, TimeFunction time = {}) {
+    on_set(set, [&](const ParticleSet&, const ParticleSet& local) {
+      if (!acceleration.allFinite())
+        sphshell::detail::invalid_parameter("gravity acceleration", acceleration.transpose(), "must be finite");
+      loads_.add(std::make_unique<sphshell::detail::GravityLoad<TimeFunction>>(local, acceleration, time));
+    });
+  }
+
+  // One step on every rank (collective). A step that stopped with an Error
+  // leaves a half-updated state: later steps refuse with that error.
+  void step() {
+    if (!failure_.empty()) throw Error(failure_);
+    try {
+      advance();
+    } catch (const Error& error) {
+      failure_ = "sphshell: the solver stopped at step " + std::to_string(steps_) +
+                 " and cannot go on from its half-updated state; the error was: " + error.what();
+      throw;
+    }
+  }
+  // Steps until t_end, as Solver::run_until (collective).
+  void run_until(double t_end) {
+    collectively(comm_, [&] {
+      solver::check_run_end(t_end, solver::RunPosition{time_, time_step_, steps_}, options_.max_steps_per_run);
+    });
+    while (time_ < t_end - 0.5 * time_step_) step();
+  }
+
+  double time() const { return time_; }
+  long steps() const { return steps_; }
+  double time_step() const { return time_step_; }
+  double stable_time_step() const { return stable_time_step_; }
+  const ShellModel& model() const { return model_; }
+  const SolverOptions& options() const { return options_; }
+  const Communicator& communicator() const { return comm_; }
+  const RankLayout& layout() const { return layout_; }
+  const HaloPlan& halo() const { return halo_; }
+  const CommunicationCounters& counters() const { return counters_; }
+
+  // This rank's particles in the local numbering (owned [0, owned), then ghosts).
+  const solver::ParticleState& local_particles() const { return particles_; }
+  const solver::ParticleForces& local_forces() const { return forces_; }
+  int global_id(std::size_t local) const { return layout_.global_of(local); }
+
+  // The owned values of a per-particle field, in global order on every rank
+  // (collective; O(N) bytes: for checks and small runs).
+  std::vector<Vector3> gathered(const std::vector<Vector3>& local_field) const {
+    struct Entry {
+      std::int64_t id;
+      double value[3];
+    };
+    std::vector<Entry> mine(layout_.owned_count());
+    for (std::size_t i = 0; i < mine.size(); ++i)
+      mine[i] = {layout_.owned[i], {local_field[i].x(), local_field[i].y(), local_field[i].z()}};
+    std::vector<Vector3> all(model_.particle_count(), Vector3::Zero());
+    for (const Entry& entry : comm_.all_gather_v(mine))
+      all[static_cast<std::size_t>(entry.id)] = Vector3(entry.value[0], entry.value[1], entry.value[2]);
+    return all;
+  }
+  std::vector<Vector3> positions() const { return gathered(particles_.position); }
+  std::vector<Vector3> directors() const { return gathered(particles_.director); }
+  std::vector<Vector3> velocities() const { return gathered(particles_.velocity); }
+  std::vector<Vector3> angular_velocities() const { return gathered(particles_.angular_velocity); }
+
+  // The energy books over all ranks (collective).
+  EnergyReport energy() {
+    const auto started = std::chrono::steady_clock::now();
+    ExactSum elastic;
+    for (std::size_t p = 0; p < states_->size(); ++p)
+      if (point_owned_[p] && states_->active(p))
+        elastic.add(states_->stored_energy(p, points_->membrane_bending_weight(p), points_->shear_weight(p)));
+    const EnergyReport report = ledger_->report(comm_, elastic, 0.0);
+    counters_.agreement_seconds += seconds_since(started);
+    return report;
+  }
+
+ private:
+  // Points with a failure during the configuration phase are keyed by phase,
+  // then by global id, so a load failure wins over a later non-finite state
+  // on another rank, as in the serial step.
+  enum class Phase : long { loads = 0, motions = 1, configuration = 2 };
+
+  static double seconds_since(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+
+  void set_up(const PartitionWeights& weights) {
+    validate(options_);
+    using SectionState = typename thickness::Section<Rule, Material>::State;
+    solver::check_memory<SectionState>(model_, options_);
+    // The whole model's points and states, as the Solver builds them.
+    const Points all_points(model_, options_.physics(), options_.particle_integration(), law_.shear_modulus());
+    const States all_states(model_, law_, all_points.count(solver::PointGroup::particles));
+    stable_time_step_ = solver::stable_time_step(model_, law_, options_.physics(), all_points, all_states);
+    if (options_.time_step > 0.0) {
+      if (options_.time_step > stable_time_step_)
+        sphshell::detail::invalid_parameter("time_step", options_.time_step,
+                                            "exceeds the stable bound " + solver::number_text(stable_time_step_) + " s");
+      time_step_ = options_.time_step;
+    } else {
+      time_step_ = options_.safety_factor * stable_time_step_;
+    }
+    solver::check_damping(options_.damping, time_step_);
+
+    // The decomposition and this rank's share.
+    const DecompositionInput input = decomposition_input(model_, all_points);
+    partition_ = partition(input, comm_.size(), weights);
+    layout_ = rank_layout(input, partition_, comm_.rank());
+    points_.emplace(all_points.subset(layout_.computed, layout_.local_of, layout_.local_count()));
+    std::vector<std::size_t> computed_points;
+    for (solver::PointGroup group : solver::point_groups) {
+      const std::size_t g = solver::index_of(group);
+      for (std::size_t k = 0; k < layout_.computed[g].size(); ++k) {
+        computed_points.push_back(all_points.point(group, layout_.computed[g][k]));
+        point_owned_.push_back(layout_.computed_is_owned[g][k]);
+      }
+    }
+    global_point_ = computed_points;
+    states_.emplace(all_states.subset(computed_points));
+
+    // Particles in the local numbering.
+    const std::size_t local = layout_.local_count(), owned = layout_.owned_count();
+    const solver::Inertia all_inertia = solver::Inertia::lumped(model_, options_.density, options_.rotary_inertia_scale);
+    for (std::size_t k = 0; k < local; ++k) {
+      const auto i = static_cast<std::size_t>(layout_.global_of(k));
+      reference_position_.push_back(model_.particle_position[i]);
+      reference_normal_.push_back(model_.particle_normal[i]);
+      reference_area_.push_back(model_.particle_area[i]);
+      inertia_.mass.push_back(all_inertia.mass[i]);
+      inertia_.rotary_inertia.push_back(all_inertia.rotary_inertia[i]);
+    }
+    particles_ = solver::ParticleState::at_rest(reference_position_, reference_normal_);
+    particles_.ranges = {0, owned, owned, local};
+    forces_ = solver::ParticleForces(local);
+    assembler_.emplace(options_.nonlinear, *points_);
+    ledger_.emplace(options_.monitoring(), law_.youngs_modulus(), solver::shell_volume(model_));
+  }
+
+  // A set of global ids: checked as the Solver checks it (range, each listed
+  // once), then handed with its owned members in local indices to `apply`.
+  // Collective: an Error on any rank stops all with the same message.
+  template <class Apply>
+  void on_set(const ParticleSet& set, Apply&& apply) {
+    collectively(comm_, [&] {
+      const ParticleSet global = solver::checked_set(set, model_.particle_count());
+      ParticleSet local;
+      for (int i : global) {
+        const int k = layout_.local_of[static_cast<std::size_t>(i)];
+        if (k >= 0 && static_cast<std::size_t>(k) < layout_.owned_count()) local.push_back(k);
+      }
+      apply(global, local);
+    });
+  }
+  // A named set of the (replicated) model; an unknown name is an Error on every rank.
+  ParticleSet named(const std::string& set_name) const {
+    ParticleSet members;
+    collectively(comm_, [&] { members = model_.set(set_name); });
+    return members;
+  }
+  void require_start(const char* what) const {
+    if (steps_ != 0)
+      sphshell::detail::invalid_parameter(what, steps_,
+                                          "a distributed run takes prescribed motions before its first step");
+  }
+
+  StepTime now() const { return {steps_, time_}; }
+
+  void advance() {
+    if (!forces_current_) compute_internal_forces();
+    const stepper::StepContext context{now(), time_step_, stepper_.velocity_step(steps_, time_step_),
+                                       options_.damping};
+    std::optional<Failure> failure;
+    apply_loads(context.at, failure);
+    ledger_->remember_velocities(particles_);
+    stepper_.advance_velocities(context, particles_, inertia_, forces_);
+    ledger_->remember_free_velocities(particles_);
+    impose_conditions(context.at, failure);
+    ledger_->book_step(context, particles_, inertia_, forces_);
+    stepper_.advance_configuration(context, particles_);
+    ++steps_;
+    time_ = start_time_ + static_cast<double>(steps_) * time_step_;  // t = t0 + n Δt, as the Solver
+    forces_current_ = false;
+    check_configuration(failure);
+    agree(failure);
+    compute_internal_forces();
+    if (solver::EnergyLedger::is_check_step(steps_)) {
+      const EnergyReport report = energy();
+      ledger_->check_balance(comm_, now(), report, [&](std::size_t i) { return layout_.global_of(i); });
+    }
+  }
+
+  void agree(const std::optional<Failure>& failure) {
+    const auto started = std::chrono::steady_clock::now();
+    agree_on_failure(comm_, failure);
+    counters_.agreement_seconds += seconds_since(started);
+  }
+  long key(Phase phase, std::size_t global) const {
+    return static_cast<long>(phase) * static_cast<long>(model_.particle_count() + 1) + static_cast<long>(global);
+  }
+  // The first failure of a step is the one the serial step would stop at.
+  static void keep_first(std::optional<Failure>& kept, Failure candidate) {
+    if (!kept || candidate.key < kept->key) kept = std::move(candidate);
+  }
+
+  void apply_loads(const StepTime& at, std::optional<Failure>& failure) {
+    sphshell::detail::LoadContext context{at.time,           reference_position_, reference_normal_, particles_.director,
+                                reference_area_,   inertia_.mass,       forces_.external,  forces_.external_moment};
+    try {
+      loads_.apply(at, context);
+    } catch (const Error&) {
+      // The serial message, with the lowest global id of a non-finite load here.
+      for (std::size_t i = 0; i < layout_.owned_count(); ++i)
+        if (!forces_.external[i].allFinite() || !forces_.external_moment[i].allFinite()) {
+          keep_first(failure, {key(Phase::loads, layout_.owned[i]),
+                               unstable_text(at, "non-finite external load at particle " +
+                                                     std::to_string(layout_.owned[i]) +
+                                                     " (a pressure, force or moment function returned NaN or "
+                                                     "infinity)")});
+          break;
+        }
+    }
+  }
+
+  void impose_conditions(const StepTime& at, std::optional<Failure>& failure) {
+    try {
+      constraints_.impose(at, reference_position_, time_step_, particles_.director, particles_.velocity,
+                          particles_.angular_velocity);
+    } catch (const Error&) {
+      for (std::size_t k = 0; k < constraints_.particles().size(); ++k) {
+        const int i = constraints_.particles()[k];
+        if (!particles_.velocity[i].allFinite()) {
+          const int id = layout_.owned[static_cast<std::size_t>(i)];
+          keep_first(failure, {key(Phase::motions, static_cast<std::size_t>(id)),
+                               unstable_text(at, "prescribed motion of particle " + std::to_string(id) +
+                                                     " is not finite")});
+        }
+      }
+    }
+  }
+
+  void check_configuration(std::optional<Failure>& failure) const {
+    for (std::size_t i = 0; i < layout_.owned_count(); ++i)
+      if (!particles_.position[i].allFinite() || !particles_.director[i].allFinite() ||
+          !particles_.velocity[i].allFinite() || !particles_.angular_velocity[i].allFinite()) {
+        keep_first(failure,
+                   {key(Phase::configuration, layout_.owned[i]),
+                    unstable_text(now(), "non-finite state at particle " + std::to_string(layout_.owned[i]) +
+                                             " (external force " + solver::number_text(forces_.external[i].norm()) +
+                                             " N, internal force " + solver::number_text(forces_.internal[i].norm()) +
+                                             " N)")});
+        return;
+      }
+  }
+
+  static std::string unstable_text(const StepTime& at, const std::string& what) {
+    try {
+      sphshell::detail::fail_unstable(at, what);
+    } catch (const Error& error) {
+      return error.what();
+    }
+    return what;
+  }
+
+  // Halo exchange, then the internal forces of every computed point; a
+  // failing point stops every rank with its global index.
+  void compute_internal_forces() {
+    const auto started = std::chrono::steady_clock::now();
+    exchange_.exchange(comm_, halo_, {&particles_.position, &particles_.director});
+    counters_.exchange_seconds += seconds_since(started);
+    ++counters_.exchanges;
+    counters_.bytes_sent += halo_.bytes_sent(2);
+    std::optional<Failure> failure;
+    try {
+      assembler_->compute(now(), particles_, *points_, *states_, forces_);
+    } catch (const Error& error) {
+      failure = Failure{static_cast<long>(global_point_[assembler_->failed_point()]), error.what()};
+    }
+    agree(failure);
+    ledger_->book_internal_work(assembler_->work_increments(), point_owned_);
+    forces_current_ = true;
+  }
+
+  const Communicator& comm_;
+  ShellModel model_;
+  Material law_;
+  SolverOptions options_;
+  Partition partition_;
+  RankLayout layout_;
+  HaloPlan halo_;
+  HaloExchange exchange_;
+  std::vector<Vector3> reference_position_, reference_normal_;
+  std::vector<double> reference_area_;
+  solver::ParticleState particles_;
+  solver::Inertia inertia_;
+  solver::ParticleForces forces_;
+  std::optional<Points> points_;
+  std::optional<States> states_;
+  std::vector<std::size_t> global_point_;  // per local point: its index in the whole model's numbering
+  std::vector<char> point_owned_;          // per local point: owned here (books its work)
+  std::optional<solver::InternalForceAssembler> assembler_;
+  std::optional<DistributedLedger> ledger_;
+  Stepper stepper_;
+  sphshell::detail::Constraints constraints_;  // owned particles, local indices
+  sphshell::detail::Constraints checker_;      // the whole sets, global ids: the Solver's checks and messages
+  ExternalLoads loads_;
+  CommunicationCounters counters_;
+  double stable_time_step_ = 0.0;
+  double time_step_ = 0.0;
+  double start_time_ = 0.0;
+  double time_ = 0.0;
+  long steps_ = 0;
+  bool forces_current_ = false;
+  std::string failure_;
+};
+
+}  // namespace sphshell::mpi

@@ -1,0 +1,228 @@
+// The distributed step against the serial Solver (docs/distributed.md): the
+// same model run by sphshell::Solver in one process (on every rank, as the
+// independent reference) and by mpi::DistributedSolver over the ranks; the
+// owned particles' positions, directors, velocities and angular velocities
+// must be bitwise the serial ones, the energies within 1e-12 relative.
+#include <sphshell/approx/mls.hpp>
+#include <sphshell/kernel/cubic_spline.hpp>
+#include <sphshell/material/elastic.hpp>
+#include <sphshell/material/j2_plasticity.hpp>
+#include <sphshell/mpi/distributed_solver.hpp>
+#include <sphshell/shell/spherical_cap_ogrid.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/gauss.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstring>
+#include <functional>
+#include <string>
+#include <vector>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+using namespace sphshell;
+
+namespace {
+
+using Approximation = approx::MLS<kernel::CubicSpline>;
+template <class Material>
+using Serial = Solver<Approximation, thickness::Gauss<3>, Material>;
+template <class Material>
+using Distributed = mpi::DistributedSolver<Approximation, thickness::Gauss<3>, Material>;
+
+// How many components of two fields differ in their bits.
+std::size_t differing_components(const std::vector<Vector3>& a, const std::vector<Vector3>& b) {
+  if (a.size() != b.size()) return a.size() + b.size();
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    for (int c = 0; c < 3; ++c) count += std::memcmp(&a[i][c], &b[i][c], sizeof(double)) != 0 ? 1 : 0;
+  return count;
+}
+
+double relative(double a, double b) {
+  const double scale = std::max(std::abs(a), std::abs(b));
+  return scale == 0.0 ? 0.0 : std::abs(a - b) / scale;
+}
+
+// One run's set-up, applied alike to either solver (global ids, set names).
+template <class S>
+using Setup = std::function<void(S&)>;
+
+template <class Material>
+void compare_runs(const std::string& label, const ShellModel& model, const typename Material::Parameters& parameters,
+                  const SolverOptions& options, long steps, const Setup<Serial<Material>>& setup_serial,
+                  const Setup<Distributed<Material>>& setup_distributed, double* plastic_strain = nullptr) {
+  const mpi::Communicator comm;
+  Serial<Material> serial(model, parameters, options);
+  setup_serial(serial);
+  Distributed<Material> distributed(comm, model, parameters, options);
+  setup_distributed(distributed);
+  CHECK(distributed.time_step() == serial.time_step());
+  for (long n = 0; n < steps; ++n) {
+    serial.step();
+    distributed.step();
+  }
+  const std::size_t positions = differing_components(distributed.positions(), serial.positions());
+  const std::size_t directors = differing_components(distributed.directors(), serial.directors());
+  const std::size_t velocities = differing_components(distributed.velocities(), serial.velocities());
+  const std::size_t angular = differing_components(distributed.angular_velocities(), serial.angular_velocities());
+  const EnergyReport e = distributed.energy(), s = serial.energy();
+  INFO(label << " on " << comm.size() << " ranks, " << steps << " steps; rank " << comm.rank() << " owns "
+             << distributed.layout().owned_count() << " particles, " << distributed.layout().ghost_count()
+             << " ghosts, " << distributed.layout().redundant_point_count() << " redundant points");
+  CHECK(positions == 0);
+  CHECK(directors == 0);
+  CHECK(velocities == 0);
+  CHECK(angular == 0);
+  // The motion must be real: a test of equal zeros proves nothing.
+  double largest_displacement = 0.0;
+  for (std::size_t i = 0; i < model.particle_count(); ++i)
+    largest_displacement = std::max(largest_displacement, serial.displacement(static_cast<int>(i)).norm());
+  CHECK(largest_displacement > 1e-6);
+  CHECK(s.kinetic > 0.0);
+  CHECK(relative(e.kinetic, s.kinetic) < 1e-12);
+  CHECK(relative(e.internal, s.internal) < 1e-12);
+  CHECK(relative(e.elastic, s.elastic) < 1e-12);
+  CHECK(relative(e.external_work, s.external_work) < 1e-12);
+  CHECK(relative(e.damping_work, s.damping_work) < 1e-12);
+  CHECK(std::abs(e.balance() - s.balance()) < 1e-12 * std::max(s.external_work, s.kinetic));
+  if (comm.is_root())
+    WARN(label << " on " << comm.size() << " ranks: bitwise equal over " << steps
+               << " steps; energy differences (relative) kinetic " << relative(e.kinetic, s.kinetic) << ", internal "
+               << relative(e.internal, s.internal) << ", external " << relative(e.external_work, s.external_work));
+  if (plastic_strain) {
+    double largest = 0.0;
+    for (std::size_t p = 0; p < model.stress_point_count(); ++p)
+      largest = std::max(largest, serial.equivalent_plastic_strain(static_cast<int>(p), 0));
+    *plastic_strain = largest;
+  }
+}
+
+// The paper's plate (L = 0.5 m, d = 0.01 m, steel), 21 × 21, clamped, under
+// a step pressure.
+ShellModel plate() { return ShellModel::rectangular_plate(0.5, 0.5, 21, 21, 0.01); }
+constexpr double steel_E = 210e9, steel_nu = 0.3, steel_yield = 250e6, steel_Ep = 1e9;
+
+// The serial Solver takes sets of ids; the distributed one also takes names.
+template <class Material>
+void clamped_pressure(Serial<Material>& solver, double pressure) {
+  solver.clamp(solver.model().set("boundary"));
+  solver.add_uniform_pressure(solver.model().all_particles(), pressure);
+}
+template <class Material>
+void clamped_pressure(Distributed<Material>& solver, double pressure) {
+  solver.clamp("boundary");
+  solver.add_uniform_pressure(solver.model().all_particles(), pressure);
+}
+
+}  // namespace
+
+TEST_CASE("Distributed plate, elastic: bitwise the serial Solver", "[mpi][solver]") {
+  SolverOptions options;
+  options.density = 7850.0;
+  compare_runs<material::Elastic>(
+      "plate 21x21 elastic", plate(), {steel_E, steel_nu}, options, 300,
+      [](Serial<material::Elastic>& s) { clamped_pressure(s, 5e5); },
+      [](Distributed<material::Elastic>& s) { clamped_pressure(s, 5e5); });
+}
+
+TEST_CASE("Distributed plate, J2 plasticity: bitwise the serial Solver", "[mpi][solver]") {
+  SolverOptions options;
+  options.density = 7850.0;
+  double plastic = 0.0;
+  compare_runs<material::J2Plasticity>(
+      "plate 21x21 J2", plate(), {steel_E, steel_nu, steel_yield, steel_Ep}, options, 300,
+      [](Serial<material::J2Plasticity>& s) { clamped_pressure(s, 5e6); },
+      [](Distributed<material::J2Plasticity>& s) { clamped_pressure(s, 5e6); }, &plastic);
+  CHECK(plastic > 0.0);  // the plate yielded
+}
+
+TEST_CASE("Distributed O-grid cap, J2 plasticity: bitwise the serial Solver", "[mpi][solver]") {
+  // The paper's cap (Figs 6-7, aluminium, 600 psi inward) on a coarse O-grid.
+  const double radius = 0.5657, half_angle = 26.67 * M_PI / 180.0, thickness = 0.010414;
+  const ShellModel model = spherical_cap_ogrid(radius, half_angle, 8, thickness);
+  SolverOptions options;
+  options.density = 2618.0;
+  const double E = 72.4e9, Et = 1.448e9;
+  double plastic = 0.0;
+  auto setup = [](auto& s) { clamped_pressure(s, 600.0 * 6894.757); };
+  compare_runs<material::J2Plasticity>("O-grid cap J2", model, {E, 0.3, 165.5e6, E * Et / (E - Et)}, options, 300,
+                                       setup, setup, &plastic);
+  CHECK(plastic > 0.0);
+}
+
+TEST_CASE("Distributed plate, 2 OpenMP threads per rank: still bitwise", "[mpi][solver]") {
+#ifdef _OPENMP
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(2);
+#endif
+  SolverOptions options;
+  options.density = 7850.0;
+  compare_runs<material::J2Plasticity>(
+      "plate 21x21 J2, 2 threads per rank", plate(), {steel_E, steel_nu, steel_yield, steel_Ep}, options, 200,
+      [](Serial<material::J2Plasticity>& s) {
+#ifdef _OPENMP
+        omp_set_num_threads(1);  // the reference runs on one thread
+#endif
+        clamped_pressure(s, 5e6);
+      },
+      [](Distributed<material::J2Plasticity>& s) { clamped_pressure(s, 5e6); });
+#ifdef _OPENMP
+  omp_set_num_threads(threads);
+#endif
+}
+
+TEST_CASE("Distributed solver: an Error on one rank stops every rank with the serial message", "[mpi][solver]") {
+  const mpi::Communicator comm;
+  SolverOptions options;
+  options.density = 7850.0;
+  const ShellModel model = plate();
+  // A pressure that turns NaN at the last particle (owned by the last rank)
+  // from step 3 on.
+  const Vector3 last = model.particle_position.back();
+  auto pressure = [last](const Vector3& x, double t) {
+    return (x - last).norm() < 1e-12 && t > 2.5e-7 * 2 ? std::nan("") : 1e5;
+  };
+  Serial<material::Elastic> serial(model, {steel_E, steel_nu}, options);
+  serial.add_pressure(model.all_particles(), pressure);
+  std::string serial_message;
+  try {
+    for (int n = 0; n < 20; ++n) serial.step();
+  } catch (const Error& error) {
+    serial_message = error.what();
+  }
+  REQUIRE(!serial_message.empty());
+  Distributed<material::Elastic> distributed(comm, model, {steel_E, steel_nu}, options);
+  distributed.add_pressure(model.all_particles(), pressure);
+  std::string message;
+  try {
+    for (int n = 0; n < 20; ++n) distributed.step();
+  } catch (const Error& error) {
+    message = error.what();
+  }
+  CHECK(message == serial_message);
+  // Every rank stopped; the next step refuses with the same latch.
+  CHECK_THROWS_AS(distributed.step(), Error);
+
+  // An unknown set name: the same Error on every rank.
+  Distributed<material::Elastic> other(comm, model, {steel_E, steel_nu}, options);
+  std::string unknown;
+  try {
+    other.clamp("no such set");
+  } catch (const Error& error) {
+    unknown = error.what();
+  }
+  CHECK(unknown.find("no such set") != std::string::npos);
+  // A set member out of range: the Solver's message.
+  std::string out_of_range;
+  try {
+    other.clamp(ParticleSet{0, static_cast<int>(model.particle_count())});
+  } catch (const Error& error) {
+    out_of_range = error.what();
+  }
+  CHECK(out_of_range.find("out of range") != std::string::npos);
+}
