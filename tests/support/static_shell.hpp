@@ -89,7 +89,7 @@ struct StaticConditions {
 };
 
 struct NewtonOptions {
-  double tolerance = 1e-7;          // ‖residual‖ ≤ tolerance · ‖λ f_ext‖
+  double tolerance = 1e-6;          // ‖residual‖ ≤ tolerance · ‖λ f_ext‖ (thin shells floor near 1e-7)
   int max_iterations = 25;          // per load step, before the step is halved
   int max_halvings = 12;            // per load step
   double translation_step = 1e-7;   // finite-difference step, in units of the model's spacing
