@@ -44,9 +44,10 @@ std::optional<Arguments> parse(int argc, char** argv) {
       "The standard shell benchmarks solved statically (Newton's method on a stiffness assembled from the "
       "solver's internal forces): Scordelis-Lo roof, pinched hemisphere with an 18° hole and pinched cylinder "
       "with rigid diaphragms (linear), and the cantilevers of Sze, Liu & Lo (2004) under end shear and rolled "
-      "into a circle by an end moment (geometrically nonlinear). Each case runs at three resolutions and the "
+      "into a circle by an end moment, and the slit annular plate under end shear (geometrically nonlinear). Each case runs at three resolutions and the "
       "table printed gives the finest one's error with the two coarser ones' beside it.");
-  command_line.flag("--coarse", arguments.coarse, "three coarse resolutions per case (a quick run, for checks)");
+  command_line.flag("--coarse", arguments.coarse,
+                    "three coarse resolutions per case, without the slit annular plate (a quick run, for checks)");
   command_line.choice("--cases", arguments.cases, {"all", "linear", "nonlinear"}, "which benchmarks to run");
   command_line.output_folder(arguments.output);
   command_line.writes("benchmarks.csv", "every run: case, resolution, value, reference, error, seconds");
@@ -55,6 +56,8 @@ std::optional<Arguments> parse(int argc, char** argv) {
   command_line.writes("end_moment.csv", "cantilever under end moment: M/Mmax, tip -u and w, the circle's");
   command_line.writes("end_moment.svg", "its load-deflection chart with the closed form");
   command_line.writes("linear_convergence.svg", "the linear cases' error against the resolution");
+  command_line.writes("slit_annular_plate.csv", "slit annular plate: P/Pmax, W_A and W_B, the paper's (not with --coarse)");
+  command_line.writes("slit_annular_plate.svg", "its load-deflection chart with the paper's points");
   if (!command_line.parse(argc, argv)) return std::nullopt;
   return arguments;
 }
@@ -206,6 +209,43 @@ int run(const Arguments& arguments) {
                 << finest.points.back().w << "\n";
     }
     table.push_back({moment_rows, "tip −u at the full circle (= L)"});
+    if (!arguments.coarse) {
+      // Slit annular plate: W_A and W_B at P_max against the paper's table.
+      const std::vector<Resolution> slit_grids{{7, 31}, {9, 46}, {11, 61}};
+      std::vector<Row> slit_a, slit_b;
+      SlitPlateRun slit;
+      const std::vector<TabulatedPoint> reference = sze_slit_annular_plate_table();
+      for (const Resolution& grid : slit_grids) {
+        const auto start = std::chrono::steady_clock::now();
+        slit = run_slit_annular_plate<NonlinearSolver>(grid.nx, grid.ny, 0.025);
+        const double seconds = seconds_since(start);
+        slit_a.push_back({"Slit annular plate", grid.text(), slit.points.back().first, reference.back().first, seconds});
+        slit_b.push_back({"Slit annular plate", grid.text(), slit.points.back().second, reference.back().second, seconds});
+        csv.write_row({static_cast<double>(grid.nx * grid.ny), slit_b.back().value, slit_b.back().reference,
+                       slit_b.back().error(), seconds});
+        std::cerr << "slit annular plate, " << grid.text() << ": W_A " << slit_a.back().error() << " %, W_B "
+                  << slit_b.back().error() << " %\n";
+      }
+      table.push_back({slit_a, "W_A (inner) at P_max (the paper's table)"});
+      table.push_back({slit_b, "W_B (outer) at P_max (the paper's table)"});
+      io::CsvProbe slit_csv(arguments.output + "/slit_annular_plate.csv",
+                            {"P/Pmax", "W_A", "W_B", "paper W_A", "paper W_B"});
+      io::PlotSeries a{"SPH W_A (" + slit_grids.back().text() + ")", {0.0}, {0.0}, io::PlotStyle::line};
+      io::PlotSeries b{"SPH W_B", {0.0}, {0.0}, io::PlotStyle::line};
+      io::PlotSeries pa{"Sze et al. 2004, W_A", {}, {}, io::PlotStyle::points};
+      io::PlotSeries pb{"Sze et al. 2004, W_B", {}, {}, io::PlotStyle::points};
+      for (std::size_t k = 0; k < reference.size(); ++k) {
+        slit_csv.write_row({reference[k].load_factor, slit.points[k].first, slit.points[k].second, reference[k].first,
+                            reference[k].second});
+        a.x.push_back(reference[k].load_factor), a.y.push_back(slit.points[k].first);
+        b.x.push_back(reference[k].load_factor), b.y.push_back(slit.points[k].second);
+        pa.x.push_back(reference[k].load_factor), pa.y.push_back(reference[k].first);
+        pb.x.push_back(reference[k].load_factor), pb.y.push_back(reference[k].second);
+      }
+      io::write_svg_plot(arguments.output + "/slit_annular_plate.svg",
+                         {{"Slit annular plate under end shear (Sze, Liu & Lo 2004)", "P / Pmax", "W",
+                           {a, b, pa, pb}}});
+    }
     io::CsvProbe curve(arguments.output + "/end_moment.csv", {"M/Mmax", "-u", "w", "circle -u", "circle w"});
     io::PlotSeries u{"SPH −u/L (" + moment_grids.back().text() + ")", {}, {}, io::PlotStyle::line};
     io::PlotSeries w{"SPH w/L", {}, {}, io::PlotStyle::line};

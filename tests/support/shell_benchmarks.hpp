@@ -311,4 +311,67 @@ CantileverRun run_cantilever(EndLoad load, int nx, int ny, const std::vector<dou
   return run;
 }
 
+// Sze, Liu & Lo (2004), §3.3, slit annular plate: inner radius 6, outer 10,
+// t = 0.03, E = 21e6, ν = 0, clamped along one face of a radial slit, a
+// transverse line force q (q_max = 0.8, P_max = 0.8 × 4 = 3.2) on the other
+// face. The slit's faces are duplicated particles (the grid's first and last
+// rows, at θ = 0 and 2π) separated by a cut (ShellModel::add_cut) run half a
+// spacing past both edges. n_radial × n_circumferential particles.
+struct SlitAnnularPlate {
+  ShellModel model;
+  StaticConditions conditions;
+  int inner, outer;  // points A (r = 6) and B (r = 10) of the loaded face
+};
+inline SlitAnnularPlate slit_annular_plate(int n_radial, int n_circumferential) {
+  const double inner_radius = 6.0, outer_radius = 10.0, t = 0.03, q_max = 0.8;
+  auto surface = [&](double u, double v) {
+    const double r = inner_radius + u * (outer_radius - inner_radius), theta = 2.0 * benchmark_pi * v;
+    return std::make_pair(Vector3(r * std::cos(theta), r * std::sin(theta), 0.0), Vector3::UnitZ());
+  };
+  ShellModel model = structured_surface(n_radial, n_circumferential, surface, t);
+  const double half_spacing = 0.5 * (outer_radius - inner_radius) / (n_radial - 1);
+  model.add_cut({Vector3(inner_radius - half_spacing, 0.0, 0.0), Vector3(outer_radius + half_spacing, 0.0, 0.0)});
+  StaticConditions conditions(model.particle_count());
+  ParticleSet clamped, loaded;
+  for (int i = 0; i < n_radial; ++i) {
+    clamped.push_back(i);
+    loaded.push_back((n_circumferential - 1) * n_radial + i);
+  }
+  conditions.clamp(clamped);
+  const std::vector<double> share = edge_shares(n_radial);
+  const double P_max = q_max * (outer_radius - inner_radius);
+  for (int i = 0; i < n_radial; ++i) conditions.add_force({loaded[i]}, Vector3(0.0, 0.0, P_max * share[i]));
+  return {std::move(model), std::move(conditions), loaded.front(), loaded.back()};
+}
+
+// Its tabulated reference (Sze, Liu & Lo 2004, §3.3, the table of W_A and
+// W_B): P/P_max, W_A (inner), W_B (outer); the paper's points at 0.025 and
+// 0.1 … 1.
+inline std::vector<TabulatedPoint> sze_slit_annular_plate_table() {
+  return {{0.025, 1.305, 1.789}, {0.10, 4.277, 5.876},  {0.20, 6.725, 9.160},  {0.30, 8.340, 11.213},
+          {0.40, 9.529, 12.661}, {0.50, 10.468, 13.768}, {0.60, 11.257, 14.674}, {0.70, 11.970, 15.469},
+          {0.80, 12.642, 16.202}, {0.90, 13.282, 16.886}, {1.00, 13.891, 17.528}};
+}
+
+// The slit plate solved at the table's load factors up to `last_factor`: W_A and W_B at each.
+struct SlitPlateRun {
+  std::vector<TabulatedPoint> points;  // load factor, W_A, W_B
+  NewtonReport report;
+};
+template <class NonlinearSolver>
+SlitPlateRun run_slit_annular_plate(int n_radial, int n_circumferential, double step, double last_factor = 1.0) {
+  SlitAnnularPlate plate = slit_annular_plate(n_radial, n_circumferential);
+  NonlinearSolver solver(plate.model, {21e6, 0.0});
+  StaticShell<NonlinearSolver> statics(solver, plate.conditions);
+  SlitPlateRun run;
+  for (const TabulatedPoint& point : sze_slit_annular_plate_table()) {
+    if (point.load_factor > last_factor + 1e-12) break;
+    statics.solve_to(point.load_factor, step);
+    run.points.push_back(
+        {point.load_factor, statics.displacement(plate.inner).z(), statics.displacement(plate.outer).z()});
+  }
+  run.report = statics.report();
+  return run;
+}
+
 }  // namespace sphshell::test_support
