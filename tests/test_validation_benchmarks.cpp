@@ -82,8 +82,8 @@ TEST_CASE("Static shell: the elastica by shooting matches the tabulated cantilev
 }
 
 TEST_CASE("Benchmark: Scordelis-Lo roof (linear)", "[validation][benchmarks]") {
-  // Reference 0.3024 (MacNeal & Harder 1985). Measured −0.50 % at 33 x 33
-  // (+0.11 % at 17, −0.34 % at 25; −0.54 % at 41 in the example).
+  // Reference 0.3024 (MacNeal & Harder 1985). Measured −0.49 % at 33 x 33
+  // (+0.09 % at 17, −0.33 % at 25; −0.54 % at 41 in the example).
   const double error = linear_convergence("Scordelis-Lo roof", scordelis_lo_roof, {17, 25, 33});
   CHECK(std::abs(error) < 0.75);
 }
