@@ -135,6 +135,34 @@ class IntegrationPoints {
     part.build_slot_transpose(local_count);
     return part;
   }
+  // A subset's row set to a row of the whole model's points after a crack
+  // rebuilt it there (rebuilds sort by global particle index, so they run on
+  // the whole model's rows): every slot, the reference gradients and the flag,
+  // neighbours renumbered by local_of. The capacities must agree.
+  void copy_row(PointGroup group, std::size_t row, const IntegrationPoints& from, std::size_t from_row,
+                const std::vector<int>& local_of) {
+    const std::size_t g = index_of(group);
+    approx::ShapeFunctions& to = shape_[g];
+    const approx::ShapeFunctions& source = from.shape_[g];
+    if (to.capacity(row) != source.capacity(from_row))
+      detail::invalid_parameter(std::string("capacity of ") + name_of(group) + " row " + std::to_string(from_row),
+                                to.capacity(row), "must equal the source row's " + std::to_string(source.capacity(from_row)));
+    for (std::size_t k = 0; k < to.capacity(row); ++k) {
+      const std::size_t s = to.row_begin[row] + k, t = source.row_begin[from_row] + k;
+      to.neighbour[s] = local_of.at(static_cast<std::size_t>(source.neighbour[t]));
+      if (to.neighbour[s] < 0)
+        detail::invalid_parameter(std::string("particle of ") + name_of(group) + " row " + std::to_string(from_row),
+                                  source.neighbour[t], "is not local to the subset (its rows need it)");
+      to.phi[s] = source.phi[t];
+      to.dphi_d1[s] = source.dphi_d1[t];
+      to.dphi_d2[s] = source.dphi_d2[t];
+    }
+    to.row_size[row] = source.row_size[from_row];
+    to.shepard[row] = source.shepard[from_row];
+    reference_[point(group, row)] = from.reference_[from.point(group, from_row)];
+    mark_rebuilt(group, row);
+  }
+
   // The row of the whole model a row stands for (itself but in a subset).
   std::size_t global_row(PointGroup group, std::size_t row) const {
     const std::vector<std::size_t>& rows = global_row_[index_of(group)];
