@@ -133,7 +133,7 @@ void threads_idle(benchmark::State& state) { two_against_one_thread(state, false
 
 }  // namespace
 
-BENCHMARK(threads_under_load)->Arg(50)->Arg(0)->Arg(1000)->UseManualTime()->Iterations(1)->Unit(benchmark::kMicrosecond);
-BENCHMARK(threads_idle)->Arg(50)->UseManualTime()->Iterations(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(threads_under_load)->Arg(50)->Arg(20)->Arg(5)->Arg(0)->Arg(1000)->UseManualTime()->Iterations(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(threads_idle)->Arg(50)->Arg(20)->Arg(5)->Arg(0)->UseManualTime()->Iterations(1)->Unit(benchmark::kMicrosecond);
 
 BENCHMARK_MAIN();

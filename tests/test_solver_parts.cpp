@@ -6,11 +6,13 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 using namespace sphshell;
@@ -215,6 +217,45 @@ TEST_CASE("parallel::for_each visits every index once, nested and repeated, with
   CHECK_THROWS_AS(parallel::set_spin_time(std::chrono::nanoseconds(-1)), Error);
   CHECK(parallel::spin_time() == default_spin);
 #ifdef _OPENMP
+  omp_set_num_threads(1);
+#endif
+}
+
+TEST_CASE("parallel::for_each gives each thread one contiguous block, not indices in turn", "[core][parallel]") {
+  // The cache affinity that makes two threads faster than one: the worker of a
+  // two-thread team runs one contiguous range of a loop (its block, less what
+  // the caller took from the block's back), whichever thread ran faster.
+#ifndef _OPENMP
+  SUCCEED("built without OpenMP: the loops run on one thread");
+#else
+  omp_set_num_threads(2);
+  constexpr std::size_t n = 20000;
+  std::vector<std::thread::id> runner(n);
+  std::vector<double> values(n, 1.0);
+  int loops_with_worker = 0;
+  bool contiguous = true;
+  for (int repeat = 0; repeat < 200; ++repeat) {
+    const std::thread::id caller = std::this_thread::get_id();
+    parallel::for_each(std::size_t{0}, n, [&](std::size_t i) noexcept {
+      double x = values[i];
+      for (int k = 0; k < 20; ++k) x = std::sqrt(x + 1.0);
+      values[i] = x;
+      runner[i] = std::this_thread::get_id();
+    });
+    std::size_t first = n, last = 0, count = 0;
+    for (std::size_t i = 0; i < n; ++i)
+      if (runner[i] != caller) {
+        first = std::min(first, i);
+        last = i;
+        ++count;
+      }
+    if (count == 0) continue;
+    ++loops_with_worker;
+    contiguous = contiguous && count == last - first + 1;
+  }
+  INFO("the worker joined " << loops_with_worker << " of 200 loops");
+  CHECK(loops_with_worker > 0);
+  CHECK(contiguous);
   omp_set_num_threads(1);
 #endif
 }

@@ -19,8 +19,13 @@
 // other CPU-bound process two threads were several times slower than one
 // (README, "Threads"); OpenMP's spin time is fixed at program start by an
 // environment variable, which a library must not impose on its users.
-// Indices are handed out in small tasks that idle threads claim in turn, so a
-// thread that the operating system holds back leaves its share to the others.
+// Each thread has its own contiguous block of a loop's indices, the same block
+// in every loop of the same size: a point's data then stays in the cache of
+// the core that wrote it in the step before (handing the indices out in turn,
+// task by task, made two threads slower than one, README "Thread counts").
+// A block is split into small tasks; a thread that has finished its own block
+// takes the tasks left in the others', so a thread that the operating system
+// holds back leaves most of its share to the others.
 //
 // How many threads: OpenMP's setting when the program is built with OpenMP
 // (OMP_NUM_THREADS, omp_set_num_threads; one inside an OpenMP parallel
@@ -122,12 +127,18 @@ class Team {
 
   // Runs tasks [0, task_count) of `function` on the caller and up to
   // threads − 1 workers. The team must be acquired.
+  // Thread t's block is tasks [t·task_count/threads, (t+1)·task_count/threads);
+  // the caller is thread 0 and worker k (in the order they were started) is
+  // thread k + 1.
   void run(std::size_t task_count, int threads, TaskFunction function, void* context) {
     const int helpers = std::min(start_workers(threads - 1), max_joined);
     function_ = function;
     context_ = context;
     task_count_ = task_count;
-    next_task_.store(0, std::memory_order_relaxed);
+    block_count_ = static_cast<std::size_t>(helpers) + 1;
+    if (blocks_.size() < block_count_) blocks_ = std::vector<Block>(block_count_);
+    for (std::size_t b = 0; b < block_count_; ++b)
+      blocks_[b].range.store(pack(block_start(b), block_start(b + 1)), std::memory_order_relaxed);
     finished_.store(0, std::memory_order_relaxed);
     sequence_ = (sequence_ + 1) & sequence_mask;
     job_.store(sequence_ << sequence_shift | static_cast<std::uint64_t>(helpers) << limit_shift,
@@ -136,7 +147,7 @@ class Team {
       std::lock_guard<std::mutex> lock(mutex_);
       work_ready_.notify_all();
     }
-    work(function, context, task_count);
+    work(0);
     const std::uint64_t closed = job_.fetch_or(closed_bit, std::memory_order_acq_rel);
     const int joined = static_cast<int>(closed & joined_mask);
     wait_for_workers(joined);
@@ -155,10 +166,40 @@ class Team {
 
   static std::uint64_t sequence_of(std::uint64_t job) { return job >> sequence_shift; }
 
-  void work(TaskFunction function, void* context, std::size_t task_count) {
-    for (std::size_t task = next_task_.fetch_add(1, std::memory_order_relaxed); task < task_count;
-         task = next_task_.fetch_add(1, std::memory_order_relaxed))
-      function(context, task);
+  std::size_t block_start(std::size_t block) const { return block * task_count_ / block_count_; }
+
+  // A block's unclaimed tasks [front, back) in one word: its thread claims from
+  // the front, the others from the back, so a thread that helps out takes the
+  // tasks farthest from where the block's own thread is working.
+  static std::uint64_t pack(std::size_t front, std::size_t back) {
+    return static_cast<std::uint64_t>(front) << half_shift | static_cast<std::uint64_t>(back);
+  }
+  static std::size_t front_of(std::uint64_t range) { return static_cast<std::size_t>(range >> half_shift); }
+  static std::size_t back_of(std::uint64_t range) { return static_cast<std::size_t>(range & half_mask); }
+
+  // Claims a task of `block` from its front (own) or back; false when none is left.
+  bool claim(std::size_t block, bool own, std::size_t& task) {
+    std::atomic<std::uint64_t>& range = blocks_[block].range;
+    std::uint64_t current = range.load(std::memory_order_relaxed);
+    for (;;) {
+      const std::size_t front = front_of(current), back = back_of(current);
+      if (front >= back) return false;
+      const std::uint64_t claimed = own ? pack(front + 1, back) : pack(front, back - 1);
+      if (range.compare_exchange_weak(current, claimed, std::memory_order_relaxed)) {
+        task = own ? front : back - 1;
+        return true;
+      }
+    }
+  }
+
+  // Thread `own` runs the tasks of its own block, then those still unclaimed
+  // in the other blocks.
+  void work(std::size_t own) {
+    std::size_t task = 0;
+    for (std::size_t k = 0; k < block_count_; ++k) {
+      const std::size_t block = (own + k) % block_count_;
+      while (claim(block, k == 0, task)) function_(context_, task);
+    }
   }
 
   // Starts workers until there are `wanted` (or as many as the system gives);
@@ -166,7 +207,7 @@ class Team {
   int start_workers(int wanted) {
     while (static_cast<int>(workers_started_) < wanted && !start_failed_) {
       try {
-        std::thread(&Team::worker_loop, this).detach();
+        std::thread(&Team::worker_loop, this, static_cast<std::size_t>(workers_started_) + 1).detach();
         ++workers_started_;
       } catch (const std::system_error&) {
         start_failed_ = true;  // run with the threads there are
@@ -184,7 +225,8 @@ class Team {
     caller_sleeping_.store(false, std::memory_order_relaxed);
   }
 
-  void worker_loop() {
+  // `thread` is this worker's place in the team (its block, see run()).
+  void worker_loop(std::size_t thread) {
     std::uint64_t seen = sequence_of(job_.load(std::memory_order_acquire));
     for (;;) {
       auto published = [&] { return sequence_of(job_.load(std::memory_order_acquire)) != seen; };
@@ -196,8 +238,8 @@ class Team {
       }
       std::uint64_t job = job_.load(std::memory_order_acquire);
       seen = sequence_of(job);
-      if (!join(job)) continue;
-      work(function_, context_, task_count_);
+      if (!join(job, thread)) continue;
+      work(thread);
       finished_.fetch_add(1, std::memory_order_seq_cst);
       if (caller_sleeping_.load(std::memory_order_seq_cst)) {
         std::lock_guard<std::mutex> lock(mutex_);
@@ -206,13 +248,13 @@ class Team {
     }
   }
 
-  // Joins the job if it is still open and has room; the caller then waits for
-  // this worker, so the job's data stays valid until it reports back.
-  bool join(std::uint64_t job) {
+  // Joins the job if it is still open and this worker is one of the threads
+  // it may use; the caller then waits for this worker, so the job's data stays
+  // valid until it reports back.
+  bool join(std::uint64_t job, std::size_t thread) {
     const std::uint64_t sequence = sequence_of(job);
     for (;;) {
-      if (sequence_of(job) != sequence || (job & closed_bit) ||
-          (job & joined_mask) >= ((job >> limit_shift) & limit_mask))
+      if (sequence_of(job) != sequence || (job & closed_bit) || thread > ((job >> limit_shift) & limit_mask))
         return false;
       if (job_.compare_exchange_weak(job, job + 1, std::memory_order_acq_rel, std::memory_order_acquire))
         return true;
@@ -223,7 +265,13 @@ class Team {
   static constexpr std::size_t cache_line = 64;
   alignas(cache_line) std::atomic<bool> busy_{false};
   alignas(cache_line) std::atomic<std::uint64_t> job_{0};
-  alignas(cache_line) std::atomic<std::size_t> next_task_{0};
+  // The unclaimed tasks of each thread's block (see claim()).
+  struct alignas(cache_line) Block {
+    std::atomic<std::uint64_t> range{0};
+  };
+  static constexpr int half_shift = 32;
+  static constexpr std::uint64_t half_mask = 0xffffffff;
+  std::vector<Block> blocks_;
   alignas(cache_line) std::atomic<int> finished_{0};
   alignas(cache_line) std::atomic<int> sleeping_workers_{0};
   std::atomic<bool> caller_sleeping_{false};
@@ -232,15 +280,16 @@ class Team {
   // Written by the caller before it publishes a job, read by workers that joined it.
   TaskFunction function_ = nullptr;
   void* context_ = nullptr;
-  std::size_t task_count_ = 0;
+  std::size_t task_count_ = 0, block_count_ = 1;
   // The caller's own bookkeeping (only the thread holding the team touches these).
   std::uint64_t sequence_ = 0;
   unsigned workers_started_ = 0;
   bool start_failed_ = false;
 };
 
-// Tasks per thread: enough that a thread held back by the system leaves most
-// of its share to the others, few enough that claiming them costs nothing.
+// Tasks per thread (per block): enough that a thread held back by the system
+// leaves most of its share to the others, few enough that claiming them costs
+// nothing.
 constexpr std::size_t tasks_per_thread = 16;
 // Below this many indices per task a loop is not worth waking threads for.
 constexpr std::size_t min_task_size = 8;
