@@ -191,7 +191,12 @@ struct Basis {
   int size = 0;
 };
 
-inline int free_directions(const Matrix3& projector, Vector3* out, int at_most) {
+// The functions below that use Eigen's eigen solvers or sparse factorisations
+// are templates so that they are compiled only in programs that call a static
+// solve (as ordinary inline functions they added about 15 s to the compile
+// time of every program that includes the library).
+template <class Projector>
+int free_directions(const Projector& projector, Vector3* out, int at_most) {
   Eigen::SelfAdjointEigenSolver<Matrix3> eigen(0.5 * (projector + projector.transpose()));
   int count = 0;
   for (int k = 2; k >= 0 && count < at_most; --k)
@@ -210,7 +215,8 @@ inline Matrix3 free_rotation_normal_to(const Matrix3& free_rotation, const Vecto
   return normal * free * normal;
 }
 
-inline Basis make_basis(const ParticleState& particles, const detail::Constraints& constraints) {
+template <class Particles>
+Basis make_basis(const Particles& particles, const detail::Constraints& constraints) {
   const std::size_t n = particles.size();
   Basis b;
   b.translation.resize(n);
@@ -327,8 +333,9 @@ inline std::vector<std::vector<int>> connected_parts(const std::vector<std::vect
 // about its centroid, scaled by its size) is left entirely free by the
 // kinematic conditions: equilibrium would not be unique and the relaxation
 // would drift for ever.
-inline void check_rigid_body_modes(const std::vector<std::vector<int>>& parts, const ParticleState& particles,
-                                   const Basis& basis) {
+template <class Particles>
+void check_rigid_body_modes(const std::vector<std::vector<int>>& parts, const Particles& particles,
+                            const Basis& basis) {
   for (const std::vector<int>& part : parts) {
     Vector3 centre = Vector3::Zero();
     for (int i : part) centre += particles.position[static_cast<std::size_t>(i)];
@@ -385,10 +392,9 @@ inline void check_rigid_body_modes(const std::vector<std::vector<int>>& parts, c
 // The Newton step K dq = r: a sparse LDLᵀ of the symmetric part when the
 // tangent is symmetric to finite-difference accuracy (conservative loads on
 // an elastic or path-dependent law), else a sparse LU; an Error when the
-// tangent is singular.
-inline Eigen::VectorXd newton_step(const Eigen::SparseMatrix<double>& K, const Eigen::VectorXd& r, int step,
-                                   double lambda) {
-  using SparseMatrix = Eigen::SparseMatrix<double>;
+// tangent is singular. (A template for the reason given above free_directions.)
+template <class SparseMatrix>
+Eigen::VectorXd newton_step(const SparseMatrix& K, const Eigen::VectorXd& r, int step, double lambda) {
   auto singular = [&] {
     return Error("sphshell: static solve: the tangent stiffness is singular at load step " + std::to_string(step + 1) +
                  " (load factor " + number_text(lambda) +
