@@ -153,6 +153,102 @@ void BM_stress_point_5_integral_points(benchmark::State& benchmark_state) {
   benchmark_state.SetItemsProcessed(benchmark_state.iterations() * points);
 }
 
+// Batched updates (update_lanes, material/lanes.hpp), N lanes per call; the
+// counter ns_per_lane is the time per call over N. Lane k follows the stream
+// from offset 37k (so the lanes differ), from the preloaded state scaled by
+// 1 + 0.3(k/(N−1) − ½) (all on the yield surface). `plastic_share` is the
+// share of lane updates that yielded.
+template <int N>
+std::vector<VoigtLanes<N>> lane_stream(const std::vector<StrainVoigt>& increments, bool alternate_sign) {
+  std::vector<VoigtLanes<N>> lanes(increments.size());
+  for (std::size_t i = 0; i < increments.size(); ++i)
+    for (int k = 0; k < N; ++k) {
+      const double sign = alternate_sign && i % 2 ? -1.0 : 1.0;
+      lanes[i].set(k, sign * increments[(i + 37 * std::size_t(k)) % increments.size()]);
+    }
+  return lanes;
+}
+
+double lane_scale(int k, int lanes) { return lanes == 1 ? 1.0 : 1.0 + 0.3 * (double(k) / (lanes - 1) - 0.5); }
+
+template <int N>
+void run_lanes(benchmark::State& benchmark_state, const J2Plasticity::Lanes<N>& start,
+               const std::vector<VoigtLanes<N>>& increments) {
+  J2Plasticity::Lanes<N> lanes = start;
+  std::size_t index = 0;
+  long plastic = 0;
+  for (auto _ : benchmark_state) {
+    plastic += j2_law.update_lanes(lanes, increments[index]);
+    benchmark::DoNotOptimize(lanes);
+    if (++index == increments.size()) {
+      index = 0;
+      lanes = start;
+    }
+  }
+  benchmark_state.SetItemsProcessed(benchmark_state.iterations() * N);
+  benchmark_state.counters["ns_per_lane"] =
+      benchmark::Counter(N * 1e-9, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  benchmark_state.counters["plastic_share"] = double(plastic) / (double(benchmark_state.iterations()) * N);
+}
+
+// Every lane yields at (nearly) every step: the closed-form return for all lanes.
+template <int N>
+void BM_j2_batched_plastic(benchmark::State& benchmark_state) {
+  J2Plasticity::Lanes<N> start;
+  for (int k = 0; k < N; ++k) start.set_state(k, preloaded(j2_law, lane_scale(k, N) * preload_strain));
+  run_lanes(benchmark_state, start, lane_stream<N>(stream, false));
+}
+
+// No lane yields: the elastic predictor and the yield check. The lanes start
+// inside the surface (half the preload) and the increments alternate in sign.
+template <int N>
+void BM_j2_batched_elastic(benchmark::State& benchmark_state) {
+  J2Plasticity::Lanes<N> start;
+  for (int k = 0; k < N; ++k) start.set_state(k, preloaded(j2_law, 0.5 * lane_scale(k, N) * preload_strain));
+  run_lanes(benchmark_state, start, lane_stream<N>(stream, true));
+}
+
+// BM_stress_point_5_integral_points through the batched update: the section's
+// states stay an array of State, copied into lanes and back around the call
+// (material::update_lanes), as a section loop that keeps its storage would do.
+void BM_stress_point_5_integral_points_batched(benchmark::State& benchmark_state) {
+  constexpr int points = 5;
+  constexpr double thickness = 0.01;
+  const std::array<double, points> zeta = {
+      -0.9061798459386640 * thickness / 2, -0.5384693101056831 * thickness / 2, 0.0,
+      0.5384693101056831 * thickness / 2, 0.9061798459386640 * thickness / 2};
+  std::vector<StrainVoigt> curvature_stream(stream.size());
+  for (std::size_t k = 0; k < stream.size(); ++k)
+    curvature_stream[k] = stream[(k + stream.size() / 2) % stream.size()] / (thickness / 2);
+  std::array<J2Plasticity::State, points> start;
+  for (int p = 0; p < points; ++p)
+    start[p] = preloaded(j2_law, preload_strain * (1.0 + 0.3 * zeta[p] / thickness));
+  std::array<J2Plasticity::State, points> states = start;
+  std::size_t index = 0;
+  for (auto _ : benchmark_state) {
+    VoigtLanes<points> d_eps;
+    for (int p = 0; p < points; ++p) d_eps.set(p, stream[index] + zeta[p] * curvature_stream[index]);
+    benchmark::DoNotOptimize(material::update_lanes(j2_law, states, d_eps));
+    benchmark::DoNotOptimize(states);
+    if (++index == stream.size()) {
+      index = 0;
+      states = start;
+    }
+  }
+  benchmark_state.SetItemsProcessed(benchmark_state.iterations() * points);
+}
+
+BENCHMARK_TEMPLATE(BM_j2_batched_plastic, 1);
+BENCHMARK_TEMPLATE(BM_j2_batched_plastic, 5);
+BENCHMARK_TEMPLATE(BM_j2_batched_plastic, 8);
+BENCHMARK_TEMPLATE(BM_j2_batched_plastic, 16);
+BENCHMARK_TEMPLATE(BM_j2_batched_plastic, 32);
+BENCHMARK_TEMPLATE(BM_j2_batched_elastic, 1);
+BENCHMARK_TEMPLATE(BM_j2_batched_elastic, 5);
+BENCHMARK_TEMPLATE(BM_j2_batched_elastic, 8);
+BENCHMARK_TEMPLATE(BM_j2_batched_elastic, 16);
+BENCHMARK_TEMPLATE(BM_j2_batched_elastic, 32);
+BENCHMARK(BM_stress_point_5_integral_points_batched);
 BENCHMARK(BM_elastic_update);
 BENCHMARK(BM_j2_closed_appendix_b);
 BENCHMARK(BM_j2_closed_zero_start);

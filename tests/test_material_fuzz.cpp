@@ -1,5 +1,6 @@
 // Random states and random strain increments: the invariants every return must
-// keep, and agreement of the closed-form and generic 3×3 return maps.
+// keep, agreement of the closed-form and generic 3×3 return maps, and of the
+// batched update (update_lanes) with the single-point one.
 
 #include <sphshell/material/all.hpp>
 
@@ -7,7 +8,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <array>
 #include <random>
+#include <string>
 
 using namespace sphshell;
 using namespace sphshell::material;
@@ -205,4 +208,109 @@ TEST_CASE("Fuzz: the closed form's fast path agrees with the kernel path", "[mat
     }
   }
   CHECK(fast_one_correction > 0);
+}
+
+// The batched update (lanes.hpp) against update(), lane by lane, over the fuzz
+// stream (states on or inside the surface, increments 1e-6..1e-2) and over a
+// stream of explicit-step increments (1e-7..1e-5, where the closed form's fast
+// path serves nearly every lane), in batches of 1, 5, 8 and 16 lanes. The two
+// run the same operations, so they should agree to the last bit or, where the
+// compiler contracts multiply-adds differently (-march with FMA), to round-off.
+template <int N>
+void check_lanes_against_update(double smallest_exponent, double largest_exponent, int draws) {
+  const J2Plasticity law({210e9, 0.3, 235e6, 1.5e9});
+  const Elastic elastic({210e9, 0.3});
+  Sampler sampler;
+  Worst stress_difference, strain_difference, elastic_difference;
+  int plastic = 0, reported_plastic = 0, fast = 0, unequal_bits = 0;
+  for (int batch = 0; batch < draws / N; ++batch) {
+    std::array<J2Plasticity::State, N> states;
+    std::array<Elastic::State, N> elastic_states;
+    VoigtLanes<N> d_eps;
+    for (int k = 0; k < N; ++k) {
+      J2Plasticity::State& state = states[std::size_t(k)];
+      state.eps_p = 0.3 * sampler.uniform(sampler.engine);
+      state.sigma_y = 235e6 + 1.5e9 * state.eps_p;
+      state.stress = sampler.stress_with_equivalent(state.sigma_y);
+      elastic_states[std::size_t(k)].stress = state.stress;
+      const double magnitude =
+          std::pow(10.0, smallest_exponent + (largest_exponent - smallest_exponent) * sampler.uniform(sampler.engine));
+      d_eps.set(k, magnitude * sampler.direction());
+    }
+    J2Plasticity::Lanes<N> lanes;
+    Elastic::Lanes<N> elastic_lanes;
+    for (int k = 0; k < N; ++k) {
+      lanes.set_state(k, states[std::size_t(k)]);
+      elastic_lanes.set_state(k, elastic_states[std::size_t(k)]);
+    }
+    reported_plastic += law.update_lanes(lanes, d_eps);
+    elastic.update_lanes(elastic_lanes, d_eps);
+    for (int k = 0; k < N; ++k) {
+      J2Plasticity::State single = states[std::size_t(k)];
+      const StrainVoigt increment = d_eps.at(k);
+      const StressVoigt trial = single.stress + law.elasticity().stress_increment(increment);
+      if (law.update(single, increment).plastic) {
+        ++plastic;
+        const double sum = trial.x() + trial.y(), diff = trial.x() - trial.y();
+        const double a = 0.25 * sum * sum, b = 0.75 * diff * diff + 3.0 * trial.z() * trial.z();
+        fast += return_map::detail::closed_form_lane(return_map::ClosedFormConstants(law.elasticity(), 1.5e9), sum,
+                                                     diff, trial.z(), a, b, std::sqrt(a + b),
+                                                     states[std::size_t(k)].sigma_y)
+                    .fast;
+      }
+      const J2Plasticity::State batched = lanes.state(k);
+      stress_difference.see((batched.stress - single.stress).norm() / single.sigma_y, batch * N + k);
+      strain_difference.see(std::abs(batched.eps_p - single.eps_p) / (single.eps_p + 235e6 / 210e9), batch * N + k);
+      if (!(batched.stress == single.stress && batched.eps_p == single.eps_p && batched.sigma_y == single.sigma_y))
+        ++unequal_bits;
+      Elastic::State elastic_single = elastic_states[std::size_t(k)];
+      elastic.update(elastic_single, increment);
+      elastic_difference.see((elastic_lanes.state(k).stress - elastic_single.stress).norm() / 235e6, batch * N + k);
+    }
+  }
+  CAPTURE(N, plastic, fast, unequal_bits, stress_difference.draw, strain_difference.draw);
+  INFO("largest differences: stress " << stress_difference.value << " of sigma_s, eps_p "
+                                      << strain_difference.value << ", elastic stress " << elastic_difference.value);
+  CHECK(reported_plastic == plastic);
+  CHECK(plastic > draws / 10);
+  CHECK(stress_difference.value <= 1e-14);
+  CHECK(strain_difference.value <= 1e-14);
+  CHECK(elastic_difference.value <= 1e-14);
+  // Without FMA contraction the operations are the same, hence bitwise equal.
+#if !defined(__FMA__)
+  CHECK(unequal_bits == 0);
+#endif
+  WARN("update_lanes<" << N << ">: " << plastic << " plastic lanes (" << fast << " on the fast path), "
+                       << unequal_bits << " not bitwise equal; largest stress difference "
+                       << stress_difference.value << " of sigma_s");
+}
+
+TEST_CASE("Fuzz: the batched update (update_lanes) agrees with update() lane by lane", "[material][fuzz]") {
+  // The fuzz stream: increments 1e-6..1e-2.
+  check_lanes_against_update<1>(-6.0, -2.0, 20000);
+  check_lanes_against_update<5>(-6.0, -2.0, 50000);
+  check_lanes_against_update<8>(-6.0, -2.0, 50000);
+  check_lanes_against_update<16>(-6.0, -2.0, 50000);
+  // Explicit-step increments: the fast path.
+  check_lanes_against_update<5>(-7.0, -5.0, 50000);
+  check_lanes_against_update<16>(-7.0, -5.0, 50000);
+}
+
+TEST_CASE("The batched update refuses a non-finite increment with update()'s message", "[material]") {
+  const J2Plasticity law({210e9, 0.3, 235e6, 1.5e9});
+  J2Plasticity::Lanes<5> lanes;
+  for (int k = 0; k < 5; ++k) lanes.set_state(k, law.initial_state());
+  VoigtLanes<5> d_eps;
+  d_eps.set(3, StrainVoigt(0.0, std::nan(""), 0.0));
+  J2Plasticity::State single = law.initial_state();
+  std::string expected;
+  try {
+    law.update(single, d_eps.at(3));
+  } catch (const Error& error) {
+    expected = error.what();
+  }
+  CHECK(!expected.empty());
+  CHECK_THROWS_WITH(law.update_lanes(lanes, d_eps), expected);
+  // Nothing changed.
+  for (int k = 0; k < 5; ++k) CHECK(lanes.state(k).stress == StressVoigt::Zero());
 }

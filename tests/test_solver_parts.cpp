@@ -6,10 +6,13 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 using namespace sphshell;
@@ -175,6 +178,107 @@ TEST_CASE("parallel::for_each rethrows the lowest failing index's error for any 
 #ifdef _OPENMP
   omp_set_num_threads(1);
 #endif
+}
+
+TEST_CASE("parallel::for_each visits every index once, nested and repeated, with any spin time", "[core][parallel]") {
+  const std::chrono::nanoseconds default_spin = parallel::spin_time();
+  CHECK(default_spin == std::chrono::microseconds(50));
+  for (std::chrono::nanoseconds spin : {std::chrono::nanoseconds(0), std::chrono::nanoseconds(20'000)}) {
+    parallel::set_spin_time(spin);
+    for (int threads : {1, 2, 3}) {
+#ifdef _OPENMP
+      omp_set_num_threads(threads);
+#endif
+      INFO(threads << " threads, spin " << spin.count() << " ns");
+      // Many short loops in a row (the team is woken and parked over and
+      // over), of sizes below, at and above a task's: each index once.
+      bool all_once = true;
+      for (int repeat = 0; repeat < 400; ++repeat) {
+        const std::size_t n = 1 + static_cast<std::size_t>(repeat * 37 % 1500);
+        std::vector<int> visits(n, 0);
+        parallel::for_each(std::size_t{0}, n, [&](std::size_t i) noexcept { ++visits[i]; });
+        for (int v : visits) all_once = all_once && v == 1;
+      }
+      CHECK(all_once);
+      // A loop started inside a body runs serially on that thread, and an
+      // index range that does not start at 0 is visited as given.
+      std::vector<long> inner_sums(200, 0);
+      parallel::for_each(100, 300, [&](int i) noexcept {
+        long sum = 0;
+        parallel::for_each(0, i, [&](int j) noexcept { sum += j; });
+        inner_sums[static_cast<std::size_t>(i - 100)] = sum;
+      });
+      bool sums_right = true;
+      for (int i = 100; i < 300; ++i) sums_right = sums_right && inner_sums[static_cast<std::size_t>(i - 100)] == long(i) * (i - 1) / 2;
+      CHECK(sums_right);
+    }
+  }
+  parallel::set_spin_time(default_spin);
+  CHECK_THROWS_AS(parallel::set_spin_time(std::chrono::nanoseconds(-1)), Error);
+  CHECK(parallel::spin_time() == default_spin);
+#ifdef _OPENMP
+  omp_set_num_threads(1);
+#endif
+}
+
+TEST_CASE("parallel::for_each gives each thread one contiguous block, not indices in turn", "[core][parallel]") {
+  // The cache affinity that makes two threads faster than one: the worker of a
+  // two-thread team runs one contiguous range of a loop (its block, less what
+  // the caller took from the block's back), whichever thread ran faster.
+#ifndef _OPENMP
+  SUCCEED("built without OpenMP: the loops run on one thread");
+#else
+  omp_set_num_threads(2);
+  constexpr std::size_t n = 20000;
+  std::vector<std::thread::id> runner(n);
+  std::vector<double> values(n, 1.0);
+  int loops_with_worker = 0;
+  bool contiguous = true;
+  for (int repeat = 0; repeat < 200; ++repeat) {
+    const std::thread::id caller = std::this_thread::get_id();
+    parallel::for_each(std::size_t{0}, n, [&](std::size_t i) noexcept {
+      double x = values[i];
+      for (int k = 0; k < 20; ++k) x = std::sqrt(x + 1.0);
+      values[i] = x;
+      runner[i] = std::this_thread::get_id();
+    });
+    std::size_t first = n, last = 0, count = 0;
+    for (std::size_t i = 0; i < n; ++i)
+      if (runner[i] != caller) {
+        first = std::min(first, i);
+        last = i;
+        ++count;
+      }
+    if (count == 0) continue;
+    ++loops_with_worker;
+    contiguous = contiguous && count == last - first + 1;
+  }
+  INFO("the worker joined " << loops_with_worker << " of 200 loops");
+  CHECK(loops_with_worker > 0);
+  CHECK(contiguous);
+  omp_set_num_threads(1);
+#endif
+}
+
+TEST_CASE("A plate's step is bitwise the same on 1, 2 and 3 threads", "[core][parallel]") {
+  std::vector<std::vector<Vector3>> positions, directors;
+  for (int threads : {1, 2, 3}) {
+#ifdef _OPENMP
+    omp_set_num_threads(threads);
+#endif
+    auto solver = loaded_plate<stepper::CentralDifference>();
+    solver.run_until(60 * solver.time_step());
+    positions.push_back(solver.positions());
+    directors.push_back(solver.directors());
+  }
+#ifdef _OPENMP
+  omp_set_num_threads(1);
+#endif
+  CHECK(positions[0][40].z() != 0.0);
+  for (std::size_t run = 1; run < positions.size(); ++run) {
+    CHECK(positions[run] == positions[0]);
+    CHECK(directors[run] == directors[0]);
+  }
 }
 
 TEST_CASE("Options are grouped by concern and still read as flat fields", "[solver][options]") {

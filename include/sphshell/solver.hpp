@@ -41,6 +41,7 @@
 #include <sphshell/solver/run_checks.hpp>
 #include <sphshell/solver/section_states.hpp>
 #include <sphshell/solver/stable_time_step.hpp>
+#include <sphshell/solver/static_solution.hpp>
 #include <sphshell/stepper/central_difference.hpp>
 #include <sphshell/stepper/stepper.hpp>
 #include <sphshell/thickness/section.hpp>
@@ -450,6 +451,54 @@ class Solver {
   }
   void run_until(double t_end) {
     run_until(t_end, [](const Solver&) {});
+  }
+
+  // Static equilibrium under the loads evaluated at parameters.load_time and
+  // scaled by each load factor in turn (solver/static_solution.hpp; docs/method.md,
+  // "Static solutions"). After it the solver holds the equilibrium at rest
+  // (velocities zero, energy books restarted at it) and can step on from there.
+  // observer(const solver::StaticIteration&) is called after every iteration.
+  // An Error (no convergence within the budget, a free rigid-body mode, bad
+  // parameters) leaves the solver as it was before the call.
+  template <class Observer>
+  solver::StaticResult solve_static(const solver::StaticParameters& parameters, Observer&& observer) {
+    if (!failure_.empty()) throw Error(failure_);
+    solver::validate(parameters);
+    const double load_time = std::isnan(parameters.load_time) ? time_ : parameters.load_time;
+    const solver::ParticleState start = particles_;
+    const solver::SectionStates<Rule, Material> start_states = states_;
+    solver::SectionStates<Rule, Material> converged = states_;
+    auto evaluate = [&](double load_factor) {
+      apply_loads({steps_, load_time});
+      for (std::size_t i = 0; i < particles_.size(); ++i) {
+        forces_.external[i] *= load_factor;
+        forces_.external_moment[i] *= load_factor;
+      }
+      assembler_.compute(now(), particles_, points_, states_, forces_);
+    };
+    auto save = [&] {
+      if constexpr (!solver::is_path_independent_v<Material>) converged = states_;
+    };
+    auto restore = [&] {
+      if constexpr (!solver::is_path_independent_v<Material>) states_ = converged;
+    };
+    solver::StaticSystem<Approx, decltype(evaluate), decltype(save), decltype(restore)> system{
+        model_, particles_, forces_, constraints_, points_, evaluate, save, restore,
+        options_.progress_stream};
+    try {
+      const solver::StaticResult result = solver::solve_static(system, parameters, observer);
+      forces_current_ = true;
+      ledger_.restart_at_rest(energy().elastic);
+      return result;
+    } catch (...) {
+      particles_ = start;
+      states_ = start_states;
+      compute_internal_forces();
+      throw;
+    }
+  }
+  solver::StaticResult solve_static(const solver::StaticParameters& parameters = {}) {
+    return solve_static(parameters, [](const solver::StaticIteration&) {});
   }
 
   double time() const { return time_; }

@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <sstream>
+#include <utility>
 #include <vector>
 
 namespace sphshell::approx {
@@ -141,10 +142,26 @@ class CellList {
         }
   }
 
-  // Throws naming the first pair of points closer than `tolerance`. Each point
-  // is compared with its own cell; the neighbouring cells are searched only
-  // for points within `tolerance` of a cell face, so this is nearly free.
+  // Throws naming the first pair of points closer than `tolerance`.
   void require_no_coincident_points(double tolerance, const std::string& set_name) const {
+    for_each_coincident_pair(tolerance, [&](int i, int j) { report_coincident(i, j, set_name); });
+  }
+
+  // Every pair (i < j) of points closer than `tolerance`, sorted, each once.
+  std::vector<std::pair<int, int>> coincident_pairs(double tolerance) const {
+    std::vector<std::pair<int, int>> pairs;
+    for_each_coincident_pair(tolerance, [&](int i, int j) { pairs.emplace_back(i, j); });
+    std::sort(pairs.begin(), pairs.end());
+    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+    return pairs;
+  }
+
+  // Calls visit(i, j), i < j, for each pair of points closer than `tolerance`
+  // (a pair near a cell face may come twice). Each point is compared with its
+  // own cell; the neighbouring cells are searched only for points within
+  // `tolerance` of a cell face, so this is nearly free.
+  template <class Visit>
+  void for_each_coincident_pair(double tolerance, Visit&& visit) const {
     const double tolerance_squared = tolerance * tolerance;
     for (std::size_t c = 0; c + 1 < cell_begin_.size(); ++c) {
       const auto begin = static_cast<std::size_t>(cell_begin_[c]);
@@ -153,12 +170,11 @@ class CellList {
         const Vector3& p = point_in_cell_[a];
         for (std::size_t b = a + 1; b < end; ++b)
           if ((point_in_cell_[b] - p).squaredNorm() <= tolerance_squared)
-            report_coincident(cell_points_[a], cell_points_[b], set_name);
+            visit(std::min(cell_points_[a], cell_points_[b]), std::max(cell_points_[a], cell_points_[b]));
         if (near_cell_face(p, tolerance)) {
           const int i = cell_points_[a];
           for_each_within(p, std::max(tolerance, 0.0) + 1e-300, [&](int j, double distance_squared) {
-            if (j != i && distance_squared <= tolerance_squared)
-              report_coincident(std::min(i, j), std::max(i, j), set_name);
+            if (j != i && distance_squared <= tolerance_squared) visit(std::min(i, j), std::max(i, j));
           });
         }
       }

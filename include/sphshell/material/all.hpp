@@ -3,6 +3,7 @@
 
 #include <sphshell/material/elastic.hpp>
 #include <sphshell/material/j2_plasticity.hpp>
+#include <sphshell/material/lanes.hpp>
 #include <sphshell/material/lemaitre_damage.hpp>
 #include <sphshell/material/material.hpp>
 #include <sphshell/material/return_map.hpp>

@@ -5,8 +5,11 @@
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/types.hpp>
+#include <sphshell/material/lanes.hpp>
 
+#include <array>
 #include <cmath>
+#include <cstddef>
 #include <sstream>
 
 namespace sphshell::material {
@@ -82,6 +85,8 @@ class PlaneStressElasticity {
   double youngs_modulus() const { return E_; }
   double poisson_ratio() const { return nu_; }
   double shear_modulus() const { return shear_modulus_; }
+  // E/(1 − ν²), the factor of Γ's normal block.
+  double biaxial_modulus() const { return biaxial_modulus_; }
 
   // Eigenvalues of ΓΞ along (1,1,0)/√2 and along (1,−1,0)/√2, (0,0,1): the
   // stiffness the return map sees against the volumetric-like and deviatoric
@@ -161,6 +166,31 @@ struct Elastic {
   // Same signature as the plastic laws so generic code can pass options to any law.
   UpdateResult update(State& state, const StrainVoigt& d_eps, const ReturnMapOptions&) const {
     return update(state, d_eps);
+  }
+
+  // N states in structure-of-arrays form, for update_lanes (lanes.hpp).
+  template <int N>
+  struct Lanes {
+    VoigtLanes<N> stress;
+    State state(int k) const { return State{stress.at(k)}; }
+    void set_state(int k, const State& s) { stress.set(k, s.stress); }
+  };
+  // update() of every lane at once; never yields, returns 0.
+  template <int N>
+  int update_lanes(Lanes<N>& lanes, const VoigtLanes<N>& d_eps) const {
+    alignas(64) std::array<double, std::size_t(N)> non_finite;  // NaN where an increment is not finite
+    for (std::size_t k = 0; k < std::size_t(N); ++k)
+      non_finite[k] = (d_eps.xx[k] - d_eps.xx[k]) + (d_eps.yy[k] - d_eps.yy[k]) + (d_eps.xy[k] - d_eps.xy[k]);
+    if (detail::any_lane(non_finite))
+      for (int k = 0; k < N; ++k) detail::require_finite_strain(d_eps.at(k));
+    const double biaxial = elasticity_.biaxial_modulus(), nu = elasticity_.poisson_ratio(),
+                 shear_modulus = elasticity_.shear_modulus();
+    for (std::size_t k = 0; k < std::size_t(N); ++k) {  // eq. (2.23), as in update()
+      lanes.stress.xx[k] += biaxial * (d_eps.xx[k] + nu * d_eps.yy[k]);
+      lanes.stress.yy[k] += biaxial * (nu * d_eps.xx[k] + d_eps.yy[k]);
+      lanes.stress.xy[k] += shear_modulus * d_eps.xy[k];
+    }
+    return 0;
   }
 
   const Parameters& parameters() const { return parameters_; }

@@ -514,6 +514,73 @@ inline Solution closed_form_default(const ClosedFormConstants& constants, const 
                   increment, 1};
 }
 
+// One lane of the batched return (lanes.hpp): closed_form_default's fast path,
+// operation for operation and in the same order, without its branches, for a
+// trial stress given by P* = σx+σy, Q* = σx−σy, s* = σxy, A, B and σ̄* = √(A+B)
+// (the caller takes the square roots of all lanes at once). `fast` is false
+// where closed_form_default would leave its fast path (trial on or inside the
+// surface, |ε₀| outside the series range, a step outside the bracket, the
+// reciprocals needing a division, or a residual above the tolerance); the
+// caller then solves that lane with closed_form, which takes the very same
+// route. Where `fast` is true, stress and increment are closed_form_default's.
+struct LaneReturn {
+  double xx, yy, xy;
+  double increment;
+  bool fast;
+};
+
+inline LaneReturn closed_form_lane(const ClosedFormConstants& constants, double sum, double diff, double shear,
+                                   double equibiaxial, double deviatoric, double trial_equivalent,
+                                   double yield_stress) {
+  const double trial_squared = equibiaxial + deviatoric;
+  const double excess = trial_equivalent - yield_stress;
+  const double slope_1 = constants.slope_1, slope_2 = constants.slope_2;
+  const double inverse_denominator = 1.0 / (slope_1 * equibiaxial + slope_2 * deviatoric);
+  const double scaled_trial_squared = trial_squared * inverse_denominator;
+  const double start = excess * scaled_trial_squared;
+  const double difference_scaled = constants.slope_difference * inverse_denominator * yield_stress;
+  const double u1 = difference_scaled * deviatoric + (slope_1 * scaled_trial_squared) * trial_equivalent;
+  const double u2 = (slope_2 * scaled_trial_squared) * trial_equivalent - difference_scaled * equibiaxial;
+  const double product = u1 * u2;
+  const double u1_squared = u1 * u1, u2_squared = u2 * u2;
+  const double m = product * product;
+  const double inverse_m = 1.0 / m;
+  const double twice_y = ((2.0 * slope_1 * equibiaxial) * u2) * u2_squared +
+                         ((2.0 * slope_2 * deviatoric) * u1) * u1_squared;
+  const double residual_0_numerator = equibiaxial * u2_squared + deviatoric * u1_squared - m;
+  const double residual_0 = residual_0_numerator * inverse_m;
+  const double lower_0 = std::min(excess * constants.inverse_max_slope, start);
+  const double upper_0 = std::max(excess * constants.inverse_min_slope, start);
+  const double lower = residual_0 > 0.0 ? start : lower_0;
+  const double upper = residual_0 > 0.0 ? upper_0 : start;
+  const double series_numerator =
+      (m * m + (0.75 * residual_0_numerator) * m) - 0.125 * residual_0_numerator * residual_0_numerator;
+  const double correction = ((residual_0_numerator * product) * series_numerator) / (twice_y * (m * m));
+  const double increment = start + correction;
+  const double sigma_s = yield_stress + constants.plastic_modulus * increment;
+  const double inverse_u1_start = (u2 * product) * inverse_m;
+  const double inverse_u2_start = (u1 * product) * inverse_m;
+  const double x1 = (slope_1 * inverse_u1_start) * correction;
+  const double x2 = (slope_2 * inverse_u2_start) * correction;
+  const double factor_1 = (1.0 - x1) * (1.0 + x1 * x1);
+  const double factor_2 = (1.0 - x2) * (1.0 + x2 * x2);
+  const double inverse_u1 = inverse_u1_start * factor_1, inverse_u2 = inverse_u2_start * factor_2;
+  const double residual_1 = (equibiaxial * inverse_u1 * inverse_u1 + deviatoric * inverse_u2 * inverse_u2) - 1.0;
+  const double half_sigma_s = 0.5 * sigma_s;
+  const double returned_half_sum = ((sum * half_sigma_s) * inverse_u1_start) * factor_1;
+  const double deviatoric_scale = sigma_s * inverse_u2_start;
+  const double returned_half_diff = ((0.5 * diff) * deviatoric_scale) * factor_2;
+  // The fast path's tests, as closed_form_default applies them (NaN fails
+  // each); `&`, not `&&`: all are evaluated, so the lane loop has no branch.
+  const bool fast = (excess > 0.0) & (std::abs(residual_0) > relative_tolerance) &
+                    (std::abs(residual_0) <= series_limit) &
+                    (upper - lower > 4.0 * std::numeric_limits<double>::epsilon() * upper) & (increment > lower) &
+                    (increment < upper) & (std::abs(x1) <= reciprocal_series_limit) &
+                    (std::abs(x2) <= reciprocal_series_limit) & (std::abs(residual_1) <= relative_tolerance);
+  return LaneReturn{returned_half_sum + returned_half_diff, returned_half_sum - returned_half_diff,
+                    (shear * deviatoric_scale) * factor_2, increment, fast};
+}
+
 }  // namespace detail
 
 inline Solution closed_form(const ClosedFormConstants& constants, const StressVoigt& trial,

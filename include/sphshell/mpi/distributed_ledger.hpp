@@ -107,11 +107,10 @@ class DistributedLedger {
   }
 
   // The books over all ranks, with the elastic energy held by this rank's
-  // owned points and the energy the fracture released (already global).
-  // Collective.
-  EnergyReport report(const Communicator& comm, const ExactSum& elastic, double released_by_fracture) const {
-    const std::array<double, 6> total =
-        sum_each<6>(comm, {&kinetic_, &internal_, &previous_internal_, &external_work_, &damping_work_, &elastic});
+  // owned points and the energy the fracture released at them. Collective.
+  EnergyReport report(const Communicator& comm, const ExactSum& elastic, const ExactSum& released) const {
+    const std::array<double, 7> total = sum_each<7>(
+        comm, {&kinetic_, &internal_, &previous_internal_, &external_work_, &damping_work_, &elastic, &released});
     EnergyReport report;
     report.kinetic = total[0];
     report.internal = total[1];
@@ -119,7 +118,7 @@ class DistributedLedger {
     report.plastic_dissipation = total[1] - total[5];
     report.external_work = total[3];
     report.damping_work = total[4];
-    report.released_by_fracture = released_by_fracture;
+    report.released_by_fracture = total[6];
     report.balance_ = total[0] + 0.5 * (total[2] + total[1]) + total[4] - total[3];
     return report;
   }

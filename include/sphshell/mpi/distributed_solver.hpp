@@ -24,12 +24,15 @@
 // (mpi/error_agreement.hpp): loads → velocities → conditions → books →
 // configuration → finite-state check ★ agreement (a load, a prescribed motion
 // or a particle that is not finite; global ids) → halo exchange → internal
-// forces ★ agreement (the failing point's global index) → books → balance
-// check (reduced books, decided alike on every rank). An Error on any rank
+// forces ★ agreement (the failing point's global index) → fracture → books →
+// balance check (reduced books, decided alike on every rank). An Error on any rank
 // therefore stops every rank with the same message.
 //
 // Particles, sets, loads and conditions are addressed by global ids or by the
-// model's set names; a rank applies them to the members it owns.
+// model's set names; a rank applies them to the members it owns. Cracks grow
+// across rank boundaries with the whole crack set on every rank
+// (mpi/distributed_fracture.hpp); frames are written in pieces and probes by
+// the owning rank (mpi/distributed_output.hpp).
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/parallel.hpp>
@@ -37,7 +40,9 @@
 #include <sphshell/crack/none.hpp>
 #include <sphshell/material/material.hpp>
 #include <sphshell/mpi/communicator.hpp>
+#include <sphshell/mpi/distributed_fracture.hpp>
 #include <sphshell/mpi/distributed_ledger.hpp>
+#include <sphshell/mpi/distributed_output.hpp>
 #include <sphshell/mpi/error_agreement.hpp>
 #include <sphshell/mpi/exact_sum.hpp>
 #include <sphshell/mpi/halo.hpp>
@@ -46,6 +51,7 @@
 #include <sphshell/solver.hpp>
 
 #include <chrono>
+#include <ctime>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -64,15 +70,12 @@ struct CommunicationCounters {
   std::size_t bytes_sent = 0;        // by this rank, all exchanges
   double exchange_seconds = 0.0;     // wall time inside the halo exchange
   double agreement_seconds = 0.0;    // wall time inside agreement points and reductions
+  double communication_cpu_seconds = 0.0;  // process CPU time inside both (MPI polls while it waits)
 };
 
 template <class Approx, class Rule, class Material, class Crack = crack::None,
           class Stepper = stepper::CentralDifference>
 class DistributedSolver {
-  static_assert(!Crack::enabled,
-                "mpi::DistributedSolver: fracture across ranks is not wired yet; use crack::None "
-                "(docs/distributed.md lists what is left)");
-
  public:
   using MaterialParameters = typename Material::Parameters;
   using Points = solver::IntegrationPoints<Approx>;
@@ -85,6 +88,7 @@ class DistributedSolver {
       : comm_(comm), model_(std::move(model)), law_(parameters), options_(std::move(options)) {
     collectively(comm_, [&] { set_up(weights); });
     halo_ = HaloPlan(comm_, layout_);
+    frames_ = DistributedFrames(comm_, options_.output());
   }
 
   // Conditions (shell/constraints.hpp) on a set of global particle ids or on a
@@ -219,6 +223,53 @@ class DistributedSolver {
     });
   }
 
+  // CSV history of one particle (global id; Solver::add_particle_probe's
+  // columns and schedule), written by the rank that owns it. Collective.
+  void add_particle_probe(const std::string& csv_path, int particle) {
+    collectively(comm_, [&] {
+      solver::checked_set({particle}, model_.particle_count());
+      for (const DistributedProbe& probe : probes_)
+        if (probe.path == csv_path)
+          throw Error("sphshell: probe file '" + csv_path + "' is already the file of another probe; give each probe "
+                      "a file of its own");
+      DistributedProbe probe{particle, csv_path, nullptr};
+      if (owns(particle)) {
+        probe.file = std::make_unique<io::CsvProbe>(csv_path, solver::ParticleProbe{particle}.columns());
+        probe.file->write_row(solver::ParticleProbe{particle}.row(OwnedView{*this}));
+      }
+      probes_.push_back(std::move(probe));
+    });
+  }
+  // One ParaView frame now (a piece per rank, a .pvtu, the .pvd series);
+  // needs output_directory. Collective.
+  void write_frame() {
+    FramePiece piece;
+    piece.time = time_;
+    const bool deformed = options_.frame_coordinates == FrameCoordinates::deformed;
+    for (std::size_t i = 0; i < layout_.owned_count(); ++i) {
+      piece.points.push_back(deformed ? particles_.position[i] : reference_position_[i]);
+      piece.global_id.push_back(layout_.owned[i]);
+      piece.displacement.push_back(particles_.position[i] - reference_position_[i]);
+      piece.velocity.push_back(particles_.velocity[i]);
+      piece.director.push_back(particles_.director[i]);
+      if constexpr (Crack::enabled) piece.fragment.push_back(fragment_flag(layout_.owned[i]));
+    }
+    frames_.write(comm_, piece, steps_);
+  }
+
+  // A pre-crack (Solver::add_precrack), on every rank alike (collective).
+  void add_precrack(const std::vector<Vector3>& polyline) {
+    static_assert(Crack::enabled, "add_precrack needs a crack policy: a solver with crack::None has no cracks; "
+                                  "use crack::LineSegments as the fourth parameter");
+    fracture_.add_precrack(polyline, fracture_parts());
+  }
+  // The crack topology, whole on every rank, and the fracture counters.
+  const Crack& crack() const { return fracture_.crack(); }
+  std::size_t damaged_stress_point_count() const { return fracture_.damaged_stress_point_count(); }
+  std::size_t precrack_stress_point_count() const { return fracture_.precrack_stress_point_count(); }
+  bool is_fragment(int particle) const { return fracture_.is_fragment(static_cast<std::size_t>(particle)); }
+  std::size_t fragment_count() const { return fracture_.fragment_count(); }
+
   // One step on every rank (collective). A step that stopped with an Error
   // leaves a half-updated state: later steps refuse with that error.
   void step() {
@@ -237,6 +288,7 @@ class DistributedSolver {
       solver::check_run_end(t_end, solver::RunPosition{time_, time_step_, steps_}, options_.max_steps_per_run);
     });
     while (time_ < t_end - 0.5 * time_step_) step();
+    if (frames_.writes_on_schedule() && frames_.last_frame_step() != steps_) write_frame();
   }
 
   double time() const { return time_; }
@@ -278,12 +330,13 @@ class DistributedSolver {
   // The energy books over all ranks (collective).
   EnergyReport energy() {
     const auto started = std::chrono::steady_clock::now();
+    const std::clock_t cpu = std::clock();
     ExactSum elastic;
     for (std::size_t p = 0; p < states_->size(); ++p)
       if (point_owned_[p] && states_->active(p))
         elastic.add(states_->stored_energy(p, points_->membrane_bending_weight(p), points_->shear_weight(p)));
-    const EnergyReport report = ledger_->report(comm_, elastic, 0.0);
-    counters_.agreement_seconds += seconds_since(started);
+    const EnergyReport report = ledger_->report(comm_, elastic, fracture_.released_energy());
+    count_agreement(started, cpu);
     return report;
   }
 
@@ -298,6 +351,7 @@ class DistributedSolver {
   }
 
   void set_up(const PartitionWeights& weights) {
+    detail::check_parts(comm_.size(), model_.particle_count());  // before rows that a tiny model cannot build
     validate(options_);
     using SectionState = typename thickness::Section<Rule, Material>::State;
     solver::check_memory<SectionState>(model_, options_);
@@ -346,6 +400,9 @@ class DistributedSolver {
     particles_.ranges = {0, owned, owned, local};
     forces_ = solver::ParticleForces(local);
     assembler_.emplace(options_.nonlinear, *points_);
+    fracture_.initialize(model_, all_points, layout_);
+    // Crack rebuilds run on the whole model's rows (fracture): kept only then.
+    if constexpr (Crack::enabled) all_points_.emplace(all_points);
     ledger_.emplace(options_.monitoring(), law_.youngs_modulus(), solver::shell_volume(model_));
   }
 
@@ -377,9 +434,18 @@ class DistributedSolver {
   }
 
   StepTime now() const { return {steps_, time_}; }
+  using FractureParts = DistributedFractureParts<Approx, Rule, Material>;
+  FractureParts fracture_parts() {
+    return FractureParts{comm_,      model_,     layout_, particles_, *all_points_, *points_,
+                         *states_,   *assembler_, forces_, point_owned_};
+  }
 
   void advance() {
     if (!forces_current_) compute_internal_forces();
+    if (steps_ == 0 && frames_.writes_on_schedule() && frames_.last_frame_step() < 0) {
+      write_frame();
+      frames_.schedule_next(time_ + options_.output_interval);
+    }
     const stepper::StepContext context{now(), time_step_, stepper_.velocity_step(steps_, time_step_),
                                        options_.damping};
     std::optional<Failure> failure;
@@ -396,16 +462,74 @@ class DistributedSolver {
     check_configuration(failure);
     agree(failure);
     compute_internal_forces();
+    if constexpr (Crack::enabled) fracture_.update(fracture_parts());
     if (solver::EnergyLedger::is_check_step(steps_)) {
       const EnergyReport report = energy();
       ledger_->check_balance(comm_, now(), report, [&](std::size_t i) { return layout_.global_of(i); });
     }
+    write_scheduled();
   }
+
+  // The serial schedule (solver::SolverOutput::write_scheduled).
+  void write_scheduled() {
+    if (frames_.writes_on_schedule() && time_ >= frames_.next_frame_time() - 0.5 * time_step_) {
+      if (frames_.last_frame_step() != steps_) write_frame();
+      const double interval = options_.output_interval;
+      const double passed = std::floor((time_ + 0.5 * time_step_ - frames_.next_frame_time()) / interval);
+      frames_.schedule_next(frames_.next_frame_time() + interval * (std::max(0.0, passed) + 1.0));
+    }
+    if (!probes_.empty() && time_ >= next_probe_time_ - probe_schedule_tolerance * time_step_) {
+      for (DistributedProbe& probe : probes_)
+        if (probe.file) probe.file->write_row(solver::ParticleProbe{probe.particle}.row(OwnedView{*this}));
+      next_probe_time_ = time_ + options_.probe_interval;
+    }
+  }
+
+  // What solver::ParticleProbe reads, for the particles owned here (global ids).
+  struct OwnedView {
+    const DistributedSolver& solver;
+    struct Field {
+      const std::vector<Vector3>& local;
+      const std::vector<int>& local_of;
+      const Vector3& operator[](int global) const { return local[static_cast<std::size_t>(local_of[global])]; }
+    };
+    double time() const { return solver.time_; }
+    Field velocities() const { return {solver.particles_.velocity, solver.layout_.local_of}; }
+    Vector3 displacement(int global) const {
+      const auto i = static_cast<std::size_t>(solver.layout_.local_of[global]);
+      return solver.particles_.position[i] - solver.reference_position_[i];
+    }
+    // Solver::rotation: the rotation vector taking the reference director to the current one.
+    Vector3 rotation(int global) const {
+      const auto i = static_cast<std::size_t>(solver.layout_.local_of[global]);
+      const Vector3& from = solver.reference_normal_[i];
+      const Vector3& to = solver.particles_.director[i];
+      const Vector3 axis = from.cross(to);
+      const double sine = axis.norm();
+      if (sine < negligible_rotation_sine) return Vector3::Zero();
+      return axis / sine * std::atan2(sine, from.dot(to));
+    }
+  };
+  bool owns(int global) const {
+    const int k = layout_.local_of[static_cast<std::size_t>(global)];
+    return k >= 0 && static_cast<std::size_t>(k) < layout_.owned_count();
+  }
+  double fragment_flag(int global) const { return fracture_.is_fragment(static_cast<std::size_t>(global)) ? 1 : 0; }
 
   void agree(const std::optional<Failure>& failure) {
     const auto started = std::chrono::steady_clock::now();
-    agree_on_failure(comm_, failure);
+    const std::clock_t cpu = std::clock();
+    try {
+      agree_on_failure(comm_, failure);
+    } catch (...) {
+      count_agreement(started, cpu);
+      throw;
+    }
+    count_agreement(started, cpu);
+  }
+  void count_agreement(std::chrono::steady_clock::time_point started, std::clock_t cpu) {
     counters_.agreement_seconds += seconds_since(started);
+    counters_.communication_cpu_seconds += static_cast<double>(std::clock() - cpu) / CLOCKS_PER_SEC;
   }
   long key(Phase phase, std::size_t global) const {
     return static_cast<long>(phase) * static_cast<long>(model_.particle_count() + 1) + static_cast<long>(global);
@@ -478,8 +602,10 @@ class DistributedSolver {
   // failing point stops every rank with its global index.
   void compute_internal_forces() {
     const auto started = std::chrono::steady_clock::now();
+    const std::clock_t cpu = std::clock();
     exchange_.exchange(comm_, halo_, {&particles_.position, &particles_.director});
     counters_.exchange_seconds += seconds_since(started);
+    counters_.communication_cpu_seconds += static_cast<double>(std::clock() - cpu) / CLOCKS_PER_SEC;
     ++counters_.exchanges;
     counters_.bytes_sent += halo_.bytes_sent(2);
     std::optional<Failure> failure;
@@ -506,17 +632,26 @@ class DistributedSolver {
   solver::ParticleState particles_;
   solver::Inertia inertia_;
   solver::ParticleForces forces_;
+  std::optional<Points> all_points_;  // the whole model's rows, with cracks only
   std::optional<Points> points_;
   std::optional<States> states_;
   std::vector<std::size_t> global_point_;  // per local point: its index in the whole model's numbering
   std::vector<char> point_owned_;          // per local point: owned here (books its work)
   std::optional<solver::InternalForceAssembler> assembler_;
   std::optional<DistributedLedger> ledger_;
+  DistributedFracture<Crack> fracture_;
   Stepper stepper_;
   sphshell::detail::Constraints constraints_;  // owned particles, local indices
   sphshell::detail::Constraints checker_;      // the whole sets, global ids: the Solver's checks and messages
   ExternalLoads loads_;
   CommunicationCounters counters_;
+  DistributedFrames frames_;
+  std::vector<DistributedProbe> probes_;
+  double next_probe_time_ = 0.0;
+  // As the Solver's: below this the reference and current directors are parallel.
+  static constexpr double negligible_rotation_sine = 1e-300;
+  // As the serial output's probe schedule (solver/output.hpp).
+  static constexpr double probe_schedule_tolerance = 1e-9;
   double stable_time_step_ = 0.0;
   double time_step_ = 0.0;
   double start_time_ = 0.0;

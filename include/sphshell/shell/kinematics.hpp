@@ -34,17 +34,32 @@ struct Strains {
   Vector2 shear;          // (γ1, γ2)
 };
 
+// The reference configuration's dot products in the Green strains: fixed for
+// a point (total Lagrangian), so a solver computes them once per point.
+struct ReferenceProducts {
+  double a1a1 = 0.0, a2a2 = 0.0, a1a2 = 0.0;              // A_α·A_β
+  double a1n1 = 0.0, a2n2 = 0.0, a1n2 = 0.0, a2n1 = 0.0;  // A_α·N_β
+  double a1n = 0.0, a2n = 0.0;                            // A_α·N
+};
+
+inline ReferenceProducts reference_products(const SurfaceGradients& r) {
+  return ReferenceProducts{r.a1.dot(r.a1), r.a2.dot(r.a2), r.a1.dot(r.a2), r.a1.dot(r.n1), r.a2.dot(r.n2),
+                           r.a1.dot(r.n2), r.a2.dot(r.n1), r.a1.dot(r.n),  r.a2.dot(r.n)};
+}
+
+// Green strains (nonlinear analysis), from the reference's products.
+inline Strains green_strains(const SurfaceGradients& g, const ReferenceProducts& r) {
+  Strains s;
+  s.membrane = StrainVoigt(0.5 * (g.a1.dot(g.a1) - r.a1a1), 0.5 * (g.a2.dot(g.a2) - r.a2a2), g.a1.dot(g.a2) - r.a1a2);
+  s.curvature = StrainVoigt(g.a1.dot(g.n1) - r.a1n1, g.a2.dot(g.n2) - r.a2n2,
+                            g.a1.dot(g.n2) + g.a2.dot(g.n1) - r.a1n2 - r.a2n1);
+  s.shear = Vector2(g.a1.dot(g.n) - r.a1n, g.a2.dot(g.n) - r.a2n);
+  return s;
+}
+
 // Green strains (nonlinear analysis).
 inline Strains green_strains(const SurfaceGradients& g, const SurfaceGradients& reference) {
-  const SurfaceGradients& r = reference;
-  Strains s;
-  s.membrane = StrainVoigt(0.5 * (g.a1.dot(g.a1) - r.a1.dot(r.a1)),
-                           0.5 * (g.a2.dot(g.a2) - r.a2.dot(r.a2)),
-                           g.a1.dot(g.a2) - r.a1.dot(r.a2));
-  s.curvature = StrainVoigt(g.a1.dot(g.n1) - r.a1.dot(r.n1), g.a2.dot(g.n2) - r.a2.dot(r.n2),
-                            g.a1.dot(g.n2) + g.a2.dot(g.n1) - r.a1.dot(r.n2) - r.a2.dot(r.n1));
-  s.shear = Vector2(g.a1.dot(g.n) - r.a1.dot(r.n), g.a2.dot(g.n) - r.a2.dot(r.n));
-  return s;
+  return green_strains(g, reference_products(reference));
 }
 
 // Small-strain, small-rotation strains: the first-order part of green_strains

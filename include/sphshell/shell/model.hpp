@@ -8,6 +8,7 @@
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/shell/cell.hpp>
+#include <sphshell/shell/cuts.hpp>
 #include <sphshell/shell/model_checks.hpp>
 
 #include <Eigen/Eigenvalues>
@@ -46,17 +47,8 @@ class ShellModel {
              std::vector<double> areas, std::vector<Vector3> stress_positions,
              std::vector<Vector3> stress_normals, std::vector<double> stress_areas,
              double thickness)
-      : particle_position(std::move(positions)),
-        particle_normal(std::move(normals)),
-        particle_area(std::move(areas)),
-        stress_point_position(std::move(stress_positions)),
-        stress_point_normal(std::move(stress_normals)),
-        stress_point_area(std::move(stress_areas)),
-        thickness_(thickness) {
-    validate();
-    particle_thickness_.assign(particle_position.size(), thickness_);
-    stress_point_thickness_.assign(stress_point_position.size(), thickness_);
-  }
+      : ShellModel(std::move(positions), std::move(normals), std::move(areas), std::move(stress_positions),
+                   std::move(stress_normals), std::move(stress_areas), thickness, {}) {}
 
   // Particles at the nodes of user quads, stress points at the quad centres
   // (positions and normals averaged), areas from the quads: each quad's area goes
@@ -106,11 +98,11 @@ class ShellModel {
       if (!(areas[i] > 0.0))
         detail::invalid_parameter("particle " + std::to_string(i), positions[i].transpose(),
                                   "belongs to no quad: every particle must be a corner of a quad");
+    std::vector<Cell> cells(quads.begin(), quads.end());
     ShellModel model(std::move(positions), std::move(normals), std::move(areas),
                      std::move(stress_positions), std::move(stress_normals),
-                     std::move(stress_areas), thickness);
+                     std::move(stress_areas), thickness, std::move(cells));
     model.quads_ = quads;
-    for (const Quad& quad : quads) model.cells_.emplace_back(quad);
     return model;
   }
 
@@ -166,8 +158,7 @@ class ShellModel {
       if (!(areas[i] > 0.0))
         detail::invalid_parameter("particle " + std::to_string(i), positions[i].transpose(), "belongs to no cell");
     ShellModel model(std::move(positions), std::move(normals), std::move(areas), std::move(centres),
-                     std::move(cell_normals), std::move(cell_areas), thickness);
-    model.cells_ = cells;
+                     std::move(cell_normals), std::move(cell_areas), thickness, cells);
     if (std::none_of(cells.begin(), cells.end(), [](const Cell& cell) { return cell.is_triangle(); }))
       for (const Cell& cell : cells) model.quads_.push_back({cell[0], cell[1], cell[2], cell[3]});
     return model;
@@ -276,6 +267,31 @@ class ShellModel {
     return std::sqrt(area_per_particle(p));
   }
 
+  // Cuts (shell/cuts.hpp, docs/method.md §6): a polyline on the mid-surface
+  // (reference coordinates) along which the shell is separated from the start,
+  // with any crack policy: particle pairs whose connecting segment crosses it
+  // do not interact. Use it for two edges of the model that touch without
+  // being joined: a slit (duplicated particles along it, one copy per face,
+  // e.g. from_quads with a slit), a cut-out, a seam left open. A polyline of
+  // fewer than 2 points or with a zero-length piece, a point off the shell, a
+  // cut through a stress point, through a particle that is neither duplicated
+  // nor at its end, or across a cell is an Error naming it. A cut that ends on
+  // an edge should go on half a spacing past it: near a concave edge a pair
+  // can otherwise see around its end through the hole.
+  void add_cut(std::vector<Vector3> polyline) {
+    shell::check_cut(polyline, cuts_.size(), cut_geometry());
+    cuts_.push_back(std::move(polyline));
+  }
+  const std::vector<std::vector<Vector3>>& cuts() const { return cuts_; }
+  // Near-coincident particles that share no cell (i < j): the faces of a slit,
+  // which a solver refuses unless a cut separates them.
+  const std::vector<std::pair<int, int>>& coincident_particles() const { return coincident_particles_; }
+  // What the cut checks and the solver's cut visibility read.
+  shell::CutGeometry cut_geometry() const {
+    return {particle_position, particle_normal, stress_point_position, stress_point_normal,
+            cells_,            coincident_particles_, maximum_spacing()};
+  }
+
   // Named particle sets, for boundary conditions, loads and probes.
   template <class Predicate>
   // A name in use (a builder's own set such as "boundary" too) is an Error:
@@ -335,6 +351,25 @@ class ShellModel {
  private:
   static constexpr double kPi = 3.14159265358979323846;
 
+  // The constructors' common path; `cells` are the model's cells (empty for
+  // the general constructor), known before the checks so that coincident
+  // particles of a slit (sharing no cell) can be told from a mistake.
+  ShellModel(std::vector<Vector3> positions, std::vector<Vector3> normals, std::vector<double> areas,
+             std::vector<Vector3> stress_positions, std::vector<Vector3> stress_normals,
+             std::vector<double> stress_areas, double thickness, std::vector<Cell> cells)
+      : particle_position(std::move(positions)),
+        particle_normal(std::move(normals)),
+        particle_area(std::move(areas)),
+        stress_point_position(std::move(stress_positions)),
+        stress_point_normal(std::move(stress_normals)),
+        stress_point_area(std::move(stress_areas)),
+        thickness_(thickness),
+        cells_(std::move(cells)) {
+    validate();
+    particle_thickness_.assign(particle_position.size(), thickness_);
+    stress_point_thickness_.assign(stress_point_position.size(), thickness_);
+  }
+
   // Particles at the nodes of an nu × nv parametric grid on [0,1]², stress points
   // at the cell centres; `periodic_u` closes the grid in u (a full tube).
   template <class Surface>
@@ -385,7 +420,7 @@ class ShellModel {
     detail::model_checks::check_area_sums(particle_area, stress_point_area);
     detail::model_checks::check_orientation(particle_position, particle_normal, stress_point_position,
                                             stress_point_normal, particle_area);
-    detail::model_checks::check_separation(particle_position, particle_area);
+    coincident_particles_ = detail::model_checks::check_separation(particle_position, particle_area, cells_);
   }
   static void normalize_all(const std::vector<Vector3>& positions, std::vector<Vector3>& normals,
                             const std::vector<double>& areas, const std::string& what) {
@@ -408,6 +443,8 @@ class ShellModel {
   std::vector<double> stress_point_thickness_;
   std::vector<Quad> quads_;
   std::vector<Cell> cells_;
+  std::vector<std::pair<int, int>> coincident_particles_;
+  std::vector<std::vector<Vector3>> cuts_;
   std::map<std::string, ParticleSet> sets_;
 };
 

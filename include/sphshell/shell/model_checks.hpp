@@ -22,6 +22,7 @@
 #include <sstream>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 namespace sphshell::detail::model_checks {
@@ -200,24 +201,46 @@ inline void check_orientation(const std::vector<Vector3>& particle_position, con
                                     ": neighbouring normals must share one orientation");
   }
 }
-// No two particles closer than coincident_spacing_fraction × √A_i.
-inline void check_separation(const std::vector<Vector3>& particle_position, const std::vector<double>& particle_area) {
+// Pairs of particles closer than coincident_spacing_fraction × √A_i. Such a
+// pair is an Error when the particles share a cell, or always in a model
+// without cells; pairs that share no cell are the two faces of a slit and are
+// returned (i < j, sorted): a cut must separate them (shell/cuts.hpp).
+inline std::vector<std::pair<int, int>> check_separation(const std::vector<Vector3>& particle_position,
+                                                         const std::vector<double>& particle_area,
+                                                         const std::vector<Cell>& cells) {
   // Cells about one (median) spacing wide: a few particles each (cells as
   // narrow as the tolerance would be mostly empty and slow to search).
   std::vector<double> spacing(particle_area.size());
   for (std::size_t i = 0; i < spacing.size(); ++i) spacing[i] = std::sqrt(particle_area[i]);
   const approx::CellList particles(particle_position, median(spacing));
+  std::vector<std::pair<int, int>> pairs;
   for (std::size_t i = 0; i < particle_position.size(); ++i) {
     const double limit = coincident_spacing_fraction * std::sqrt(particle_area[i]);
-    particles.for_each_within(particle_position[i], limit, [&](int j, double distance_squared) {
-      if (static_cast<std::size_t>(j) <= i) return;
-      detail::invalid_parameter(
-          "distance between particles " + std::to_string(i) + " and " + std::to_string(j),
-          std::sqrt(distance_squared),
-          "must be at least " + std::to_string(coincident_spacing_fraction) + " of the local spacing √A = " +
-              std::to_string(std::sqrt(particle_area[i])) + " m: near-coincident particles (merge them)");
+    particles.for_each_within(particle_position[i], limit, [&](int j, double) {
+      if (static_cast<std::size_t>(j) > i) pairs.emplace_back(static_cast<int>(i), j);
     });
   }
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  std::vector<std::vector<int>> cells_of(pairs.empty() ? 0 : particle_position.size());
+  for (std::size_t c = 0; c < cells.size() && !pairs.empty(); ++c)
+    for (int corner : cells[c]) cells_of[static_cast<std::size_t>(corner)].push_back(static_cast<int>(c));
+  for (const auto& [i, j] : pairs) {
+    bool share_a_cell = cells.empty();
+    for (int c : cells_of[static_cast<std::size_t>(i)])
+      share_a_cell = share_a_cell || std::find(cells[static_cast<std::size_t>(c)].begin(),
+                                               cells[static_cast<std::size_t>(c)].end(), j) !=
+                                         cells[static_cast<std::size_t>(c)].end();
+    if (!share_a_cell) continue;
+    const auto first = static_cast<std::size_t>(i);
+    detail::invalid_parameter(
+        "distance between particles " + std::to_string(i) + " and " + std::to_string(j),
+        (particle_position[first] - particle_position[static_cast<std::size_t>(j)]).norm(),
+        "must be at least " + std::to_string(coincident_spacing_fraction) + " of the local spacing √A = " +
+            std::to_string(std::sqrt(particle_area[first])) + " m: near-coincident particles (merge them)" +
+            (cells.empty() ? "" : "; only particles that share no cell (the faces of a slit) may coincide"));
+  }
+  return pairs;
 }
 inline void check_area_sums(const std::vector<double>& particle_area, const std::vector<double>& stress_point_area) {
   double particles = 0.0, stress_points = 0.0;

@@ -169,6 +169,11 @@ inline std::vector<NamedCount> model_fingerprints(const ShellModel& model) {
     cells.push_back(static_cast<int>(cell.size()));
     cells.insert(cells.end(), cell.begin(), cell.end());
   }
+  std::vector<double> cuts;  // each polyline's point count, then its coordinates
+  for (const std::vector<Vector3>& polyline : model.cuts()) {
+    cuts.push_back(static_cast<double>(polyline.size()));
+    for (const Vector3& point : polyline) cuts.insert(cuts.end(), point.data(), point.data() + 3);
+  }
   return {{"particle positions", fingerprint(model.particle_position)},
           {"particle normals", fingerprint(model.particle_normal)},
           {"particle areas", fingerprint(model.particle_area)},
@@ -177,7 +182,8 @@ inline std::vector<NamedCount> model_fingerprints(const ShellModel& model) {
           {"stress point normals", fingerprint(model.stress_point_normal)},
           {"stress point areas", fingerprint(model.stress_point_area)},
           {"stress point thicknesses", fingerprint(stress_thickness)},
-          {"cells", fingerprint(cells)}};
+          {"cells", fingerprint(cells)},
+          {"cuts", fingerprint(cuts)}};
 }
 
 // The law's constants through the material contract's members.

@@ -111,6 +111,16 @@ class EnergyLedger {
     for (double work : work_increments) internal_energy_ += work;
   }
 
+  // After a static solve (solver/static_solution.hpp): the shell at rest
+  // holding `elastic`, booked as work the loads did, so the balance of a run
+  // that follows starts at zero.
+  void restart_at_rest(double elastic) {
+    previous_internal_energy_ = internal_energy_ = elastic;
+    external_work_ = elastic;
+    damping_work_ = 0.0;
+    kinetic_energy_ = 0.0;
+  }
+
   // The books, with the elastic energy now held and the energy the fracture released.
   EnergyReport report(double elastic, double released_by_fracture) const {
     EnergyReport report;

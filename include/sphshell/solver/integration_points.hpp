@@ -15,10 +15,12 @@
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/shell/cell_shear.hpp>
+#include <sphshell/shell/cuts.hpp>
 #include <sphshell/shell/kinematics.hpp>
 #include <sphshell/shell/model.hpp>
 #include <sphshell/solver/local_spacing.hpp>
 #include <sphshell/solver/options.hpp>
+#include <sphshell/solver/particles.hpp>
 
 #include <algorithm>
 #include <array>
@@ -58,11 +60,14 @@ class IntegrationPoints {
       for (double local : spacing.particle) smoothing_length_[1].push_back(smoothing(local));
     for (const Vector3& normal : model.stress_point_normal) frames_[0].push_back(tangent_frame(normal));
     for (const Vector3& normal : model.particle_normal) frames_[1].push_back(tangent_frame(normal));
+    // The cut test looks for cut pieces within the largest row support (each
+    // row's own support lies within it).
+    cuts_ = shell::CutVisibility(model.cut_geometry(), model.cuts(), largest_support_radius());
     shape_[0] = Approx::build(model.particle_position, model.particle_area, model.stress_point_position,
-                              frames_[0], smoothing_length_[0]);
+                              frames_[0], smoothing_length_[0], cut_visibility(model, PointGroup::stress_points));
     if (particles_integrate)
       shape_[1] = Approx::build(model.particle_position, model.particle_area, model.particle_position,
-                                frames_[1], smoothing_length_[1]);
+                                frames_[1], smoothing_length_[1], cut_visibility(model, PointGroup::particles));
 
     // A row that fell back to the constant approximation has no gradient: the
     // support is too small for the spacing.
@@ -80,9 +85,10 @@ class IntegrationPoints {
     tie_shear(model, physics, shear_modulus);
     compute_weights(model, physics, particle_integration, shear_modulus, stress_points, particle_points);
     reference_.resize(size());
+    reference_products_.resize(size());
     for (PointGroup group : point_groups)
       for (std::size_t row = 0; row < count(group); ++row)
-        reference_[point(group, row)] = gather(group, row, model.particle_position, model.particle_normal);
+        set_reference(point(group, row), gather(group, row, model.particle_position, model.particle_normal));
     build_slot_transpose(model.particle_count());
     for (PointGroup group : point_groups) rebuilt_[index_of(group)].assign(count(group), 0);
   }
@@ -104,7 +110,6 @@ class IntegrationPoints {
       return j;
     };
     IntegrationPoints part;
-    part.smoothing_length_ = smoothing_length_;
     for (PointGroup group : point_groups) {
       const std::size_t g = index_of(group);
       const approx::ShapeFunctions& from = shape_[g];
@@ -120,6 +125,7 @@ class IntegrationPoints {
         to.row_begin.push_back(to.neighbour.size());
         to.row_size.push_back(from.row_size[row]);
         to.shepard.push_back(from.shepard[row]);
+        part.smoothing_length_[g].push_back(smoothing_length_[g][row]);
         part.frames_[g].push_back(frames_[g][row]);
         part.rebuilt_[g].push_back(rebuilt_[g][row]);
       }
@@ -132,6 +138,7 @@ class IntegrationPoints {
         part.membrane_bending_weight_.push_back(membrane_bending_weight_[p]);
         part.shear_weight_.push_back(shear_weight_[p]);
         part.reference_.push_back(reference_[p]);
+        part.reference_products_.push_back(reference_products_[p]);
       }
     if (!shear_tying_.empty())
       for (std::size_t row : rows[0]) {
@@ -143,6 +150,35 @@ class IntegrationPoints {
     part.build_slot_transpose(local_count);
     return part;
   }
+  // A subset's row set to a row of the whole model's points after a crack
+  // rebuilt it there (rebuilds sort by global particle index, so they run on
+  // the whole model's rows): every slot, the reference gradients and the flag,
+  // neighbours renumbered by local_of. The capacities must agree.
+  void copy_row(PointGroup group, std::size_t row, const IntegrationPoints& from, std::size_t from_row,
+                const std::vector<int>& local_of) {
+    const std::size_t g = index_of(group);
+    approx::ShapeFunctions& to = shape_[g];
+    const approx::ShapeFunctions& source = from.shape_[g];
+    if (to.capacity(row) != source.capacity(from_row))
+      detail::invalid_parameter(std::string("capacity of ") + name_of(group) + " row " + std::to_string(from_row),
+                                to.capacity(row), "must equal the source row's " + std::to_string(source.capacity(from_row)));
+    for (std::size_t k = 0; k < to.capacity(row); ++k) {
+      const std::size_t s = to.row_begin[row] + k, t = source.row_begin[from_row] + k;
+      to.neighbour[s] = local_of.at(static_cast<std::size_t>(source.neighbour[t]));
+      if (to.neighbour[s] < 0)
+        detail::invalid_parameter(std::string("particle of ") + name_of(group) + " row " + std::to_string(from_row),
+                                  source.neighbour[t], "is not local to the subset (its rows need it)");
+      to.phi[s] = source.phi[t];
+      to.dphi_d1[s] = source.dphi_d1[t];
+      to.dphi_d2[s] = source.dphi_d2[t];
+    }
+    to.row_size[row] = source.row_size[from_row];
+    to.shepard[row] = source.shepard[from_row];
+    reference_[point(group, row)] = from.reference_[from.point(group, from_row)];
+    reference_products_[point(group, row)] = from.reference_products_[from.point(group, from_row)];
+    mark_rebuilt(group, row);
+  }
+
   // The row of the whole model a row stands for (itself but in a subset).
   std::size_t global_row(PointGroup group, std::size_t row) const {
     const std::vector<std::size_t>& rows = global_row_[index_of(group)];
@@ -178,6 +214,8 @@ class IntegrationPoints {
       for (double h : lengths) largest = std::max(largest, h);
     return largest * Approx::kernel_type::support_radius_factor;
   }
+  // The model's cuts, as the rows see them.
+  const shell::CutVisibility& cuts() const { return cuts_; }
 
   // Weights: the area share for membrane and bending; area × κs G d (softened
   // at particles) for transverse shear.
@@ -190,6 +228,8 @@ class IntegrationPoints {
   }
   const shell::CellShearTying& shear_tying(std::size_t row) const { return shear_tying_[row]; }
   const shell::SurfaceGradients& reference(std::size_t p) const { return reference_[p]; }
+  // Its dot products in the Green strains (shell::green_strains).
+  const shell::ReferenceProducts& reference_products(std::size_t p) const { return reference_products_[p]; }
 
   // Interpolated a1, a2, n, n1, n2 of one row from particle positions x and directors d.
   shell::SurfaceGradients gather(PointGroup group, std::size_t row, const std::vector<Vector3>& x,
@@ -208,16 +248,34 @@ class IntegrationPoints {
     return g;
   }
 
+  // The same from the packed positions and directors (solver/particles.hpp).
+  shell::SurfaceGradients gather(PointGroup group, std::size_t row, const std::vector<PackedKinematics>& packed) const {
+    const approx::ShapeFunctions& sf = shape(group);
+    shell::SurfaceGradients g;
+    const std::size_t end = sf.row_begin[row] + sf.row_size[row];
+    for (std::size_t s = sf.row_begin[row]; s < end; ++s) {
+      const PackedKinematics& particle = packed[std::size_t(sf.neighbour[s])];
+      g.a1 += sf.dphi_d1[s] * particle.position;
+      g.a2 += sf.dphi_d2[s] * particle.position;
+      g.n += sf.phi[s] * particle.director;
+      g.n1 += sf.dphi_d1[s] * particle.director;
+      g.n2 += sf.dphi_d2[s] * particle.director;
+    }
+    return g;
+  }
+
   // Recomputes one row with a visibility predicate visible(row, particle)
-  // (after a crack), and its reference gradients. Throws Error when nothing
-  // stays visible.
+  // (after a crack), and its reference gradients; the model's cuts keep
+  // hiding what they hide. Throws Error when nothing stays visible.
   template <class Visible>
   void rebuild_row(const ShellModel& model, PointGroup group, std::size_t row, Visible&& visible) {
     // Flagged first: a rebuild that throws (nothing visible) leaves its row changed too.
     mark_rebuilt(group, row);
+    const auto cut_visible = cut_visibility(model, group);
+    const auto both = [&](std::size_t r, std::size_t j) { return cut_visible(r, j) && visible(r, j); };
     Approx::rebuild_row(shape_[index_of(group)], row, model.particle_position, model.particle_area,
-                        positions(model, group)[row], frame(group, row), smoothing_length(group, row), visible);
-    reference_[point(group, row)] = gather(group, row, model.particle_position, model.particle_normal);
+                        positions(model, group)[row], frame(group, row), smoothing_length(group, row), both);
+    set_reference(point(group, row), gather(group, row, model.particle_position, model.particle_normal));
   }
 
   // Checkpoints (solver/checkpoint.hpp): the rows cracks rebuilt, whole (all
@@ -276,8 +334,9 @@ class IntegrationPoints {
             in.fail(std::string(name_of(group)) + " row " + std::to_string(row) + " names particle " +
                     std::to_string(sf.neighbour[s]));
         }
-        shell::SurfaceGradients& g = reference_[point(group, row)];
+        shell::SurfaceGradients g;
         in(g.a1, g.a2, g.n, g.n1, g.n2);
+        set_reference(point(group, row), g);
         rebuilt[row] = 1;
       }
     }
@@ -292,6 +351,18 @@ class IntegrationPoints {
   const std::vector<std::size_t>& particle_slot_begin() const { return particle_slot_begin_; }
   const std::vector<std::size_t>& particle_slots() const { return particle_slots_; }
 
+  // The same slots in the same order, each with what a particle needs to add
+  // its force from the point's conjugate forces (InternalForceAssembler): the
+  // point, the slot's shape-function values, and which corner of the point's
+  // edge-tied cell the particle is (−1: none). Contiguous per particle, so the
+  // per-particle sum streams through them.
+  struct ForceEntry {
+    std::uint32_t point;
+    std::int32_t corner;
+    double phi, dphi_d1, dphi_d2;
+  };
+  const std::vector<ForceEntry>& force_entries() const { return force_entries_; }
+
   // Maps every particle to the shape-function slots that reference it, so the
   // force gather is a deterministic per-particle sum (no atomics, identical
   // results for any thread count). Rows keep their capacity when cracks shrink
@@ -299,23 +370,51 @@ class IntegrationPoints {
   void build_slot_transpose(std::size_t particle_count) {
     slot_offset_ = {0, shape_[0].neighbour.size()};
     std::vector<std::size_t> count_of(particle_count + 1, 0);
-    auto for_each_slot = [&](auto&& visit) {
-      for (PointGroup group : point_groups) {
-        const approx::ShapeFunctions& sf = shape(group);
-        for (std::size_t row = 0; row < count(group); ++row)
-          for (std::size_t s = sf.row_begin[row]; s < sf.row_begin[row] + sf.row_size[row]; ++s)
-            visit(sf.neighbour[s], slot(group, s));
-      }
-    };
-    for_each_slot([&](int particle, std::size_t) { ++count_of[particle + 1]; });
+    for (PointGroup group : point_groups) {
+      const approx::ShapeFunctions& sf = shape(group);
+      for (std::size_t row = 0; row < count(group); ++row)
+        for (std::size_t s = sf.row_begin[row]; s < sf.row_begin[row] + sf.row_size[row]; ++s)
+          ++count_of[std::size_t(sf.neighbour[s]) + 1];
+    }
     for (std::size_t i = 1; i < count_of.size(); ++i) count_of[i] += count_of[i - 1];
     particle_slot_begin_ = count_of;
     particle_slots_.resize(count_of.back());
-    for_each_slot([&](int particle, std::size_t s) { particle_slots_[count_of[particle]++] = s; });
+    force_entries_.resize(count_of.back());
+    for (PointGroup group : point_groups) {
+      const approx::ShapeFunctions& sf = shape(group);
+      for (std::size_t row = 0; row < count(group); ++row) {
+        const bool tied = shear_tied(group, row);
+        for (std::size_t s = sf.row_begin[row]; s < sf.row_begin[row] + sf.row_size[row]; ++s) {
+          const int particle = sf.neighbour[s];
+          std::int32_t corner = -1;
+          for (int k = 0; tied && k < shear_tying_[row].corners; ++k)
+            if (shear_tying_[row].particle[std::size_t(k)] == particle) corner = k;
+          const std::size_t k = count_of[particle]++;
+          particle_slots_[k] = slot(group, s);
+          force_entries_[k] = ForceEntry{static_cast<std::uint32_t>(point(group, row)), corner, sf.phi[s],
+                                         sf.dphi_d1[s], sf.dphi_d2[s]};
+        }
+      }
+    }
   }
 
  private:
   IntegrationPoints() = default;  // subset() fills it
+
+  void set_reference(std::size_t p, const shell::SurfaceGradients& g) {
+    reference_[p] = g;
+    reference_products_[p] = shell::reference_products(g);
+  }
+
+  // The cuts' visibility predicate of a group's rows (shell/cuts.hpp): a
+  // particle evaluation point stands where its particle does in the cut test.
+  auto cut_visibility(const ShellModel& model, PointGroup group) const {
+    return [this, &model, group](std::size_t row, std::size_t j) {
+      if (cuts_.empty()) return true;
+      const Vector3& x = group == PointGroup::particles ? cuts_.side_point(row) : model.stress_point_position[row];
+      return cuts_.visible(x, cuts_.side_point(j), frame(group, row));
+    };
+  }
 
   // Rows are rebuilt in parallel: each sets its own flag, in an array sized
   // by the constructor (never resized here).
@@ -377,6 +476,7 @@ class IntegrationPoints {
   }
 
   std::array<std::vector<double>, 2> smoothing_length_;  // h_i per row of each group
+  shell::CutVisibility cuts_;  // the model's cuts
   std::vector<shell::CellShearTying> shear_tying_;  // per stress point, or empty
   std::array<approx::ShapeFunctions, 2> shape_;
   std::array<std::vector<TangentFrame>, 2> frames_;  // evaluation frames, kept for rebuilds
@@ -384,7 +484,9 @@ class IntegrationPoints {
   std::array<std::size_t, 2> slot_offset_{};
   std::vector<double> membrane_bending_weight_, shear_weight_;
   std::vector<shell::SurfaceGradients> reference_;
+  std::vector<shell::ReferenceProducts> reference_products_;
   std::vector<std::size_t> particle_slot_begin_, particle_slots_;
+  std::vector<ForceEntry> force_entries_;  // per particle, in particle_slots_ order
   std::array<std::vector<unsigned char>, 2> rebuilt_;  // per row: changed by a crack since construction
   std::array<std::vector<std::size_t>, 2> global_row_;  // a subset's global rows (empty: the whole model)
 };

@@ -2,11 +2,14 @@
 // The internal-force assembler: the one hot loop of a step. For every active
 // integration point: gather a1, a2, n, n1, n2 from its neighbours → strains
 // (Green or linear, shell/kinematics.hpp) → material update through the
-// thickness (Section) → resultants → the conjugate forces scattered to the
-// point's shape-function slots; then each particle sums the slots that refer to
-// it, in a fixed order (the deterministic sum: no atomics, identical results
-// for any thread count). The work of each point over the step is kept for the
-// energy ledger.
+// thickness (Section) → resultants → the point's five conjugate forces (and
+// the corner forces of its edge-tied shear) kept per point; then each particle
+// sums, over the shape-function slots that refer to it and in a fixed order
+// (IntegrationPoints::force_entries), the slot's share of its point's forces
+// (the deterministic sum: no atomics, identical results for any thread
+// count). The per-slot forces are formed where they are added, so no array of
+// them is written and read back. The work of each point over the step is kept
+// for the energy ledger.
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/parallel.hpp>
@@ -40,6 +43,10 @@ class InternalForceAssembler {
   void compute(const StepTime& at, const ParticleState& particles, const IntegrationPoints<Approx>& points,
                SectionStates<Rule, Law>& states, ParticleForces& forces) {
     prepare(points);
+    packed_.resize(particles.size());
+    parallel::for_each(std::size_t{0}, particles.size(), [&](std::size_t i) noexcept {
+      packed_[i] = PackedKinematics{particles.position[i], particles.director[i]};
+    });
     for (PointGroup group : point_groups)
       parallel::for_each(
           std::size_t{0}, points.count(group),
@@ -53,10 +60,11 @@ class InternalForceAssembler {
     sum_particle_forces(points, forces);
   }
 
-  // Forces of one point's stored resultants on the slots of its row (no
-  // material update), from the current surface gradients, plus the forces of
+  // Forces of one point's stored resultants (no material update), from the
+  // current surface gradients, kept as its conjugate forces, plus the forces of
   // its edge-tied shear from the particles' configuration. Returns the tied
-  // shear's elastic energy (0 for a point whose shear is not tied).
+  // shear's elastic energy (0 for a point whose shear is not tied, or whose
+  // cell has a corner outside its row).
   template <class Approx, class Rule, class Law>
   double scatter_point(PointGroup group, std::size_t row, const shell::SurfaceGradients& current,
                        const ParticleState& particles, const IntegrationPoints<Approx>& points,
@@ -65,37 +73,49 @@ class InternalForceAssembler {
     const double w = points.membrane_bending_weight(p);
     const shell::WeightedStresses weighted{w * states.membrane_force(p), w * states.bending_moment(p),
                                            states.shear_force(p)};
-    const shell::ConjugateForces f = shell::conjugate_forces(nonlinear_ ? current : points.reference(p), weighted);
-    const approx::ShapeFunctions& shape = points.shape(group);
-    const std::size_t end = shape.row_begin[row] + shape.row_size[row];
-    for (std::size_t s = shape.row_begin[row]; s < end; ++s) {
-      const std::size_t slot = points.slot(group, s);
-      slot_force_[slot] = shape.dphi_d1[s] * f.a1 + shape.dphi_d2[s] * f.a2;
-      slot_director_force_[slot] = shape.phi[s] * f.n + shape.dphi_d1[s] * f.n1 + shape.dphi_d2[s] * f.n2;
-    }
-    return points.shear_tied(group, row) ? scatter_tied_shear(row, particles, points) : 0.0;
+    conjugate_[p] = shell::conjugate_forces(nonlinear_ ? current : points.reference(p), weighted);
+    cleared_[p] = 0;
+    tied_active_[p] = 0;
+    return points.shear_tied(group, row) ? tied_shear(row, p, particles, points) : 0.0;
   }
 
-  // Zeroes the forces a point left on the slots of its row (a removed point).
+  // Zeroes the forces a point leaves on the slots of its row (a removed point).
   template <class Approx>
   void clear_slots(PointGroup group, std::size_t row, const IntegrationPoints<Approx>& points) {
-    const approx::ShapeFunctions& shape = points.shape(group);
-    for (std::size_t s = shape.row_begin[row]; s < shape.row_begin[row + 1]; ++s) {
-      slot_force_[points.slot(group, s)].setZero();
-      slot_director_force_[points.slot(group, s)].setZero();
-    }
+    const std::size_t p = points.point(group, row);
+    cleared_[p] = 1;
+    tied_active_[p] = 0;
   }
 
-  // Deterministic per-particle sums of the slot forces.
+  // Deterministic per-particle sums: for each slot that refers to the particle,
+  // in the order of IntegrationPoints::force_entries, the slot's force
+  // ∂Φ/∂X1 F_a1 + ∂Φ/∂X2 F_a2 (director: Φ F_n + ∂Φ/∂X1 F_n1 + ∂Φ/∂X2 F_n2) of its
+  // point, plus the tied shear's force on that corner, is added. A removed
+  // point adds zero vectors.
   template <class Approx>
   void sum_particle_forces(const IntegrationPoints<Approx>& points, ParticleForces& forces) const {
     const std::vector<std::size_t>& begin = points.particle_slot_begin();
-    const std::vector<std::size_t>& slots = points.particle_slots();
+    const auto& entries = points.force_entries();
     parallel::for_each(std::size_t{0}, forces.internal.size(), [&](std::size_t i) noexcept {
       Vector3 force = Vector3::Zero(), director_force = Vector3::Zero();
       for (std::size_t k = begin[i]; k < begin[i + 1]; ++k) {
-        force += slot_force_[slots[k]];
-        director_force += slot_director_force_[slots[k]];
+        const auto& entry = entries[k];
+        const std::size_t p = entry.point;
+        if (cleared_[p]) {
+          force += Vector3::Zero();
+          director_force += Vector3::Zero();
+          continue;
+        }
+        const shell::ConjugateForces& f = conjugate_[p];
+        Vector3 slot_force = entry.dphi_d1 * f.a1 + entry.dphi_d2 * f.a2;
+        Vector3 slot_director_force = entry.phi * f.n + entry.dphi_d1 * f.n1 + entry.dphi_d2 * f.n2;
+        if (entry.corner >= 0 && tied_active_[p]) {
+          const TiedShearForces& tied = tied_forces_[p];
+          slot_force += tied.force[std::size_t(entry.corner)];
+          slot_director_force += tied.director_force[std::size_t(entry.corner)];
+        }
+        force += slot_force;
+        director_force += slot_director_force;
       }
       forces.internal[i] = force;
       forces.internal_director[i] = director_force;
@@ -114,15 +134,32 @@ class InternalForceAssembler {
   shell::Strains strains_of(const shell::SurfaceGradients& current, const shell::SurfaceGradients& reference) const {
     return nonlinear_ ? shell::green_strains(current, reference) : shell::linear_strains(current, reference);
   }
+  // The same for point p, with its precomputed reference products (the same numbers).
+  template <class Approx>
+  shell::Strains strains_of(const shell::SurfaceGradients& current, const IntegrationPoints<Approx>& points,
+                            std::size_t p) const {
+    return nonlinear_ ? shell::green_strains(current, points.reference_products(p))
+                      : shell::linear_strains(current, points.reference(p));
+  }
 
  private:
-  // Slot arrays are sized once (rows keep their capacity when cracks shrink
-  // them); the work is zero for points that do not integrate.
+  // A stress point's edge-tied shear forces on its cell's corners.
+  struct TiedShearForces {
+    std::array<Vector3, shell::max_cell_corners> force, director_force;
+  };
+
+  // Per-point arrays are sized once; the work is zero for points that do not integrate.
   template <class Approx>
   void prepare(const IntegrationPoints<Approx>& points) {
-    if (slot_force_.size() != points.slot_count()) {
-      slot_force_.assign(points.slot_count(), Vector3::Zero());
-      slot_director_force_.assign(points.slot_count(), Vector3::Zero());
+    if (conjugate_.size() != points.size()) {
+      const Vector3 zero = Vector3::Zero();
+      conjugate_.assign(points.size(), shell::ConjugateForces{zero, zero, zero, zero, zero});
+      cleared_.assign(points.size(), 1);
+      tied_active_.assign(points.size(), 0);
+      TiedShearForces none;
+      none.force.fill(zero);
+      none.director_force.fill(zero);
+      tied_forces_.assign(points.count(PointGroup::stress_points), none);
     }
     work_increment_.assign(points.size(), 0.0);
   }
@@ -132,8 +169,8 @@ class InternalForceAssembler {
                        const IntegrationPoints<Approx>& points, SectionStates<Rule, Law>& states) {
     const std::size_t p = points.point(group, row);
     if (!states.active(p)) return;
-    const shell::SurfaceGradients current = points.gather(group, row, particles.position, particles.director);
-    const shell::Strains strains = strains_of(current, points.reference(p));
+    const shell::SurfaceGradients current = points.gather(group, row, packed_);
+    const shell::Strains strains = strains_of(current, points, p);
     const StrainVoigt d_membrane = strains.membrane - states.membrane_strain(p);
     const StrainVoigt d_curvature = strains.curvature - states.curvature(p);
     const Vector2 d_shear = strains.shear - states.shear_strain(p);
@@ -158,33 +195,40 @@ class InternalForceAssembler {
     states.tied_shear_energy(p) = tied_energy;
   }
 
-  // Adds the forces of a stress point's edge-tied shear (shell/cell_shear.hpp)
-  // to the slots of its cell's corners in its row; returns its energy. A corner
-  // hidden from the point by a crack leaves the cell's shear out (energy 0).
+  // The forces of a stress point's edge-tied shear (shell/cell_shear.hpp) on
+  // its cell's corners, kept for the per-particle sums; returns its energy. A
+  // corner hidden from the point by a crack leaves the cell's shear out (energy 0).
   template <class Approx>
-  double scatter_tied_shear(std::size_t row, const ParticleState& particles, const IntegrationPoints<Approx>& points) {
+  double tied_shear(std::size_t row, std::size_t p, const ParticleState& particles,
+                    const IntegrationPoints<Approx>& points) {
     const shell::CellShearTying& tying = points.shear_tying(row);
     const approx::ShapeFunctions& shape = points.shape(PointGroup::stress_points);
     const std::size_t begin = shape.row_begin[row], end = begin + shape.row_size[row];
-    std::array<std::size_t, shell::max_cell_corners> corner_slot{};
     for (int k = 0; k < tying.corners; ++k) {
       std::size_t s = begin;
-      while (s < end && shape.neighbour[s] != tying.particle[k]) ++s;
+      while (s < end && shape.neighbour[s] != tying.particle[std::size_t(k)]) ++s;
       if (s == end) return 0.0;
-      corner_slot[k] = points.slot(PointGroup::stress_points, s);
     }
     const shell::CellShearForces f = shell::cell_shear_forces(tying, particles.position, particles.director, nonlinear_);
+    TiedShearForces& tied = tied_forces_[row];
     for (int k = 0; k < tying.corners; ++k) {
-      slot_force_[corner_slot[k]] += f.force[k];
-      slot_director_force_[corner_slot[k]] += f.director_force[k];
+      tied.force[std::size_t(k)] = f.force[std::size_t(k)];
+      tied.director_force[std::size_t(k)] = f.director_force[std::size_t(k)];
     }
+    tied_active_[p] = 1;
     return f.energy;
   }
 
   bool nonlinear_;
   std::size_t failed_point_ = 0;
-  std::vector<Vector3> slot_force_, slot_director_force_;
+  // Per point: its conjugate forces, whether it was removed (its slots then
+  // carry zero forces), whether its tied shear acts, and (stress points) the
+  // tied shear's corner forces.
+  std::vector<shell::ConjugateForces> conjugate_;
+  std::vector<unsigned char> cleared_, tied_active_;
+  std::vector<TiedShearForces> tied_forces_;
   std::vector<double> work_increment_;
+  std::vector<PackedKinematics> packed_;  // this step's positions and directors
 };
 
 }  // namespace sphshell::solver

@@ -57,6 +57,13 @@ struct ParticleState {
   }
 };
 
+// A particle's position and director side by side: the internal-force
+// assembler packs them once per step, so gathering a point's neighbours reads
+// one place per neighbour instead of two.
+struct PackedKinematics {
+  Vector3 position, director;
+};
+
 // Lumped translational mass m (kg) and rotary inertia I (kg·m²) per particle.
 struct Inertia {
   std::vector<double> mass, rotary_inertia;

@@ -36,11 +36,12 @@ namespace sphshell::solver {
 // approximation (8.0 measured for the membrane).
 inline constexpr double highest_mode_factor = 9.0;
 
-// Smallest distance between two particles: on distorted grids (the corners
-// of a spherical cap) it is shorter than the square root of the cell area.
+// Smallest distance between two particles that interact: on distorted grids
+// (the corners of a spherical cap) it is shorter than the square root of the
+// cell area. Pairs a cut separates (the coincident faces of a slit) do not count.
 // Each particle's nearest neighbour is sought within two of its local
 // spacings (solver/local_spacing.hpp); infinity when none lies that close.
-inline double nearest_particle_distance(const ShellModel& model) {
+inline double nearest_particle_distance(const ShellModel& model, const shell::CutVisibility& cuts) {
   const std::vector<double>& local = local_spacing(model).particle;
   std::vector<double> reach(local.size());
   for (std::size_t i = 0; i < local.size(); ++i) reach[i] = 2.0 * local[i];
@@ -48,7 +49,12 @@ inline double nearest_particle_distance(const ShellModel& model) {
   double nearest = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < model.particle_count(); ++i)
     cells.for_each_within(model.particle_position[i], reach[i], [&](int j, double distance_squared) {
-      if (static_cast<std::size_t>(j) != i) nearest = std::min(nearest, std::sqrt(distance_squared));
+      const auto other = static_cast<std::size_t>(j);
+      if (other == i || std::sqrt(distance_squared) >= nearest) return;
+      if (!cuts.empty() &&
+          !cuts.visible(cuts.side_point(i), cuts.side_point(other), tangent_frame(model.particle_normal[i])))
+        return;
+      nearest = std::sqrt(distance_squared);
     });
   return nearest;
 }
@@ -78,7 +84,7 @@ double stable_time_step(const ShellModel& model, const Law& law, const PhysicsOp
   const double E = law.youngs_modulus(), nu = law.poisson_ratio();
   const double rho = physics.density;
   const double G = law.shear_modulus();
-  const double spacing = std::min(model.minimum_spacing(), nearest_particle_distance(model));
+  const double spacing = std::min(model.minimum_spacing(), nearest_particle_distance(model, points.cuts()));
   const double membrane_speed_squared = E / (rho * (1.0 - nu * nu));
   const double shear_speed_squared = physics.shear_correction * G / rho;
   const double membrane = highest_mode_factor * membrane_speed_squared / (spacing * spacing);

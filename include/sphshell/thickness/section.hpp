@@ -55,13 +55,18 @@ class Section {
   }
 
   Resultants resultants(const State& state) const {
-    Resultants result;
+    // Component by component: GCC left Eigen's `+= w·σ` out of line here, a
+    // call per integral point; the sums are the same, in the same order.
+    double membrane[3] = {0.0, 0.0, 0.0}, moment[3] = {0.0, 0.0, 0.0};
     for (int k = 0; k < num_points; ++k) {
       const StressVoigt& stress = state[std::size_t(k)].stress;
-      result.membrane += weight_[std::size_t(k)] * stress;
-      result.moment += (weight_[std::size_t(k)] * zeta_[std::size_t(k)]) * stress;
+      const double w = weight_[std::size_t(k)], w_zeta = weight_[std::size_t(k)] * zeta_[std::size_t(k)];
+      for (int c = 0; c < 3; ++c) {
+        membrane[c] += w * stress[c];
+        moment[c] += w_zeta * stress[c];
+      }
     }
-    return result;
+    return Resultants{StressVoigt(membrane[0], membrane[1], membrane[2]), StressVoigt(moment[0], moment[1], moment[2])};
   }
 
   double equivalent_stress(const State& state, int k) const {

@@ -19,6 +19,7 @@
 #include <new>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 
@@ -216,6 +217,48 @@ class RowSmoothingLengths {
   double smallest_ = 0.0, median_ = 0.0, largest_ = 0.0;
 };
 
+// Coincident particles would act as one particle of twice the volume, and
+// coincident evaluation points as one point counted twice: both are refused
+// unless the visibility predicate separates them, i.e. no row sees both
+// particles of a coincident pair, and coincident evaluation points see
+// different particles (the two faces of a slit hidden from each other by a cut).
+inline void require_coincident_points_apart(const ShapeFunctions& sf, const std::vector<Vector3>& particles,
+                                            const std::vector<std::pair<int, int>>& coincident_particles,
+                                            const std::vector<std::pair<int, int>>& coincident_evaluation_points) {
+  if (!coincident_particles.empty()) {
+    std::vector<char> paired(particles.size(), 0);
+    for (const auto& [i, j] : coincident_particles) paired[i] = paired[j] = 1;
+    std::vector<int> seen;
+    for (std::size_t row = 0; row < sf.rows(); ++row) {
+      seen.clear();
+      for (std::size_t s = sf.row_begin[row]; s < sf.row_begin[row] + sf.row_size[row]; ++s)
+        if (paired[sf.neighbour[s]]) seen.push_back(sf.neighbour[s]);
+      for (std::size_t a = 0; a < seen.size(); ++a)
+        for (std::size_t b = a + 1; b < seen.size(); ++b) {
+          const std::pair<int, int> pair{std::min(seen[a], seen[b]), std::max(seen[a], seen[b])};
+          if (!std::binary_search(coincident_particles.begin(), coincident_particles.end(), pair)) continue;
+          std::ostringstream message;
+          message << "sphshell: coincident particles " << pair.first << " and " << pair.second << " (distance "
+                  << (particles[pair.first] - particles[pair.second]).norm() << " m) are both visible from evaluation point "
+                  << row << ": points of one set must be distinct, or hidden from each other's evaluation points "
+                     "(a cut between the two faces of a slit)";
+          throw Error(message.str());
+        }
+    }
+  }
+  for (const auto& [a, b] : coincident_evaluation_points) {
+    const auto first = sf.neighbour.begin() + static_cast<std::ptrdiff_t>(sf.row_begin[a]);
+    const auto second = sf.neighbour.begin() + static_cast<std::ptrdiff_t>(sf.row_begin[b]);
+    if (sf.row_size[a] == sf.row_size[b] && std::equal(first, first + sf.row_size[a], second)) {
+      std::ostringstream message;
+      message << "sphshell: coincident evaluation points " << a << " and " << b
+              << " see the same particles: points of one set must be distinct, unless a cut gives them different "
+                 "neighbours";
+      throw Error(message.str());
+    }
+  }
+}
+
 template <class Kernel, class Method, class Visible>
 ShapeFunctions build_all_unguarded(const std::vector<Vector3>& particles,
                                    const std::vector<double>& volumes,
@@ -245,8 +288,11 @@ ShapeFunctions build_all_unguarded(const std::vector<Vector3>& particles,
   const double cell_width = Kernel::support_radius_factor * h.median();
   const double tolerance = coincidence_tolerance_factor * h.smallest();
   const CellList particle_cells(particles, cell_width);
-  particle_cells.require_no_coincident_points(tolerance, "particles");
-  CellList(eval_positions, cell_width).require_no_coincident_points(tolerance, "evaluation points");
+  // Points at one place are refused unless visibility tells them apart (a cut
+  // between the two edges of a slit): checked once the rows are built.
+  const std::vector<std::pair<int, int>> coincident_particles = particle_cells.coincident_pairs(tolerance);
+  const std::vector<std::pair<int, int>> coincident_evaluation_points =
+      CellList(eval_positions, cell_width).coincident_pairs(tolerance);
 
   const std::size_t rows = eval_positions.size();
   ShapeFunctions sf;
@@ -315,6 +361,7 @@ ShapeFunctions build_all_unguarded(const std::vector<Vector3>& particles,
     }
   }
   if (error) std::rethrow_exception(error);
+  require_coincident_points_apart(sf, particles, coincident_particles, coincident_evaluation_points);
   return sf;
 }
 

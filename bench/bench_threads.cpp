@@ -1,0 +1,139 @@
+// Two threads against one on the paper's plate (51 × 51 particles, 2500
+// stress points, Gauss<5>, J2 plasticity, the square_plate example's 1 MPa
+// step load), wall time:
+//  - threads_under_load: while a busy process that this benchmark starts (and
+//    stops) holds a core, the situation of a user's laptop or a shared node;
+//  - threads_idle: without it (the machine's other load stays: report it).
+// Two solvers of the same plate step in alternating chunks of 20 steps, one on
+// 1 thread and one on 2 (the order swapped every round), so a change of the
+// machine's load hits both alike. The counter `ratio` is the median over the
+// rounds of (2-thread chunk time) / (1-thread chunk time): below 1 the second
+// thread helps, 1.1 is the limit under load. `load1` is the 1-minute
+// load average when the benchmark started. The argument is the team's spin
+// time in µs (parallel::set_spin_time; 50 is the library's default).
+#include <sphshell/sphshell.hpp>
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <thread>
+#include <vector>
+
+#include <csignal>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+using namespace sphshell;
+
+namespace {
+
+using PlateSolver = Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<5>, material::J2Plasticity>;
+
+PlateSolver loaded_plate() {
+  SolverOptions options;
+  options.density = 7850.0;
+  PlateSolver solver(ShellModel::rectangular_plate(0.5, 0.5, 51, 51, 0.01), {210e9, 0.3, 235e6, 0.0}, options);
+  solver.clamp(solver.model().set("boundary"));
+  solver.add_uniform_pressure(solver.model().all_particles(), 1e6);
+  return solver;
+}
+
+// A child process that spins on one core until it is killed.
+class BusyProcess {
+ public:
+  BusyProcess() : pid_(fork()) {
+    if (pid_ == 0) {
+      volatile unsigned long counter = 0;
+      for (;;) counter = counter + 1;
+    }
+    // Let the scheduler see it before the timing starts.
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
+  ~BusyProcess() {
+    if (pid_ > 0) {
+      kill(pid_, SIGKILL);
+      waitpid(pid_, nullptr, 0);
+    }
+  }
+  BusyProcess(const BusyProcess&) = delete;
+  BusyProcess& operator=(const BusyProcess&) = delete;
+  bool running() const { return pid_ > 0; }
+
+ private:
+  pid_t pid_;
+};
+
+void use_threads(int threads) {
+#ifdef _OPENMP
+  omp_set_num_threads(threads);
+#else
+  (void)threads;
+#endif
+}
+
+double seconds_for_steps(PlateSolver& solver, int steps) {
+  const auto start = std::chrono::steady_clock::now();
+  for (int k = 0; k < steps; ++k) solver.step();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+void two_against_one_thread(benchmark::State& state, bool with_busy_process) {
+#ifndef _OPENMP
+  state.SkipWithError("built without OpenMP: the loops run on one thread");
+  return;
+#endif
+  const std::chrono::nanoseconds previous_spin = parallel::spin_time();
+  parallel::set_spin_time(std::chrono::microseconds(state.range(0)));
+  double load1 = 0.0;
+  getloadavg(&load1, 1);
+  PlateSolver one = loaded_plate(), two = loaded_plate();
+  constexpr int chunk = 20, rounds = 15;
+  for (auto _ : state) {
+    BusyProcess* busy = with_busy_process ? new BusyProcess : nullptr;
+    if (busy && !busy->running()) state.SkipWithError("could not start the busy process");
+    std::vector<double> ratios;
+    double one_seconds = 0.0, two_seconds = 0.0;
+    for (int round = 0; round < rounds; ++round) {
+      double t1 = 0.0, t2 = 0.0;
+      for (int turn = 0; turn < 2; ++turn) {
+        if ((turn == 0) == (round % 2 == 0)) {
+          use_threads(1);
+          t1 = seconds_for_steps(one, chunk);
+        } else {
+          use_threads(2);
+          t2 = seconds_for_steps(two, chunk);
+        }
+      }
+      ratios.push_back(t2 / t1);
+      one_seconds += t1;
+      two_seconds += t2;
+    }
+    delete busy;
+    use_threads(1);
+    state.SetIterationTime(two_seconds / (rounds * chunk));
+    state.counters["ratio"] = median(ratios);
+    state.counters["one_thread_us_per_step"] = 1e6 * one_seconds / (rounds * chunk);
+    state.counters["two_threads_us_per_step"] = 1e6 * two_seconds / (rounds * chunk);
+    state.counters["load1"] = load1;
+  }
+  parallel::set_spin_time(previous_spin);
+}
+
+void threads_under_load(benchmark::State& state) { two_against_one_thread(state, true); }
+void threads_idle(benchmark::State& state) { two_against_one_thread(state, false); }
+
+}  // namespace
+
+BENCHMARK(threads_under_load)->Arg(50)->Arg(20)->Arg(5)->Arg(0)->Arg(1000)->UseManualTime()->Iterations(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(threads_idle)->Arg(50)->Arg(20)->Arg(5)->Arg(0)->UseManualTime()->Iterations(1)->Unit(benchmark::kMicrosecond);
+
+BENCHMARK_MAIN();

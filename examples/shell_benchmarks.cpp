@@ -1,0 +1,288 @@
+// The standard shell benchmarks, solved statically: the linear "obstacle
+// course" (Scordelis-Lo roof, pinched hemisphere with an 18° hole, pinched
+// cylinder with rigid diaphragms; MacNeal & Harder 1985) and the geometrically
+// nonlinear cantilevers of Sze, Liu & Lo (2004) (end shear, rolled into a
+// circle by an end moment). Each case runs at three resolutions; the table
+// printed (Markdown) gives the finest one's value, reference and error with
+// the two coarser ones' errors beside it, as in the README. The cases and the
+// static Newton solution on the solver's own forces are the validation tests'
+// (tests/support/shell_benchmarks.hpp, tests/support/static_shell.hpp).
+// `shell_benchmarks --help` lists the options and the files written.
+
+#include <sphshell/sphshell.hpp>
+
+#include "example_arguments.hpp"
+#include "support/shell_benchmarks.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <iostream>
+#include <optional>
+#include <string>
+#include <vector>
+
+using namespace sphshell;
+using namespace sphshell::test_support;
+
+namespace {
+
+using LinearSolver = Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<2>, material::Elastic>;
+using NonlinearSolver = Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<3>, material::Elastic>;
+
+struct Arguments {
+  bool coarse = false;
+  std::string cases = "all";
+  std::string output = "shell_benchmarks";
+};
+
+std::optional<Arguments> parse(int argc, char** argv) {
+  Arguments arguments;
+  example::CommandLine command_line(
+      "shell_benchmarks",
+      "The standard shell benchmarks solved statically (Newton's method on a stiffness assembled from the "
+      "solver's internal forces): Scordelis-Lo roof, pinched hemisphere with an 18° hole and pinched cylinder "
+      "with rigid diaphragms (linear), and the cantilevers of Sze, Liu & Lo (2004) under end shear and rolled "
+      "into a circle by an end moment, and the slit annular plate under end shear (geometrically nonlinear). Each case runs at three resolutions and the "
+      "table printed gives the finest one's error with the two coarser ones' beside it.");
+  command_line.flag("--coarse", arguments.coarse,
+                    "three coarse resolutions per case, without the slit annular plate (a quick run, for checks)");
+  command_line.choice("--cases", arguments.cases, {"all", "linear", "nonlinear"}, "which benchmarks to run");
+  command_line.output_folder(arguments.output);
+  command_line.writes("benchmarks.csv", "every run: case, resolution, value, reference, error, seconds");
+  command_line.writes("end_shear.csv", "cantilever under end shear: P/Pmax, tip w and -u, the elastica's");
+  command_line.writes("end_shear.svg", "its load-deflection chart with the elastica and the paper's points");
+  command_line.writes("end_moment.csv", "cantilever under end moment: M/Mmax, tip -u and w, the circle's");
+  command_line.writes("end_moment.svg", "its load-deflection chart with the closed form");
+  command_line.writes("linear_convergence.svg", "the linear cases' error against the resolution");
+  command_line.writes("slit_annular_plate.csv", "slit annular plate: P/Pmax, W_A and W_B, the paper's (not with --coarse)");
+  command_line.writes("slit_annular_plate.svg", "its load-deflection chart with the paper's points");
+  if (!command_line.parse(argc, argv)) return std::nullopt;
+  return arguments;
+}
+
+struct Row {
+  std::string name, resolution;
+  double value, reference, seconds;
+  double error() const { return 100.0 * (value / reference - 1.0); }
+};
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// The Markdown row of a case: the finest run, and the coarser runs' errors.
+void print_row(const std::vector<Row>& runs, const std::string& quantity) {
+  const Row& finest = runs.back();
+  std::string convergence;
+  for (std::size_t k = 0; k + 1 < runs.size(); ++k) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%s%s: %+.2f %%", k ? ", " : "", runs[k].resolution.c_str(), runs[k].error());
+    convergence += text;
+  }
+  std::printf("| %s | %s | %s | %.5g | %.5g | %+.2f %% | %s | %.1f s |\n", finest.name.c_str(), quantity.c_str(),
+              finest.resolution.c_str(), finest.value, finest.reference, finest.error(), convergence.c_str(),
+              finest.seconds);
+}
+
+std::vector<Row> run_linear(const std::string& name, const std::function<StaticBenchmark(int)>& build,
+                            const std::vector<int>& resolutions, io::CsvProbe& csv) {
+  std::vector<Row> rows;
+  for (int n : resolutions) {
+    const auto start = std::chrono::steady_clock::now();
+    const StaticBenchmark benchmark = build(n);
+    SolverOptions options;
+    options.nonlinear = false;
+    LinearSolver solver(benchmark.model, {benchmark.E, benchmark.nu}, options);
+    StaticShell<LinearSolver> statics(solver, benchmark.conditions);
+    statics.linear_solve(1.0);
+    const double value = reported_displacement(benchmark, solver);
+    rows.push_back({name, std::to_string(n) + "²", value, benchmark.reference, seconds_since(start)});
+    csv.write_row({static_cast<double>(n * n), value, benchmark.reference, rows.back().error(), rows.back().seconds});
+    std::cerr << name << ", " << n << " x " << n << ": " << value << " (" << rows.back().error() << " %)\n";
+  }
+  return rows;
+}
+
+struct Resolution {
+  int nx, ny;
+  std::string text() const { return std::to_string(nx) + "×" + std::to_string(ny); }
+};
+
+int run(const Arguments& arguments) {
+  io::make_directory(arguments.output, "", "--output");
+  const bool linear = arguments.cases != "nonlinear", nonlinear = arguments.cases != "linear";
+  // Runs: resolution (particles), value, reference, error %, seconds; one file per case kind.
+  io::CsvProbe csv(arguments.output + "/benchmarks.csv",
+                   {"particles", "value", "reference", "error [%]", "seconds"});
+  std::vector<std::pair<std::vector<Row>, std::string>> table;
+  std::vector<io::PlotSeries> convergence;
+
+  if (linear) {
+    const std::vector<int> roof = arguments.coarse ? std::vector<int>{9, 13, 17} : std::vector<int>{25, 33, 41};
+    const std::vector<int> rest = arguments.coarse ? std::vector<int>{9, 13, 17} : std::vector<int>{33, 41, 49};
+    table.push_back({run_linear("Scordelis-Lo roof", scordelis_lo_roof, roof, csv), "w at the free edge's midpoint"});
+    table.push_back({run_linear("Pinched hemisphere", [](int n) { return pinched_hemisphere(n, PointLoad::shape_functions); },
+                                rest, csv),
+                     "radial u under the load"});
+    table.push_back({run_linear("Pinched cylinder", [](int n) { return pinched_cylinder(n, PointLoad::shape_functions); },
+                                rest, csv),
+                     "radial u under the load"});
+    for (const auto& [rows, quantity] : table) {
+      io::PlotSeries series{rows.front().name, {}, {}, io::PlotStyle::line};
+      for (const Row& row : rows) {
+        series.x.push_back(std::stod(row.resolution));
+        series.y.push_back(row.error());
+      }
+      convergence.push_back(series);
+    }
+    io::write_svg_plot(arguments.output + "/linear_convergence.svg",
+                       {{"Linear benchmarks: error against the resolution", "particles per side", "error [%]",
+                         convergence}});
+  }
+
+  if (nonlinear) {
+    // End shear: the load-deflection curve at the finest resolution, the
+    // elastica and the paper's tabulated points.
+    const std::vector<Resolution> shear_grids = arguments.coarse ? std::vector<Resolution>{{11, 3}, {16, 3}, {21, 3}}
+                                                                 : std::vector<Resolution>{{21, 3}, {31, 3}, {41, 5}};
+    std::vector<double> factors;
+    for (int k = 1; k <= 20; ++k) factors.push_back(0.05 * k);
+    std::vector<Row> shear_w, shear_u;
+    CantileverRun finest;
+    for (const Resolution& grid : shear_grids) {
+      const auto start = std::chrono::steady_clock::now();
+      finest = run_cantilever<NonlinearSolver>(EndLoad::shear, grid.nx, grid.ny, factors, 0.1);
+      const double seconds = seconds_since(start);
+      const TipDisplacement exact = elastica_tip(finest.full_load, finest.EI, finest.L);
+      shear_w.push_back({"Cantilever, end shear", grid.text(), finest.points.back().w, exact.w, seconds});
+      shear_u.push_back({"Cantilever, end shear", grid.text(), finest.points.back().u, exact.u, seconds});
+      csv.write_row({static_cast<double>(grid.nx * grid.ny), shear_w.back().value, exact.w, shear_w.back().error(), seconds});
+      std::cerr << "end shear, " << grid.text() << ": w " << shear_w.back().error() << " %, -u "
+                << shear_u.back().error() << " %\n";
+    }
+    table.push_back({shear_w, "tip w at P = 4 (elastica)"});
+    table.push_back({shear_u, "tip −u at P = 4 (elastica)"});
+    {
+      io::CsvProbe curve(arguments.output + "/end_shear.csv",
+                         {"P/Pmax", "w", "-u", "elastica w", "elastica -u"});
+      io::PlotSeries w{"SPH w (" + shear_grids.back().text() + ")", {}, {}, io::PlotStyle::line};
+      io::PlotSeries u{"SPH −u", {}, {}, io::PlotStyle::line};
+      io::PlotSeries ew{"elastica w", {}, {}, io::PlotStyle::dashed}, eu{"elastica −u", {}, {}, io::PlotStyle::dashed};
+      io::PlotSeries pw{"Sze et al. 2004, w", {}, {}, io::PlotStyle::points};
+      io::PlotSeries pu{"Sze et al. 2004, −u", {}, {}, io::PlotStyle::points};
+      w.x.push_back(0.0), w.y.push_back(0.0), u.x.push_back(0.0), u.y.push_back(0.0);
+      for (const CantileverPoint& point : finest.points) {
+        const TipDisplacement exact = elastica_tip(point.load_factor * finest.full_load, finest.EI, finest.L);
+        curve.write_row({point.load_factor, point.w, point.u, exact.w, exact.u});
+        w.x.push_back(point.load_factor), w.y.push_back(point.w);
+        u.x.push_back(point.load_factor), u.y.push_back(point.u);
+      }
+      for (int k = 0; k <= 100; ++k) {
+        const TipDisplacement exact = elastica_tip(0.01 * k * finest.full_load, finest.EI, finest.L);
+        ew.x.push_back(0.01 * k), ew.y.push_back(exact.w), eu.x.push_back(0.01 * k), eu.y.push_back(exact.u);
+      }
+      for (const TabulatedPoint& point : sze_end_shear_table()) {
+        pw.x.push_back(point.load_factor), pw.y.push_back(point.first);
+        pu.x.push_back(point.load_factor), pu.y.push_back(point.second);
+      }
+      io::write_svg_plot(arguments.output + "/end_shear.svg",
+                         {{"Cantilever under end shear (Sze, Liu & Lo 2004)", "P / Pmax", "tip displacement",
+                           {w, u, ew, eu, pw, pu}}});
+    }
+
+    // End moment: the tip against the circle's closed form.
+    const std::vector<Resolution> moment_grids = arguments.coarse
+                                                     ? std::vector<Resolution>{{13, 3}, {19, 3}, {25, 3}}
+                                                     : std::vector<Resolution>{{25, 3}, {49, 5}, {73, 5}};
+    std::vector<Row> moment_rows;
+    for (const Resolution& grid : moment_grids) {
+      const auto start = std::chrono::steady_clock::now();
+      finest = run_cantilever<NonlinearSolver>(EndLoad::moment, grid.nx, grid.ny, factors, 0.05);
+      const double seconds = seconds_since(start);
+      // At the full circle the tip returns to the root: −u = L.
+      moment_rows.push_back({"Cantilever, end moment", grid.text(), finest.points.back().u, finest.L, seconds});
+      csv.write_row({static_cast<double>(grid.nx * grid.ny), finest.points.back().u, finest.L,
+                     moment_rows.back().error(), seconds});
+      std::cerr << "end moment, " << grid.text() << ": full circle -u " << moment_rows.back().error() << " %, w "
+                << finest.points.back().w << "\n";
+    }
+    table.push_back({moment_rows, "tip −u at the full circle (= L)"});
+    if (!arguments.coarse) {
+      // Slit annular plate: W_A and W_B at P_max against the paper's table.
+      const std::vector<Resolution> slit_grids{{7, 31}, {9, 46}, {11, 61}};
+      std::vector<Row> slit_a, slit_b;
+      SlitPlateRun slit;
+      const std::vector<TabulatedPoint> reference = sze_slit_annular_plate_table();
+      for (const Resolution& grid : slit_grids) {
+        const auto start = std::chrono::steady_clock::now();
+        slit = run_slit_annular_plate<NonlinearSolver>(grid.nx, grid.ny, 0.025);
+        const double seconds = seconds_since(start);
+        slit_a.push_back({"Slit annular plate", grid.text(), slit.points.back().first, reference.back().first, seconds});
+        slit_b.push_back({"Slit annular plate", grid.text(), slit.points.back().second, reference.back().second, seconds});
+        csv.write_row({static_cast<double>(grid.nx * grid.ny), slit_b.back().value, slit_b.back().reference,
+                       slit_b.back().error(), seconds});
+        std::cerr << "slit annular plate, " << grid.text() << ": W_A " << slit_a.back().error() << " %, W_B "
+                  << slit_b.back().error() << " %\n";
+      }
+      table.push_back({slit_a, "W_A (inner) at P_max (the paper's table)"});
+      table.push_back({slit_b, "W_B (outer) at P_max (the paper's table)"});
+      io::CsvProbe slit_csv(arguments.output + "/slit_annular_plate.csv",
+                            {"P/Pmax", "W_A", "W_B", "paper W_A", "paper W_B"});
+      io::PlotSeries a{"SPH W_A (" + slit_grids.back().text() + ")", {0.0}, {0.0}, io::PlotStyle::line};
+      io::PlotSeries b{"SPH W_B", {0.0}, {0.0}, io::PlotStyle::line};
+      io::PlotSeries pa{"Sze et al. 2004, W_A", {}, {}, io::PlotStyle::points};
+      io::PlotSeries pb{"Sze et al. 2004, W_B", {}, {}, io::PlotStyle::points};
+      for (std::size_t k = 0; k < reference.size(); ++k) {
+        slit_csv.write_row({reference[k].load_factor, slit.points[k].first, slit.points[k].second, reference[k].first,
+                            reference[k].second});
+        a.x.push_back(reference[k].load_factor), a.y.push_back(slit.points[k].first);
+        b.x.push_back(reference[k].load_factor), b.y.push_back(slit.points[k].second);
+        pa.x.push_back(reference[k].load_factor), pa.y.push_back(reference[k].first);
+        pb.x.push_back(reference[k].load_factor), pb.y.push_back(reference[k].second);
+      }
+      io::write_svg_plot(arguments.output + "/slit_annular_plate.svg",
+                         {{"Slit annular plate under end shear (Sze, Liu & Lo 2004)", "P / Pmax", "W",
+                           {a, b, pa, pb}}});
+    }
+    io::CsvProbe curve(arguments.output + "/end_moment.csv", {"M/Mmax", "-u", "w", "circle -u", "circle w"});
+    io::PlotSeries u{"SPH −u/L (" + moment_grids.back().text() + ")", {}, {}, io::PlotStyle::line};
+    io::PlotSeries w{"SPH w/L", {}, {}, io::PlotStyle::line};
+    io::PlotSeries cu{"circle −u/L", {}, {}, io::PlotStyle::dashed}, cw{"circle w/L", {}, {}, io::PlotStyle::dashed};
+    u.x.push_back(0.0), u.y.push_back(0.0), w.x.push_back(0.0), w.y.push_back(0.0);
+    for (const CantileverPoint& point : finest.points) {
+      const TipDisplacement exact = circle_tip(point.load_factor * finest.full_load, finest.EI, finest.L);
+      curve.write_row({point.load_factor, point.u, point.w, exact.u, exact.w});
+      u.x.push_back(point.load_factor), u.y.push_back(point.u / finest.L);
+      w.x.push_back(point.load_factor), w.y.push_back(point.w / finest.L);
+    }
+    for (int k = 0; k <= 100; ++k) {
+      const TipDisplacement exact = circle_tip(0.01 * k * finest.full_load, finest.EI, finest.L);
+      cu.x.push_back(0.01 * k), cu.y.push_back(exact.u / finest.L);
+      cw.x.push_back(0.01 * k), cw.y.push_back(exact.w / finest.L);
+    }
+    io::write_svg_plot(arguments.output + "/end_moment.svg",
+                       {{"Cantilever rolled up by an end moment (Sze, Liu & Lo 2004)", "M / Mmax",
+                         "tip displacement / L", {u, w, cu, cw}}});
+  }
+
+  std::printf("\n| benchmark | quantity | resolution | value | reference | error | coarser | time |\n");
+  std::printf("|---|---|---|---|---|---|---|---|\n");
+  for (const auto& [rows, quantity] : table) print_row(rows, quantity);
+  std::printf("\nfiles in %s\n", arguments.output.c_str());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    const std::optional<Arguments> parsed = parse(argc, argv);
+    if (!parsed) return 0;
+    return run(*parsed);
+  } catch (const std::exception& error) {
+    std::cerr << "shell_benchmarks: " << error.what() << '\n';
+    return 1;
+  }
+}

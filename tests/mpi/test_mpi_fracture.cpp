@@ -1,0 +1,124 @@
+// Fracture across rank boundaries (docs/distributed.md, "Fracture"): the
+// paper's clamped plate tearing (Lemaitre damage, line-segment cracks) and a
+// pre-cracked strip pulled apart, run by the serial Solver (on every rank, the
+// independent reference) and by mpi::DistributedSolver. The crack topology
+// (segments, damaged stress points, fragments) must be the serial one on every
+// rank, and the motion bitwise the serial one.
+#include <sphshell/approx/mls.hpp>
+#include <sphshell/crack/line_segments.hpp>
+#include <sphshell/kernel/cubic_spline.hpp>
+#include <sphshell/material/lemaitre_damage.hpp>
+#include <sphshell/mpi/distributed_solver.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/gauss.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
+
+using namespace sphshell;
+
+namespace {
+
+using Approximation = approx::MLS<kernel::CubicSpline>;
+using Serial = Solver<Approximation, thickness::Gauss<3>, material::LemaitreDamage, crack::LineSegments>;
+using Distributed = mpi::DistributedSolver<Approximation, thickness::Gauss<3>, material::LemaitreDamage, crack::LineSegments>;
+const material::LemaitreDamage::Parameters table_3_steel{210e9, 0.3, 235e6, 0.0, 0.02, 0.37, 0.24};
+
+std::size_t differing_components(const std::vector<Vector3>& a, const std::vector<Vector3>& b) {
+  if (a.size() != b.size()) return a.size() + b.size();
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    for (int c = 0; c < 3; ++c) count += std::memcmp(&a[i][c], &b[i][c], sizeof(double)) != 0 ? 1 : 0;
+  return count;
+}
+
+void compare(const std::string& label, const Serial& serial, Distributed& distributed, const mpi::Communicator& comm) {
+  INFO(label << " on " << comm.size() << " ranks, rank " << comm.rank() << ", step " << serial.steps());
+  CHECK(distributed.steps() == serial.steps());
+  CHECK(differing_components(distributed.positions(), serial.positions()) == 0);
+  CHECK(differing_components(distributed.directors(), serial.directors()) == 0);
+  CHECK(differing_components(distributed.velocities(), serial.velocities()) == 0);
+  CHECK(differing_components(distributed.angular_velocities(), serial.angular_velocities()) == 0);
+  CHECK(distributed.crack().segments() == serial.crack().segments());
+  CHECK(distributed.crack().points() == serial.crack().points());
+  CHECK(distributed.damaged_stress_point_count() == serial.damaged_stress_point_count());
+  CHECK(distributed.precrack_stress_point_count() == serial.precrack_stress_point_count());
+  CHECK(distributed.fragment_count() == serial.fragment_count());
+  std::size_t fragment_differences = 0;
+  for (std::size_t i = 0; i < serial.particle_count(); ++i)
+    fragment_differences += distributed.is_fragment(static_cast<int>(i)) != serial.is_fragment(static_cast<int>(i));
+  CHECK(fragment_differences == 0);
+  const EnergyReport e = distributed.energy(), s = serial.energy();
+  const double scale = std::max({s.external_work, s.kinetic, s.internal});
+  CHECK(std::abs(e.released_by_fracture - s.released_by_fracture) <= 1e-12 * scale);
+  CHECK(std::abs(e.internal - s.internal) <= 1e-12 * std::abs(s.internal));
+  CHECK(std::abs(e.kinetic - s.kinetic) <= 1e-12 * s.kinetic);
+  if (comm.is_root())
+    WARN(label << " on " << comm.size() << " ranks, step " << serial.steps() << ": "
+               << serial.damaged_stress_point_count() << " damaged stress points, "
+               << serial.crack().segments().size() << " segments, " << serial.fragment_count()
+               << " fragments; released " << s.released_by_fracture << " J (distributed "
+               << e.released_by_fracture << " J)");
+}
+
+}  // namespace
+
+TEST_CASE("Distributed tearing plate: the serial crack topology on every rank", "[mpi][fracture]") {
+  // The paper's plate, 21 x 21, clamped, 12 MPa (tests/test_solver_fracture.cpp).
+  const mpi::Communicator comm;
+  const ShellModel model = ShellModel::rectangular_plate(0.5, 0.5, 21, 21, 0.01);
+  Serial serial(model, table_3_steel);
+  serial.clamp(model.set("boundary"));
+  serial.add_uniform_pressure(model.all_particles(), 12e6);
+  Distributed distributed(comm, model, table_3_steel);
+  distributed.clamp("boundary");
+  distributed.add_uniform_pressure(model.all_particles(), 12e6);
+  const double end_time = 1.3e-3;
+  bool compared_at_first_crack = false;
+  while (serial.time() < end_time - 0.5 * serial.time_step()) {
+    serial.step();
+    distributed.step();
+    if (!compared_at_first_crack && serial.damaged_stress_point_count() > 0) {
+      compare("tearing plate, first damage", serial, distributed, comm);
+      compared_at_first_crack = true;
+    }
+  }
+  CHECK(compared_at_first_crack);
+  CHECK(serial.crack().segments().size() > 10);  // the cracks grew
+  // The cracks cross rank boundaries: damaged stress points owned by more
+  // than one rank.
+  int damaged_here = 0;
+  const mpi::RankLayout& layout = distributed.layout();
+  for (std::size_t k = 0; k < layout.computed[0].size(); ++k)
+    if (layout.computed_is_owned[0][k] && serial.crack().is_damaged(static_cast<int>(layout.computed[0][k])))
+      ++damaged_here;
+  int ranks_with_damage = 0;
+  for (int count : comm.all_gather(damaged_here)) ranks_with_damage += count > 0 ? 1 : 0;
+  CHECK(ranks_with_damage == comm.size());
+  compare("tearing plate", serial, distributed, comm);
+}
+
+TEST_CASE("Distributed pre-cracked strip separates as the serial one", "[mpi][fracture]") {
+  // 0.2 m x 0.1 m strip clamped at x = 0, pulled at x = 0.2 m, a through
+  // pre-crack at x = 0.105 m (tests/test_solver_fracture.cpp).
+  const mpi::Communicator comm;
+  const ShellModel model = ShellModel::rectangular_plate(0.2, 0.1, 21, 11, 0.005);
+  const std::vector<Vector3> precrack{Vector3(0.105, -0.002, 0.0), Vector3(0.105, 0.102, 0.0)};
+  auto pull = [](const Vector3&, double) { return Vector3(2.0, 0.0, 0.0); };
+  Serial serial(model, table_3_steel);
+  serial.add_precrack(precrack);
+  serial.clamp(model.set("x_min"));
+  serial.prescribe_velocity(model.set("x_max"), pull);
+  Distributed distributed(comm, model, table_3_steel);
+  distributed.add_precrack(precrack);
+  distributed.clamp("x_min");
+  distributed.prescribe_velocity(model.set("x_max"), pull);
+  CHECK(serial.precrack_stress_point_count() > 0);
+  serial.run_until(2e-4);
+  distributed.run_until(2e-4);
+  compare("pre-cracked strip", serial, distributed, comm);
+}

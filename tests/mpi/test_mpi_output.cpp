@@ -1,0 +1,138 @@
+// Output of a distributed run (docs/distributed.md, "Output"): one .vtu piece
+// per rank, a .pvtu per frame and one .pvd series, read back with VTK's own
+// parallel reader (tests/mpi/check_pvtu.py, when a Python with VTK was found
+// at configure time); probe CSVs written by the rank owning the particle,
+// byte for byte the serial Solver's probe of the same particle.
+#include <sphshell/approx/mls.hpp>
+#include <sphshell/kernel/cubic_spline.hpp>
+#include <sphshell/material/elastic.hpp>
+#include <sphshell/mpi/distributed_solver.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/gauss.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using namespace sphshell;
+
+namespace {
+
+using Approximation = approx::MLS<kernel::CubicSpline>;
+using Serial = Solver<Approximation, thickness::Gauss<3>, material::Elastic>;
+using Distributed = mpi::DistributedSolver<Approximation, thickness::Gauss<3>, material::Elastic>;
+
+std::string file_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+}  // namespace
+
+TEST_CASE("Distributed frames and probes", "[mpi][output]") {
+  const mpi::Communicator comm;
+  namespace fs = std::filesystem;
+  const std::string directory = "mpi_output_np" + std::to_string(comm.size());
+  if (comm.is_root()) {
+    fs::remove_all(directory);
+    fs::create_directories(directory + "/serial");
+  }
+  comm.barrier();
+  const ShellModel model = ShellModel::rectangular_plate(0.5, 0.5, 21, 21, 0.01);
+  SolverOptions options;
+  options.density = 7850.0;
+  options.frame_precision = io::VtuPrecision::float64;
+  const double end_time = 5e-5;
+  // The probed particles: the first particle each rank owns (every one on
+  // another rank for all but one rank), and a corner.
+  std::vector<int> probed;
+  {
+    Distributed layout_only(comm, model, {210e9, 0.3}, options);
+    probed = comm.all_gather(layout_only.layout().owned.front());
+  }
+  probed.push_back(static_cast<int>(model.particle_count()) - 1);
+  std::vector<Vector3> serial_positions;
+  {
+    Serial serial(model, {210e9, 0.3}, options);
+    serial.clamp(model.set("boundary"));
+    serial.add_uniform_pressure(model.all_particles(), 5e5);
+    for (std::size_t k = 0; k < probed.size(); ++k)
+      serial.add_particle_probe(directory + "/serial/probe_" + std::to_string(comm.rank()) + "_" + std::to_string(k) + ".csv",
+                                probed[k]);
+    serial.run_until(end_time);
+    serial_positions = serial.positions();
+  }
+  SolverOptions distributed_options = options;
+  distributed_options.output_directory = directory + "/frames";
+  distributed_options.output_interval = 1e-5;
+  {
+    Distributed distributed(comm, model, {210e9, 0.3}, distributed_options);
+    distributed.clamp("boundary");
+    distributed.add_uniform_pressure(model.all_particles(), 5e5);
+    for (std::size_t k = 0; k < probed.size(); ++k)
+      distributed.add_particle_probe(directory + "/probe_" + std::to_string(k) + ".csv", probed[k]);
+    // The same file twice is an Error on every rank.
+    CHECK_THROWS_WITH(distributed.add_particle_probe(directory + "/probe_0.csv", 3),
+                      Catch::Contains("already the file of another probe"));
+    distributed.run_until(end_time);
+    CHECK(distributed.positions() == serial_positions);
+  }
+  comm.barrier();
+  for (std::size_t k = 0; k < probed.size(); ++k) {
+    const std::string mine = file_text(directory + "/probe_" + std::to_string(k) + ".csv");
+    const std::string serial = file_text(directory + "/serial/probe_" + std::to_string(comm.rank()) + "_" +
+                                         std::to_string(k) + ".csv");
+    INFO("probe " << k << " of particle " << probed[k]);
+    CHECK(!serial.empty());
+    CHECK(mine == serial);  // every rank reads the file the owner wrote
+  }
+  // Frames at 0, 1e-5, ..., 5e-5 s: six, each with one piece per rank.
+  std::size_t pieces = 0;
+  for (const auto& entry : fs::directory_iterator(directory + "/frames"))
+    pieces += entry.path().extension() == ".vtu" ? 1 : 0;
+  CHECK(pieces == 6 * static_cast<std::size_t>(comm.size()));
+#ifdef SPHSHELL_VTK_PYTHON
+  if (comm.is_root()) {
+    {
+      std::ofstream reference(directory + "/serial_positions.csv");
+      char line[128];
+      for (const Vector3& x : serial_positions) {
+        std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g\n", x.x(), x.y(), x.z());
+        reference << line;
+      }
+    }
+    const std::string command = std::string(SPHSHELL_VTK_PYTHON) + " " + SPHSHELL_CHECK_PVTU + " " + directory +
+                                "/frames " + std::to_string(comm.size()) + " 6 " + directory + "/serial_positions.csv";
+    CHECK(std::system(command.c_str()) == 0);
+  }
+#else
+  if (comm.is_root()) WARN("frames not read back: no Python with VTK was found at configure time (python3-vtk9)");
+#endif
+}
+
+TEST_CASE("More ranks than particles is an Error on every rank", "[mpi][errors]") {
+  const mpi::Communicator comm;
+  // One triangle: three particles.
+  const ShellModel triangle = ShellModel::from_cells(
+      {Vector3(0, 0, 0), Vector3(0.01, 0, 0), Vector3(0, 0.01, 0)}, {Cell(0, 1, 2)}, 0.001);
+  if (comm.size() <= 3) {
+    WARN("needs 4 ranks or more (ctest mpi:test_mpi_output:np4)");
+    return;
+  }
+  std::string message;
+  try {
+    Distributed solver(comm, triangle, {210e9, 0.3});
+  } catch (const Error& error) {
+    message = error.what();
+  }
+  CHECK(message == "sphshell: invalid parameter rank count = " + std::to_string(comm.size()) +
+                       " (exceeds the particle count 3: every rank must own at least one particle)");
+}

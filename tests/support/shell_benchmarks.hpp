@@ -1,0 +1,377 @@
+#pragma once
+// The standard shell benchmarks as static problems (tests/support/static_shell.hpp):
+// geometry, material, conditions, loads, the reported displacement and its
+// published reference. Shared by test_validation_benchmarks and the
+// shell_benchmarks example.
+//
+// Linear ("obstacle course": MacNeal & Harder, Finite Elements in Analysis and
+// Design 1 (1985) 3–20; Belytschko et al., CMAME 51 (1985) 221–258):
+//   Scordelis–Lo roof, pinched hemisphere with an 18° hole, pinched cylinder
+//   with rigid end diaphragms.
+// Geometrically nonlinear (Sze, Liu & Lo, Finite Elements in Analysis and
+// Design 40 (2004) 1551–1569): cantilever under end shear, cantilever rolled
+// up by an end moment. Their references are computed here (the elastica by
+// shooting, the circle in closed form).
+//
+// The inputs are the benchmarks' own numbers; they are unit-consistent (any
+// consistent system), so they go into the SI-labelled solver unchanged.
+
+#include "static_shell.hpp"
+
+#include <sphshell/approx/mls.hpp>
+#include <sphshell/kernel/cubic_spline.hpp>
+#include <sphshell/shell/model.hpp>
+
+#include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace sphshell::test_support {
+
+inline constexpr double benchmark_pi = 3.14159265358979323846;
+
+// Particles on an nu × nv parametric grid on [0,1]², stress points at the cell
+// centres on the exact surface; surface(u, v) returns {position, unit normal}
+// and must run counter-clockwise (∂x/∂u × ∂x/∂v along the normal).
+template <class Surface>
+ShellModel structured_surface(int nu, int nv, Surface&& surface, double thickness) {
+  std::vector<Vector3> positions, normals, centres, centre_normals;
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) {
+      const auto point = surface(static_cast<double>(i) / (nu - 1), static_cast<double>(j) / (nv - 1));
+      positions.push_back(point.first);
+      normals.push_back(point.second);
+    }
+  std::vector<Quad> quads;
+  for (int j = 0; j + 1 < nv; ++j)
+    for (int i = 0; i + 1 < nu; ++i) {
+      quads.push_back({j * nu + i, j * nu + i + 1, (j + 1) * nu + i + 1, (j + 1) * nu + i});
+      const auto centre = surface((i + 0.5) / (nu - 1), (j + 0.5) / (nv - 1));
+      centres.push_back(centre.first);
+      centre_normals.push_back(centre.second);
+    }
+  return ShellModel::from_quads(std::move(positions), std::move(normals), quads, std::move(centres),
+                                std::move(centre_normals), thickness);
+}
+
+// Weights of particles' values, Σ w_j u_j: a particle itself, or the
+// approximation's value at a point.
+using ParticleWeights = std::vector<std::pair<int, double>>;
+
+// The approximation's shape functions Φ_j at a point of the surface (unit
+// normal `normal`), as the solver builds them (support radius factor ×
+// ShellModel::maximum_spacing()). A point force P there does the work
+// P · Σ Φ_j u_j: its consistent particle forces are Φ_j P, and the
+// displacement under it is Σ Φ_j u_j. With a non-interpolating approximation
+// (MLS) a particle's own displacement is not the field's value at the particle.
+template <class Approx = approx::MLS<kernel::CubicSpline>>
+ParticleWeights shape_function_weights(const ShellModel& model, const Vector3& point, const Vector3& normal,
+                                       double support_radius_factor = 2.0) {
+  const double h = support_radius_factor * model.maximum_spacing() / Approx::kernel_type::support_radius_factor;
+  const approx::ShapeFunctions sf =
+      Approx::build(model.particle_position, model.particle_area, {point}, {tangent_frame(normal)}, h);
+  ParticleWeights weights;
+  for (int k = 0; k < sf.row_size[0]; ++k) weights.push_back({sf.neighbour[k], sf.phi[k]});
+  return weights;
+}
+
+// How a point force is applied and its displacement read.
+enum class PointLoad {
+  particle,         // on the particle at the point, which reports its own displacement
+  shape_functions,  // consistently: shared as Φ_j P, the displacement read as Σ Φ_j u_j
+};
+
+// A static benchmark: the model, its material, conditions and loads at load
+// factor 1, and the displacement reported: Σ w_j u_j · direction.
+struct StaticBenchmark {
+  std::string name;
+  ShellModel model;
+  double E, nu;
+  StaticConditions conditions;
+  ParticleWeights probe;
+  Vector3 direction;
+  double reference;  // the published (or closed-form) value of the reported displacement
+};
+
+// A point force at particle `at` (on the model's surface), applied as `how` says;
+// returns the weights that read the displacement under it.
+inline ParticleWeights add_point_force(const ShellModel& model, StaticConditions& conditions, int at,
+                                       const Vector3& force, PointLoad how) {
+  ParticleWeights weights = {{at, 1.0}};
+  if (how == PointLoad::shape_functions)
+    weights = shape_function_weights(model, model.particle_position[at], model.particle_normal[at]);
+  for (const auto& [particle, weight] : weights) conditions.add_force({particle}, weight * force);
+  return weights;
+}
+
+// The reported displacement of a solved benchmark.
+template <class Solver>
+double reported_displacement(const StaticBenchmark& benchmark, const Solver& solver) {
+  double value = 0.0;
+  for (const auto& [particle, weight] : benchmark.probe)
+    value += weight * (solver.positions()[particle] - benchmark.model.particle_position[particle]).dot(benchmark.direction);
+  return value;
+}
+
+// Scordelis–Lo roof: a cylindrical panel (R = 25, L = 50, 80° opening, t =
+// 0.25, E = 4.32e8, ν = 0) on rigid end diaphragms (no translation in their
+// plane), free long edges, under its weight 90 per unit area. Reported: the
+// vertical displacement at the midpoint of a free edge. Reference 0.3024
+// (MacNeal & Harder 1985; the deep-shell value is 0.3086, Belytschko et al. 1985).
+// The whole roof, n × n particles (n odd), the axis along z.
+inline StaticBenchmark scordelis_lo_roof(int n) {
+  const double R = 25.0, L = 50.0, angle = 80.0 * benchmark_pi / 180.0, t = 0.25;
+  ShellModel model = ShellModel::cylindrical_panel(R, L, angle, n, n, t);
+  StaticConditions conditions(model.particle_count());
+  for (const char* end : {"z_min", "z_max"}) {
+    conditions.hold_translation(model.set(end), Vector3::UnitX());
+    conditions.hold_translation(model.set(end), Vector3::UnitY());
+  }
+  // The panel spans 0…80° from the x-axis: its crown (vertical) is at 40°.
+  const Vector3 up(std::cos(angle / 2), std::sin(angle / 2), 0.0);
+  const double weight = 90.0;
+  for (std::size_t i = 0; i < model.particle_count(); ++i)
+    conditions.force[i] = -weight * model.particle_area[i] * up;
+  const int probe = (n - 1) / 2 * n;  // θ = 0, z = L/2
+  return {"Scordelis-Lo roof", std::move(model), 4.32e8, 0.0, std::move(conditions), {{probe, 1.0}}, -up, 0.3024};
+}
+
+// Pinched hemisphere with an 18° hole (R = 10, t = 0.04, E = 6.825e7, ν =
+// 0.3): radial forces 2 outward on the x-axis and inward on the y-axis (one
+// quarter modelled: 1 each), free edges. Reported: the radial displacement
+// under the outward load. Reference 0.094 (MacNeal & Harder 1985).
+// Quarter 0 ≤ φ ≤ 90° with symmetry planes, n × n particles; one particle's
+// z-translation is held (the z rigid motion; its reaction is zero).
+inline StaticBenchmark pinched_hemisphere(int n, PointLoad how = PointLoad::particle) {
+  const double R = 10.0, t = 0.04, hole = 18.0 * benchmark_pi / 180.0;
+  auto surface = [&](double u, double v) {
+    const double azimuth = u * benchmark_pi / 2;
+    const double polar = benchmark_pi / 2 - v * (benchmark_pi / 2 - hole);
+    const Vector3 normal(std::sin(polar) * std::cos(azimuth), std::sin(polar) * std::sin(azimuth), std::cos(polar));
+    return std::make_pair(Vector3(R * normal), normal);
+  };
+  ShellModel model = structured_surface(n, n, surface, t);
+  StaticConditions conditions(model.particle_count());
+  ParticleSet xz_plane, yz_plane;
+  for (int j = 0; j < n; ++j) {
+    xz_plane.push_back(j * n);
+    yz_plane.push_back(j * n + n - 1);
+  }
+  conditions.symmetry_plane(xz_plane, Vector3::UnitY());
+  conditions.symmetry_plane(yz_plane, Vector3::UnitX());
+  const int on_x = 0, on_y = n - 1;
+  conditions.hold_translation({on_x}, Vector3::UnitZ());
+  ParticleWeights probe = add_point_force(model, conditions, on_x, Vector3(1.0, 0.0, 0.0), how);
+  add_point_force(model, conditions, on_y, Vector3(0.0, -1.0, 0.0), how);
+  return {"Pinched hemisphere", std::move(model), 6.825e7, 0.3, std::move(conditions), probe, Vector3::UnitX(), 0.094};
+}
+
+// Pinched cylinder with rigid end diaphragms (R = 300, L = 600, t = 3, E =
+// 3e6, ν = 0.3): two opposite radial forces P = 1 at mid-length. Reported:
+// the radial displacement under the load. Reference 1.8248e-5 (the
+// thin-shell series solution, MacNeal & Harder 1985; Belytschko et al. 1985).
+// One octant (0 ≤ θ ≤ 90°, 0 ≤ z ≤ L/2) with symmetry planes, n × n particles;
+// the octant carries P/4.
+inline StaticBenchmark pinched_cylinder(int n, PointLoad how = PointLoad::particle) {
+  const double R = 300.0, L = 600.0, t = 3.0, P = 1.0;
+  ShellModel model = ShellModel::cylindrical_panel(R, L / 2, benchmark_pi / 2, n, n, t);
+  StaticConditions conditions(model.particle_count());
+  conditions.hold_translation(model.set("z_min"), Vector3::UnitX());
+  conditions.hold_translation(model.set("z_min"), Vector3::UnitY());
+  conditions.symmetry_plane(model.set("z_max"), Vector3::UnitZ());
+  conditions.symmetry_plane(model.set("theta_min"), Vector3::UnitY());
+  conditions.symmetry_plane(model.set("theta_max"), Vector3::UnitX());
+  const int probe = (n - 1) * n;  // θ = 0, z = L/2
+  const ParticleWeights weights = add_point_force(model, conditions, probe, Vector3(-P / 4, 0.0, 0.0), how);
+  return {"Pinched cylinder", std::move(model), 3e6, 0.3, std::move(conditions), weights, -Vector3::UnitX(), 1.8248e-5};
+}
+
+// The cantilever strips of Sze, Liu & Lo (2004), §2.1–2.2: length L, width b
+// = 1, t = 0.1, E = 1.2e6, ν = 0, clamped at x = 0; nx × ny particles. The end
+// load is shared by the tip particles in proportion to their share of the
+// edge (trapezoidal: half at the two corners).
+struct CantileverStrip {
+  ShellModel model;
+  StaticConditions conditions;
+  ParticleSet tip;
+  int tip_mid;  // the tip particle on the centre line (ny odd)
+  double L, EI;
+};
+inline CantileverStrip cantilever_strip(double L, int nx, int ny) {
+  const double b = 1.0, t = 0.1, E = 1.2e6;
+  ShellModel model = ShellModel::rectangular_plate(L, b, nx, ny, t);
+  StaticConditions conditions(model.particle_count());
+  conditions.clamp(model.set("x_min"));
+  const ParticleSet tip = model.set("x_max");
+  return {std::move(model), std::move(conditions), tip, (ny - 1) / 2 * nx + nx - 1, L, E * b * t * t * t / 12.0};
+}
+// The shares of an edge load on the tip particles (ordered along y).
+inline std::vector<double> edge_shares(int ny) {
+  std::vector<double> share(ny, 1.0 / (ny - 1));
+  share.front() = share.back() = 0.5 / (ny - 1);
+  return share;
+}
+
+// The elastica of a cantilever (EI, length L) under a dead transverse tip force
+// P: θ'' = −(P/EI) cos θ, θ(0) = 0, θ'(L) = 0, by shooting on θ'(0) with RK4
+// (4000 steps) and bisection. Returns the tip's {u = L − x, w} (the
+// shortening along the axis and the transverse deflection).
+struct TipDisplacement {
+  double u, w;
+};
+inline TipDisplacement elastica_tip(double P, double EI, double L) {
+  const int steps = 4000;
+  const double h = L / steps, k = P / EI;
+  // State (θ, θ', x, w) along the arc length.
+  auto integrate = [&](double curvature0, double& end_curvature, double& x, double& w) {
+    Eigen::Vector4d y(0.0, curvature0, 0.0, 0.0);
+    auto f = [&](const Eigen::Vector4d& s) {
+      return Eigen::Vector4d(s[1], -k * std::cos(s[0]), std::cos(s[0]), std::sin(s[0]));
+    };
+    for (int i = 0; i < steps; ++i) {
+      const Eigen::Vector4d k1 = f(y), k2 = f(y + 0.5 * h * k1), k3 = f(y + 0.5 * h * k2), k4 = f(y + h * k3);
+      y += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+    }
+    end_curvature = y[1];
+    x = y[2];
+    w = y[3];
+  };
+  // θ'(0) lies in (0, k L]: the root curvature is at most the linear one, P L / EI.
+  double low = 0.0, high = k * L, x = 0.0, w = 0.0, end = 0.0;
+  for (int i = 0; i < 200 && high - low > 1e-15 * k * L; ++i) {
+    const double mid = 0.5 * (low + high);
+    integrate(mid, end, x, w);
+    // θ'(L) rises with θ'(0) here (one root on this bracket for a cantilever).
+    (end > 0.0 ? high : low) = mid;
+  }
+  integrate(0.5 * (low + high), end, x, w);
+  return {L - x, w};
+}
+
+// The tip of a cantilever (EI, length L) bent by an end moment M: a circular
+// arc of radius EI/M; the tip's shortening u and deflection w. M = 2πEI/L
+// closes the circle (u = L, w = 0).
+inline TipDisplacement circle_tip(double M, double EI, double L) {
+  if (M == 0.0) return {0.0, 0.0};
+  const double radius = EI / M;
+  return {L - radius * std::sin(L / radius), radius * (1.0 - std::cos(L / radius))};
+}
+
+// Sze, Liu & Lo (2004), §3.1, cantilever under end shear (L = 10, b = 1,
+// t = 0.1, E = 1.2e6, ν = 0, P_max = 4): the paper's tabulated tip W and −U
+// at P/P_max = 0.05, 0.10, …, 1 (a converged ABAQUS S4R mesh).
+struct TabulatedPoint {
+  double load_factor;  // P / P_max
+  double first, second;
+};
+inline std::vector<TabulatedPoint> sze_end_shear_table() {
+  const double w[] = {0.663, 1.309, 1.922, 2.493, 3.015, 3.488, 3.912, 4.292, 4.631, 4.933,
+                      5.202, 5.444, 5.660, 5.855, 6.031, 6.190, 6.335, 6.467, 6.588, 6.698};
+  const double u[] = {0.026, 0.103, 0.224, 0.381, 0.563, 0.763, 0.971, 1.184, 1.396, 1.604,
+                      1.807, 2.002, 2.190, 2.370, 2.541, 2.705, 2.861, 3.010, 3.151, 3.286};
+  std::vector<TabulatedPoint> table;
+  for (int k = 0; k < 20; ++k) table.push_back({0.05 * (k + 1), w[k], u[k]});
+  return table;
+}
+
+// A cantilever strip (tests' Sze cases) solved at the given load factors: the
+// tip's centre-line shortening −u and deflection |w| at each.
+struct CantileverPoint {
+  double load_factor, u, w;
+};
+enum class EndLoad { shear, moment };
+struct CantileverRun {
+  std::vector<CantileverPoint> points;
+  NewtonReport report;
+  double L = 0.0, EI = 0.0, full_load = 0.0;  // P_max = 4, or M_max = 2πEI/L
+};
+// End shear: L = 10, P_max = 4 along +z. End moment: L = 12, M_max = 2πEI/L
+// about −y (the strip rolls up toward +z). Load steps of at most `step`.
+template <class NonlinearSolver>
+CantileverRun run_cantilever(EndLoad load, int nx, int ny, const std::vector<double>& factors, double step) {
+  CantileverStrip strip = cantilever_strip(load == EndLoad::shear ? 10.0 : 12.0, nx, ny);
+  const std::vector<double> share = edge_shares(ny);
+  const double full = load == EndLoad::shear ? 4.0 : 2.0 * benchmark_pi * strip.EI / strip.L;
+  for (int k = 0; k < ny; ++k) {
+    if (load == EndLoad::shear)
+      strip.conditions.add_force({strip.tip[k]}, Vector3(0.0, 0.0, full * share[k]));
+    else
+      strip.conditions.add_moment({strip.tip[k]}, Vector3(0.0, -full * share[k], 0.0));
+  }
+  NonlinearSolver solver(strip.model, {1.2e6, 0.0});
+  StaticShell<NonlinearSolver> statics(solver, strip.conditions);
+  CantileverRun run{{}, {}, strip.L, strip.EI, full};
+  for (double factor : factors) {
+    statics.solve_to(factor, step);
+    const Vector3 u = statics.displacement(strip.tip_mid);
+    run.points.push_back({factor, -u.x(), std::abs(u.z())});
+  }
+  run.report = statics.report();
+  return run;
+}
+
+// Sze, Liu & Lo (2004), §3.3, slit annular plate: inner radius 6, outer 10,
+// t = 0.03, E = 21e6, ν = 0, clamped along one face of a radial slit, a
+// transverse line force q (q_max = 0.8, P_max = 0.8 × 4 = 3.2) on the other
+// face. The slit's faces are duplicated particles (the grid's first and last
+// rows, at θ = 0 and 2π) separated by a cut (ShellModel::add_cut) run half a
+// spacing past both edges. n_radial × n_circumferential particles.
+struct SlitAnnularPlate {
+  ShellModel model;
+  StaticConditions conditions;
+  int inner, outer;  // points A (r = 6) and B (r = 10) of the loaded face
+};
+inline SlitAnnularPlate slit_annular_plate(int n_radial, int n_circumferential) {
+  const double inner_radius = 6.0, outer_radius = 10.0, t = 0.03, q_max = 0.8;
+  auto surface = [&](double u, double v) {
+    const double r = inner_radius + u * (outer_radius - inner_radius), theta = 2.0 * benchmark_pi * v;
+    return std::make_pair(Vector3(r * std::cos(theta), r * std::sin(theta), 0.0), Vector3::UnitZ());
+  };
+  ShellModel model = structured_surface(n_radial, n_circumferential, surface, t);
+  const double half_spacing = 0.5 * (outer_radius - inner_radius) / (n_radial - 1);
+  model.add_cut({Vector3(inner_radius - half_spacing, 0.0, 0.0), Vector3(outer_radius + half_spacing, 0.0, 0.0)});
+  StaticConditions conditions(model.particle_count());
+  ParticleSet clamped, loaded;
+  for (int i = 0; i < n_radial; ++i) {
+    clamped.push_back(i);
+    loaded.push_back((n_circumferential - 1) * n_radial + i);
+  }
+  conditions.clamp(clamped);
+  const std::vector<double> share = edge_shares(n_radial);
+  const double P_max = q_max * (outer_radius - inner_radius);
+  for (int i = 0; i < n_radial; ++i) conditions.add_force({loaded[i]}, Vector3(0.0, 0.0, P_max * share[i]));
+  return {std::move(model), std::move(conditions), loaded.front(), loaded.back()};
+}
+
+// Its tabulated reference (Sze, Liu & Lo 2004, §3.3, the table of W_A and
+// W_B): P/P_max, W_A (inner), W_B (outer); the paper's points at 0.025 and
+// 0.1 … 1.
+inline std::vector<TabulatedPoint> sze_slit_annular_plate_table() {
+  return {{0.025, 1.305, 1.789}, {0.10, 4.277, 5.876},  {0.20, 6.725, 9.160},  {0.30, 8.340, 11.213},
+          {0.40, 9.529, 12.661}, {0.50, 10.468, 13.768}, {0.60, 11.257, 14.674}, {0.70, 11.970, 15.469},
+          {0.80, 12.642, 16.202}, {0.90, 13.282, 16.886}, {1.00, 13.891, 17.528}};
+}
+
+// The slit plate solved at the table's load factors up to `last_factor`: W_A and W_B at each.
+struct SlitPlateRun {
+  std::vector<TabulatedPoint> points;  // load factor, W_A, W_B
+  NewtonReport report;
+};
+template <class NonlinearSolver>
+SlitPlateRun run_slit_annular_plate(int n_radial, int n_circumferential, double step, double last_factor = 1.0) {
+  SlitAnnularPlate plate = slit_annular_plate(n_radial, n_circumferential);
+  NonlinearSolver solver(plate.model, {21e6, 0.0});
+  StaticShell<NonlinearSolver> statics(solver, plate.conditions);
+  SlitPlateRun run;
+  for (const TabulatedPoint& point : sze_slit_annular_plate_table()) {
+    if (point.load_factor > last_factor + 1e-12) break;
+    statics.solve_to(point.load_factor, step);
+    run.points.push_back(
+        {point.load_factor, statics.displacement(plate.inner).z(), statics.displacement(plate.outer).z()});
+  }
+  run.report = statics.report();
+  return run;
+}
+
+}  // namespace sphshell::test_support

@@ -1,0 +1,441 @@
+#pragma once
+// Static equilibrium of any elastic shell model by Newton's method on a
+// stiffness assembled from the solver's own internal forces (central
+// differences), for the benchmark tests and the shell_benchmarks example. It
+// generalises tests/support/static_plate.hpp from a flat grid's three bending
+// dofs to every model: per particle the free translations and the free
+// rotations of the director (two axes normal to it; drilling is no dof).
+//
+// - A linear solver (options.nonlinear = false) is solved by one Newton step:
+//   the exact equilibrium its dynamic relaxation would reach.
+// - A nonlinear solver is solved by load stepping, a full Newton iteration per
+//   step (the tangent re-assembled at every iteration), and step halving when
+//   an iteration diverges.
+//
+// The assembly perturbs many particles at once. A particle's motion changes
+// the forces only within two support radii (the stress points that see it and
+// the particles those points see), so particles more than four support radii
+// apart in the reference configuration (the approximation is Lagrangian) share
+// a colour and are perturbed together; each response is credited to the one
+// perturbed particle within reach. The colours come from a greedy colouring.
+//
+// Conditions are kept here, not in the solver: held translation directions,
+// held rotation axes, symmetry planes (no translation across the plane, the
+// director kept in it), and dead forces and moments (a moment M does the work
+// M · δθ for a director rotation δθ).
+
+#include <sphshell/core/error.hpp>
+#include <sphshell/core/frame.hpp>
+#include <sphshell/core/types.hpp>
+#include <sphshell/shell/cell.hpp>
+
+#include <Eigen/Dense>
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <functional>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace sphshell::test_support {
+
+// Conditions and dead loads of a static problem, per particle.
+struct StaticConditions {
+  std::vector<std::vector<Vector3>> held_translations;  // directions with zero displacement
+  std::vector<std::vector<Vector3>> held_rotation_axes;  // global axes with zero rotation
+  std::vector<std::vector<Vector3>> symmetry_normals;    // planes the particle lies on
+  std::vector<char> rotations_held;                      // both director rotations held
+  std::vector<Vector3> force;   // N, at load factor 1
+  std::vector<Vector3> moment;  // N·m, at load factor 1
+
+  explicit StaticConditions(std::size_t particles)
+      : held_translations(particles),
+        held_rotation_axes(particles),
+        symmetry_normals(particles),
+        rotations_held(particles, 0),
+        force(particles, Vector3::Zero()),
+        moment(particles, Vector3::Zero()) {}
+
+  void clamp(const ParticleSet& set) {
+    for (int i : set) {
+      held_translations[i] = {Vector3::UnitX(), Vector3::UnitY(), Vector3::UnitZ()};
+      rotations_held[i] = 1;
+    }
+  }
+  void hold_translation(const ParticleSet& set, const Vector3& direction) {
+    for (int i : set) held_translations[i].push_back(direction.normalized());
+  }
+  void hold_rotation(const ParticleSet& set, const Vector3& axis) {
+    for (int i : set) held_rotation_axes[i].push_back(axis.normalized());
+  }
+  void symmetry_plane(const ParticleSet& set, const Vector3& normal) {
+    for (int i : set) {
+      held_translations[i].push_back(normal.normalized());
+      symmetry_normals[i].push_back(normal.normalized());
+    }
+  }
+  void add_force(const ParticleSet& set, const Vector3& f) {
+    for (int i : set) force[i] += f;
+  }
+  void add_moment(const ParticleSet& set, const Vector3& m) {
+    for (int i : set) moment[i] += m;
+  }
+};
+
+struct NewtonOptions {
+  double tolerance = 1e-6;          // ‖residual‖ ≤ tolerance · ‖λ f_ext‖ (thin shells floor near 1e-7)
+  int max_iterations = 25;          // per load step, before the step is halved
+  int max_halvings = 12;            // per load step
+  double translation_step = 1e-7;   // finite-difference step, in units of the model's spacing
+  double rotation_step = 1e-7;      // rad
+  // Perturb one particle at a time (for checking the colouring; slow).
+  bool one_particle_per_colour = false;
+};
+
+struct NewtonReport {
+  int load_steps = 0;         // converged steps, halved ones included
+  int iterations = 0;         // Newton iterations (tangent assemblies) in all
+  long force_evaluations = 0;  // internal-force computations in all
+};
+
+template <class Solver>
+class StaticShell {
+ public:
+  StaticShell(Solver& solver, StaticConditions conditions, NewtonOptions options = {})
+      : solver_(solver), conditions_(std::move(conditions)), options_(options) {
+    const std::size_t n = solver_.particle_count();
+    if (conditions_.force.size() != n) throw std::invalid_argument("StaticShell: conditions sized for another model");
+    const double spacing = solver_.model().maximum_spacing();
+    reach_ = 2.0 * solver_.options().support_radius_factor * spacing;
+    translation_step_ = options_.translation_step * spacing;
+    colour_particles();
+  }
+
+  // Equilibrium at the load factor `lambda`, reached from the current state
+  // in load steps of at most `step` (halved when an iteration diverges).
+  void solve_to(double lambda, double step) {
+    if (!(step > 0.0)) throw std::invalid_argument("StaticShell: the load step must be positive");
+    double increment = std::min(step, lambda - lambda_);
+    int halvings = 0;
+    while (lambda_ < lambda - 1e-12 * std::abs(lambda)) {
+      const double target = std::min(lambda, lambda_ + increment);
+      const std::vector<Vector3> x0 = solver_.positions(), d0 = solver_.directors();
+      predict(target);
+      if (converge(target)) {
+        previous_ = {x0, d0, lambda_};
+        lambda_ = target;
+        ++report_.load_steps;
+        halvings = 0;
+        increment = std::min(step, 1.5 * increment);
+      } else {
+        solver_.set_configuration(x0, d0);
+        ++report_.force_evaluations;
+        increment *= 0.5;
+        if (++halvings > options_.max_halvings)
+          throw std::runtime_error("StaticShell: Newton did not converge at load factor " + std::to_string(target));
+      }
+    }
+  }
+
+  // One Newton step from the current configuration at load factor lambda (the
+  // whole solution of a linear solver).
+  // The stiffness is symmetrised and factorised by LDLᵀ (the linear
+  // stiffness is symmetric; the finite differences leave it so to rounding).
+  // This is K u = f at the reference state: the linear theory's answer. (The
+  // solver's linear option keeps unit directors, so its forces are not exactly
+  // linear in a finite rotation; the step is not iterated.)
+  void linear_solve(double lambda) {
+    lambda_ = lambda;
+    newton_iteration(lambda, Factorisation::symmetric);
+  }
+
+  double load_factor() const { return lambda_; }
+  const NewtonReport& report() const { return report_; }
+  std::size_t colour_count() const { return colours_.size(); }
+  Vector3 displacement(int particle) const {
+    return solver_.positions()[particle] - solver_.model().particle_position[particle];
+  }
+
+ private:
+  struct Dofs {
+    std::vector<Vector3> direction;  // translation (m) or rotation axis (rad) per dof
+    std::vector<char> is_rotation;
+    std::vector<int> first;          // first dof of each particle; first[n] = count
+  };
+
+  // Orthonormal basis of the part of span(ambient) orthogonal to `held`.
+  static std::vector<Vector3> free_basis(const std::vector<Vector3>& ambient, const std::vector<Vector3>& held) {
+    // Remove the held directions (projected into the ambient span), then orthonormalise.
+    std::vector<Vector3> held_in_span;
+    for (const Vector3& h : held) {
+      Vector3 p = Vector3::Zero();
+      for (const Vector3& a : ambient) p += h.dot(a) * a;
+      for (const Vector3& q : held_in_span) p -= p.dot(q) * q;
+      if (p.norm() > 1e-8) held_in_span.push_back(p.normalized());
+    }
+    std::vector<Vector3> result;
+    for (Vector3 v : ambient) {
+      for (const Vector3& q : held_in_span) v -= v.dot(q) * q;
+      for (const Vector3& q : result) v -= v.dot(q) * q;
+      if (v.norm() > 1e-8) result.push_back(v.normalized());
+    }
+    return result;
+  }
+
+  Dofs current_dofs() const {
+    const std::size_t n = solver_.particle_count();
+    Dofs dofs;
+    dofs.first.resize(n + 1);
+    for (std::size_t i = 0; i < n; ++i) {
+      dofs.first[i] = static_cast<int>(dofs.direction.size());
+      for (const Vector3& t : free_basis({Vector3::UnitX(), Vector3::UnitY(), Vector3::UnitZ()},
+                                         conditions_.held_translations[i])) {
+        dofs.direction.push_back(t);
+        dofs.is_rotation.push_back(0);
+      }
+      if (conditions_.rotations_held[i]) continue;
+      const Vector3 d = solver_.directors()[i];
+      const TangentFrame frame = tangent_frame(d);
+      std::vector<Vector3> held = conditions_.held_rotation_axes[i];
+      for (const Vector3& m : conditions_.symmetry_normals[i]) held.push_back(d.cross(m));
+      for (const Vector3& a : free_basis({frame.e1, frame.e2}, held)) {
+        dofs.direction.push_back(a);
+        dofs.is_rotation.push_back(1);
+      }
+    }
+    dofs.first[n] = static_cast<int>(dofs.direction.size());
+    return dofs;
+  }
+
+  // Residual λ f_ext − f_int in the dofs (f_int = ∂Π/∂q).
+  Eigen::VectorXd residual(const Dofs& dofs, double lambda) const {
+    const std::size_t n = solver_.particle_count();
+    Eigen::VectorXd r(dofs.direction.size());
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vector3 moment = solver_.directors()[i].cross(solver_.internal_director_forces()[i]);
+      for (int k = dofs.first[i]; k < dofs.first[i + 1]; ++k) {
+        const Vector3& a = dofs.direction[k];
+        r[k] = dofs.is_rotation[k] ? a.dot(lambda * conditions_.moment[i] - moment)
+                                   : a.dot(lambda * conditions_.force[i] - solver_.internal_forces()[i]);
+      }
+    }
+    return r;
+  }
+
+  double load_norm(const Dofs& dofs, double lambda) const {
+    double sum = 0.0;
+    for (std::size_t i = 0; i + 1 < dofs.first.size(); ++i)
+      for (int k = dofs.first[i]; k < dofs.first[i + 1]; ++k) {
+        const double f = dofs.direction[k].dot(dofs.is_rotation[k] ? conditions_.moment[i] : conditions_.force[i]);
+        sum += f * f;
+      }
+    return std::abs(lambda) * std::sqrt(sum);
+  }
+
+  // Moves particle i by dof k's amount `amount`.
+  static void move(const Dofs& dofs, int k, double amount, Vector3& x, Vector3& d) {
+    if (dofs.is_rotation[k])
+      d = Eigen::AngleAxisd(amount, dofs.direction[k]) * d;
+    else
+      x += amount * dofs.direction[k];
+  }
+
+  void colour_particles() {
+    const std::vector<Vector3>& X = solver_.model().particle_position;
+    const int n = static_cast<int>(X.size());
+    // Neighbours within reach (the owners' search) and within twice that
+    // plus a margin (the colouring's conflicts), by a cell grid.
+    const double conflict = 2.0 * reach_ * 1.05;
+    const double cell = conflict;
+    Vector3 lower = X[0];
+    for (const Vector3& x : X) lower = lower.cwiseMin(x);
+    auto key = [&](const Vector3& x) {
+      return Eigen::Vector3i(static_cast<int>(std::floor((x.x() - lower.x()) / cell)),
+                             static_cast<int>(std::floor((x.y() - lower.y()) / cell)),
+                             static_cast<int>(std::floor((x.z() - lower.z()) / cell)));
+    };
+    std::vector<std::pair<long long, int>> keyed(n);
+    auto code = [](const Eigen::Vector3i& c) {
+      return (static_cast<long long>(c.x()) * 4096 + c.y()) * 4096 + c.z();
+    };
+    for (int i = 0; i < n; ++i) keyed[i] = {code(key(X[i])), i};
+    std::sort(keyed.begin(), keyed.end());
+    auto for_near = [&](int i, double radius, auto&& visit) {
+      const Eigen::Vector3i c = key(X[i]);
+      for (int a = -1; a <= 1; ++a)
+        for (int b = -1; b <= 1; ++b)
+          for (int e = -1; e <= 1; ++e) {
+            const long long k = code(c + Eigen::Vector3i(a, b, e));
+            auto it = std::lower_bound(keyed.begin(), keyed.end(), std::make_pair(k, -1));
+            for (; it != keyed.end() && it->first == k; ++it)
+              if (it->second != i && (X[it->second] - X[i]).norm() <= radius) visit(it->second);
+          }
+    };
+    near_.assign(n, {});
+    std::vector<int> colour(n, -1);
+    for (int i = 0; i < n; ++i) {
+      std::vector<char> used;
+      for_near(i, conflict, [&](int j) {
+        if (colour[j] >= 0) {
+          if (static_cast<int>(used.size()) <= colour[j]) used.resize(colour[j] + 1, 0);
+          used[colour[j]] = 1;
+        }
+      });
+      int c = 0;
+      while (c < static_cast<int>(used.size()) && used[c]) ++c;
+      if (options_.one_particle_per_colour) c = i;
+      colour[i] = c;
+      if (static_cast<int>(colours_.size()) <= c) colours_.resize(c + 1);
+      colours_[c].push_back(i);
+      for_near(i, reach_ * 1.05, [&](int j) { near_[i].push_back(j); });
+      near_[i].push_back(i);
+    }
+  }
+
+  // The Jacobian of the residual's negative (the tangent stiffness) in the dofs.
+  Eigen::SparseMatrix<double> tangent(const Dofs& dofs) {
+    const std::vector<Vector3> x0 = solver_.positions(), d0 = solver_.directors();
+    const int n = static_cast<int>(x0.size());
+    const int count = dofs.first[n];
+    std::vector<Eigen::Triplet<double>> entries;
+    std::vector<int> owner(n, -1);
+    for (const std::vector<int>& members : colours_) {
+      for (int p : members)
+        for (int q : near_[p]) owner[q] = p;
+      for (int local = 0; local < 5; ++local) {
+        bool any = false;
+        for (int p : members) any = any || dofs.first[p] + local < dofs.first[p + 1];
+        if (!any) continue;
+        std::vector<Eigen::VectorXd> forces;
+        for (double sign : {1.0, -1.0}) {
+          std::vector<Vector3> x = x0, d = d0;
+          for (int p : members) {
+            const int k = dofs.first[p] + local;
+            if (k >= dofs.first[p + 1]) continue;
+            move(dofs, k, sign * (dofs.is_rotation[k] ? options_.rotation_step : translation_step_), x[p], d[p]);
+          }
+          solver_.set_configuration(std::move(x), std::move(d));
+          ++report_.force_evaluations;
+          forces.push_back(-residual(dofs, 0.0));
+        }
+        for (int p : members) {
+          const int column = dofs.first[p] + local;
+          if (column >= dofs.first[p + 1]) continue;
+          const double h = dofs.is_rotation[column] ? options_.rotation_step : translation_step_;
+          for (int q : near_[p]) {
+            if (owner[q] != p) continue;
+            for (int row = dofs.first[q]; row < dofs.first[q + 1]; ++row) {
+              const double value = (forces[0][row] - forces[1][row]) / (2.0 * h);
+              if (value != 0.0) entries.emplace_back(row, column, value);
+            }
+          }
+        }
+      }
+      for (int p : members)
+        for (int q : near_[p]) owner[q] = -1;
+    }
+    solver_.set_configuration(x0, d0);
+    ++report_.force_evaluations;
+    Eigen::SparseMatrix<double> k(count, count);
+    k.setFromTriplets(entries.begin(), entries.end());
+    return k;
+  }
+
+  enum class Factorisation { symmetric, general };
+
+  // One Newton update; returns the relative residual before it.
+  double newton_iteration(double lambda, Factorisation factorisation = Factorisation::general) {
+    const Dofs dofs = current_dofs();
+    const Eigen::VectorXd r = residual(dofs, lambda);
+    const double reference = load_norm(dofs, lambda);
+    Eigen::SparseMatrix<double> k = tangent(dofs);
+    k.makeCompressed();
+    Eigen::VectorXd update;
+    if (factorisation == Factorisation::symmetric) {
+      const Eigen::SparseMatrix<double> transposed = k.transpose();
+      const Eigen::SparseMatrix<double> symmetric = 0.5 * (k + transposed);
+      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(symmetric);
+      if (ldlt.info() != Eigen::Success)
+        throw std::runtime_error("StaticShell: the stiffness is singular (a free rigid-body mode?)");
+      update = ldlt.solve(r);
+    } else {
+      Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
+      lu.compute(k);
+      if (lu.info() != Eigen::Success)
+        throw std::runtime_error("StaticShell: the tangent stiffness is singular (a free rigid-body mode?)");
+      update = lu.solve(r);
+    }
+    std::vector<Vector3> x = solver_.positions(), d = solver_.directors();
+    const int n = static_cast<int>(x.size());
+    for (int i = 0; i < n; ++i) {
+      Vector3 rotation = Vector3::Zero();
+      for (int k2 = dofs.first[i]; k2 < dofs.first[i + 1]; ++k2) {
+        if (dofs.is_rotation[k2])
+          rotation += update[k2] * dofs.direction[k2];
+        else
+          x[i] += update[k2] * dofs.direction[k2];
+      }
+      const double angle = rotation.norm();
+      if (angle > 0.0) d[i] = Eigen::AngleAxisd(angle, rotation / angle) * d[i];
+    }
+    solver_.set_configuration(std::move(x), std::move(d));
+    ++report_.force_evaluations;
+    ++report_.iterations;
+    return reference > 0.0 ? r.norm() / reference : r.norm();
+  }
+
+  // The start of a load step: the last two converged states extrapolated
+  // linearly in the load factor (translations, and the director turned on by
+  // the last step's rotation, scaled), else the current state.
+  void predict(double target) {
+    if (previous_.x.empty()) return;
+    const double span = lambda_ - previous_.lambda;
+    if (!(span > 0.0)) return;
+    const double ratio = (target - lambda_) / span;
+    std::vector<Vector3> x = solver_.positions(), d = solver_.directors();
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      x[i] += ratio * (x[i] - previous_.x[i]);
+      const Vector3 axis = previous_.d[i].cross(d[i]);
+      const double angle = std::atan2(axis.norm(), previous_.d[i].dot(d[i]));
+      if (axis.norm() > 1e-14) d[i] = Eigen::AngleAxisd(ratio * angle, axis.normalized()) * d[i];
+    }
+    solver_.set_configuration(std::move(x), std::move(d));
+    ++report_.force_evaluations;
+  }
+
+  bool converge(double lambda) {
+    constexpr double divergence = 1e8;  // a relative residual that no iteration comes back from
+    for (int iteration = 0; iteration < options_.max_iterations; ++iteration) {
+      const Dofs dofs = current_dofs();
+      const double reference = load_norm(dofs, lambda);
+      const double relative = residual(dofs, lambda).norm() / reference;
+      if (!std::isfinite(relative)) return false;
+      if (relative <= options_.tolerance) return true;
+      if (relative > divergence) return false;
+      newton_iteration(lambda);
+    }
+    return false;
+  }
+
+  Solver& solver_;
+  StaticConditions conditions_;
+  NewtonOptions options_;
+  double reach_ = 0.0;
+  double translation_step_ = 0.0;
+  double lambda_ = 0.0;
+  struct Converged {
+    std::vector<Vector3> x, d;
+    double lambda = 0.0;
+  } previous_;  // the converged state before the current one
+  std::vector<std::vector<int>> colours_;
+  std::vector<std::vector<int>> near_;  // particles within reach of each particle (itself included)
+  NewtonReport report_;
+};
+
+}  // namespace sphshell::test_support

@@ -1,0 +1,179 @@
+// The standard shell benchmarks (issue 11), solved statically by Newton's
+// method on the solver's own forces (tests/support/static_shell.hpp; the cases
+// in tests/support/shell_benchmarks.hpp). The README's table and charts come
+// from the shell_benchmarks example, which runs the same cases one refinement
+// finer. Tolerances are the error measured at each case's finest resolution
+// here plus a small margin (the README lists the measurements).
+#include "support/shell_benchmarks.hpp"
+
+#include <sphshell/material/elastic.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/gauss.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <tuple>
+#include <vector>
+#include <algorithm>
+
+using namespace sphshell;
+using namespace sphshell::test_support;
+
+namespace {
+
+// Gauss<2> integrates the linear theory's stresses (linear through the
+// thickness) exactly; the nonlinear strains are quadratic in ζ, so Gauss<3>.
+using LinearSolver = Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<2>, material::Elastic>;
+using NonlinearSolver = Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<3>, material::Elastic>;
+
+double linear_benchmark(const StaticBenchmark& benchmark, NewtonOptions newton = {}) {
+  SolverOptions options;
+  options.nonlinear = false;
+  LinearSolver solver(benchmark.model, {benchmark.E, benchmark.nu}, options);
+  StaticShell<LinearSolver> statics(solver, benchmark.conditions, newton);
+  statics.linear_solve(1.0);
+  return reported_displacement(benchmark, solver);
+}
+
+double error_percent(double value, double reference) { return 100.0 * (value / reference - 1.0); }
+
+// Runs a linear benchmark at each resolution, prints the errors, and returns
+// the error at the last (finest) one.
+template <class Build>
+double linear_convergence(const char* name, Build&& build, std::initializer_list<int> resolutions) {
+  double error = 0.0;
+  for (int n : resolutions) {
+    const StaticBenchmark benchmark = build(n);
+    const double value = linear_benchmark(benchmark);
+    error = error_percent(value, benchmark.reference);
+    std::printf("%s, %d x %d particles: %.6g (reference %.6g, %+.2f %%)\n", name, n, n, value, benchmark.reference,
+                error);
+  }
+  return error;
+}
+
+}  // namespace
+
+TEST_CASE("Static shell: the coloured stiffness assembly equals one particle at a time", "[static][benchmarks]") {
+  // A coarse pinched hemisphere (curved, symmetry planes, point loads): the
+  // colouring perturbs many particles at once and credits each response to
+  // the one in reach; it must give the same solution as perturbing each
+  // particle alone.
+  const StaticBenchmark benchmark = pinched_hemisphere(9, PointLoad::shape_functions);
+  NewtonOptions alone;
+  alone.one_particle_per_colour = true;
+  const double coloured = linear_benchmark(benchmark);
+  const double reference = linear_benchmark(benchmark, alone);
+  CHECK(coloured == Approx(reference).epsilon(1e-6));
+}
+
+TEST_CASE("Static shell: the elastica by shooting matches the tabulated cantilever", "[static][benchmarks]") {
+  // Sze, Liu & Lo (2004), §3.1, the cantilever under end shear (L = 10,
+  // EI = 100, P_max = 4), their Table 1 at P = P_max: W = 6.698, −U = 3.286
+  // (a converged S4R mesh). The elastica here is the exact beam answer.
+  const TipDisplacement tip = elastica_tip(4.0, 100.0, 10.0);
+  CHECK(tip.w == Approx(6.698).epsilon(5e-4));
+  CHECK(tip.u == Approx(3.286).epsilon(2e-3));
+  // Small loads: the linear tip deflection P L³ / (3 EI).
+  const TipDisplacement small = elastica_tip(1e-4, 100.0, 10.0);
+  CHECK(small.w == Approx(1e-4 * 1000.0 / 300.0).epsilon(1e-6));
+}
+
+TEST_CASE("Benchmark: Scordelis-Lo roof (linear)", "[validation][benchmarks]") {
+  // Reference 0.3024 (MacNeal & Harder 1985). Measured −0.49 % at 33 x 33
+  // (+0.09 % at 17, −0.33 % at 25; −0.54 % at 41 in the example).
+  const double error = linear_convergence("Scordelis-Lo roof", scordelis_lo_roof, {17, 25, 33});
+  CHECK(std::abs(error) < 0.75);
+}
+
+TEST_CASE("Benchmark: pinched hemisphere with an 18 degree hole (linear)", "[validation][benchmarks]") {
+  // Reference 0.094 (MacNeal & Harder 1985); point loads applied consistently
+  // through the shape functions. Measured −0.34 % at 33 x 33 (−1.87 % at 25).
+  const double error = linear_convergence(
+      "Pinched hemisphere", [](int n) { return pinched_hemisphere(n, PointLoad::shape_functions); }, {25, 33});
+  CHECK(std::abs(error) < 0.6);
+}
+
+TEST_CASE("Benchmark: pinched cylinder with rigid diaphragms (linear, a known miss)", "[validation][benchmarks]") {
+  // Reference 1.8248e-5 (MacNeal & Harder 1985). Measured +3.98 % at 33 x 33
+  // (+3.61 % at 25; +3.70 / +3.37 % at 41 / 49 in the example): above the
+  // 2 % target, converging slowly from above (README, "Benchmarks").
+  const double error = linear_convergence(
+      "Pinched cylinder", [](int n) { return pinched_cylinder(n, PointLoad::shape_functions); }, {25, 33});
+  CHECK(std::abs(error) < 4.5);
+}
+
+TEST_CASE("Benchmark: cantilever under end shear (Sze, Liu & Lo 2004, nonlinear)", "[validation][benchmarks]") {
+  // The tip's w and −u against the elastica (exact for this ν = 0 strip) at
+  // P/P_max = 0.1 … 1. Measured at 41 x 5: largest error +0.11 % (w) and
+  // +0.14 % (u), at P_max; 21 x 3: +0.26 / +0.32 %.
+  std::vector<double> factors;
+  for (int k = 1; k <= 10; ++k) factors.push_back(0.1 * k);
+  for (const auto& [nx, ny, tolerance] : {std::tuple{21, 3, 0.4}, std::tuple{41, 5, 0.2}}) {
+    const CantileverRun run = run_cantilever<NonlinearSolver>(EndLoad::shear, nx, ny, factors, 0.1);
+    double worst_w = 0.0, worst_u = 0.0;
+    for (const CantileverPoint& point : run.points) {
+      const TipDisplacement exact = elastica_tip(point.load_factor * run.full_load, run.EI, run.L);
+      worst_w = std::max(worst_w, std::abs(error_percent(point.w, exact.w)));
+      worst_u = std::max(worst_u, std::abs(error_percent(point.u, exact.u)));
+    }
+    const CantileverPoint& last = run.points.back();
+    std::printf("Cantilever end shear, %d x %d: at P_max w = %.5g, -u = %.5g; largest error %.3f %% (w), %.3f %% (u); "
+                "%d Newton iterations\n",
+                nx, ny, last.w, last.u, worst_w, worst_u, run.report.iterations);
+    CHECK(worst_w < tolerance);
+    CHECK(worst_u < tolerance);
+  }
+}
+
+TEST_CASE("Benchmark: cantilever rolled into a circle by an end moment (Sze, Liu & Lo 2004, nonlinear)",
+          "[validation][benchmarks]") {
+  // M = k · 2πEI/L bends the strip into an arc of radius EI/M; at k = 1 the
+  // tip is back at the root. Measured at 49 x 5: half circle (k = 0.5) −u
+  // +0.28 %, w −0.23 %; full circle: the tip 1.16 % of L from the closed form
+  // (25 x 3: 4.7 %), converging at second order.
+  std::vector<double> factors;
+  for (int k = 1; k <= 20; ++k) factors.push_back(0.05 * k);
+  for (const auto& [nx, ny, tolerance] : {std::tuple{25, 3, 5.0}, std::tuple{49, 5, 1.4}}) {
+    const CantileverRun run = run_cantilever<NonlinearSolver>(EndLoad::moment, nx, ny, factors, 0.05);
+    const CantileverPoint& half = run.points[9];
+    const TipDisplacement half_exact = circle_tip(0.5 * run.full_load, run.EI, run.L);
+    const CantileverPoint& full = run.points.back();
+    const double miss = std::hypot(full.u - run.L, full.w) / run.L * 100.0;
+    std::printf("Cantilever end moment, %d x %d: half circle -u %+.2f %%, w %+.2f %%; full circle: tip %.2f %% of L "
+                "from the root; %d Newton iterations\n",
+                nx, ny, error_percent(half.u, half_exact.u), error_percent(half.w, half_exact.w), miss,
+                run.report.iterations);
+    CHECK(miss < tolerance);
+    if (nx == 49) {
+      CHECK(std::abs(error_percent(half.u, half_exact.u)) < 0.5);
+      CHECK(std::abs(error_percent(half.w, half_exact.w)) < 0.5);
+    }
+  }
+}
+
+TEST_CASE("Benchmark: slit annular plate under end shear (Sze, Liu & Lo 2004, nonlinear)", "[validation][benchmarks]") {
+  // W_A (inner) and W_B (outer) of the loaded face against the paper's table
+  // (§3.3) at P/P_max = 0.025, 0.1 … 1; the slit is a cut between duplicated
+  // particles. Here 9 x 46 particles up to P_max / 2 (the whole path takes
+  // ≈ 5 min): measured largest error −1.99 % (W_B at P_max / 2); to P_max it
+  // grows to −3.16 % (W_A), and at 11 x 61 the error at P_max / 2 is −0.87 %
+  // (README, shell_benchmarks).
+  constexpr int radial = 9, circumferential = 46;
+  const SlitPlateRun run = run_slit_annular_plate<NonlinearSolver>(radial, circumferential, 0.025, 0.5);
+  const std::vector<TabulatedPoint> table = sze_slit_annular_plate_table();
+  double worst = 0.0;
+  for (std::size_t k = 0; k < run.points.size(); ++k) {
+    worst = std::max({worst, std::abs(error_percent(run.points[k].first, table[k].first)),
+                      std::abs(error_percent(run.points[k].second, table[k].second))});
+  }
+  const TabulatedPoint& last = run.points.back();
+  const TabulatedPoint& reference = table[run.points.size() - 1];
+  std::printf("Slit annular plate, %d x %d: at P/P_max = %.2f W_A = %.4g (%+.2f %%), W_B = %.4g (%+.2f %%); largest "
+              "error over the table %.2f %%; %d Newton iterations\n",
+              radial, circumferential, last.load_factor, last.first, error_percent(last.first, reference.first),
+              last.second, error_percent(last.second, reference.second), worst, run.report.iterations);
+  CHECK(worst < 2.3);
+}
