@@ -65,7 +65,7 @@ bool mentions(const test_support::Vtu& vtu, const std::string& text) {
 
 }  // namespace
 
-TEST_CASE("Frames draw the shell as cells; removed stress points leave gaps", "[io][output][frames]") {
+TEST_CASE("Frames draw the shell as cells, and removed stress points leave gaps", "[io][output][frames]") {
   ScratchDirectory scratch("frames_cells");
   const std::string directory = (scratch / "frames").string();
   CrackSolver solver = pulled_strip(exact_frames(directory));

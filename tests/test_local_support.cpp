@@ -189,7 +189,7 @@ TEST_CASE("Graded plate: each row's support is support_radius_factor times its o
 // spacing) the 1:2 fine-centre plate was +1.5 % and the 1:2 coarse-centre
 // plate +67 % at 21 × 21. Stronger coarse-centre grading is a known miss
 // (README, Known limits): 1:3 +28 %, 1:4 +76 % at 21 × 21, +91 % at 41 × 41.
-TEST_CASE("Graded clamped plates (1:2, 1:4 fine centre; 1:2 coarse centre) at 41 x 41: static centre deflection "
+TEST_CASE("Graded clamped plates (1:2 and 1:4 fine centre, 1:2 coarse centre) at 41 x 41: static centre deflection "
           "within 2 % of Mindlin",
           "[solver][plate][local_support][validation]") {
   constexpr int cells = 40;

@@ -145,7 +145,7 @@ TEST_CASE("A strip cut across its width is two pieces: a free body and the canti
   CHECK(difference <= 1e-12 * largest);
 }
 
-TEST_CASE("The clamped piece of a cut strip bends as a cantilever; the free piece stays at rest", "[cuts][solver]") {
+TEST_CASE("The clamped piece of a cut strip bends as a cantilever, and the free piece stays at rest", "[cuts][solver]") {
   // ν = 0, so the strip bends as a beam: tip deflection P L³ / (3 E I) under
   // an end load P, shear deformation adding 0.6 (d/L)² of it (< 0.1 % here).
   const Strip beam{21, 6, 5, 0.025, 0.02};
