@@ -4,7 +4,13 @@
 // (docs/method.md, "Support radius"), so that one large cell widens its own
 // row and not every row of the sheet:
 //   stress point q: Δ_q = √(area per particle of its own cell) (the quad's
-//     area, twice a triangle's; ShellModel::stress_point_spacing);
+//     area, twice a triangle's; ShellModel::stress_point_spacing), or its
+//     distance to its cell's farthest corner if that is larger. The second
+//     term keeps the cell's corners inside the row (the edge-tied shear needs
+//     them) on a distorted cell: the corner cells of ShellModel::spherical_cap
+//     (an interior angle near 175°) have their corners at 2.02 √A; on a
+//     square cell the farthest corner lies at 0.71 √A, on the O-grid cap's
+//     cells at most 0.94 √A, so it changes nothing there;
 //   particle i of a model with cells: the largest, over the cells it is a
 //     corner of, of the cell's √(area per particle) and of its distance to
 //     the cell's farthest corner over √2. The second term is the spacing
@@ -69,6 +75,12 @@ inline LocalSpacing local_spacing(const ShellModel& model) {
     const double sqrt2 = std::sqrt(2.0);
     for (std::size_t c = 0; c < model.cells().size(); ++c) {
       const Cell& cell = model.cells()[c];
+      const double cell_spacing = model.stress_point_spacing(c);
+      double corner_reach = 0.0;
+      for (int k : cell)
+        corner_reach = std::max(
+            corner_reach, (model.particle_position[static_cast<std::size_t>(k)] - model.stress_point_position[c]).norm());
+      spacing.stress_point[c] = std::max(cell_spacing, corner_reach);
       for (int i : cell) {
         double farthest = 0.0;
         for (int k : cell)
@@ -76,7 +88,7 @@ inline LocalSpacing local_spacing(const ShellModel& model) {
                                          model.particle_position[static_cast<std::size_t>(i)])
                                             .norm());
         double& target = spacing.particle[static_cast<std::size_t>(i)];
-        target = std::max({target, spacing.stress_point[c], farthest / sqrt2});
+        target = std::max({target, cell_spacing, farthest / sqrt2});
       }
     }
     return spacing;
