@@ -272,16 +272,7 @@ class DistributedSolver {
 
   // One step on every rank (collective). A step that stopped with an Error
   // leaves a half-updated state: later steps refuse with that error.
-  void step() {
-    if (!failure_.empty()) throw Error(failure_);
-    try {
-      advance();
-    } catch (const Error& error) {
-      failure_ = "sphshell: the solver stopped at step " + std::to_string(steps_) +
-                 " and cannot go on from its half-updated state; the error was: " + error.what();
-      throw;
-    }
-  }
+  void step() { latch_.run(steps_, [&] { advance(); }); }
   // Steps until t_end, as Solver::run_until (collective).
   void run_until(double t_end) {
     collectively(comm_, [&] {
@@ -658,7 +649,7 @@ class DistributedSolver {
   double time_ = 0.0;
   long steps_ = 0;
   bool forces_current_ = false;
-  std::string failure_;
+  solver::StepLatch latch_;
 };
 
 }  // namespace sphshell::mpi
