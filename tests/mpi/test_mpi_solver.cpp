@@ -16,6 +16,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <vector>
@@ -225,4 +226,75 @@ TEST_CASE("Distributed solver: an Error on one rank stops every rank with the se
     out_of_range = error.what();
   }
   CHECK(out_of_range.find("out of range") != std::string::npos);
+}
+
+TEST_CASE("Distributed checkpoint: a restart continues bitwise; files of another save or rank count are an Error",
+          "[mpi][solver][checkpoint]") {
+  const mpi::Communicator comm;
+  using J2 = material::J2Plasticity;
+  // A low yield stress, so that the plastic states the file must carry change within the run.
+  const J2::Parameters steel{steel_E, steel_nu, 20e6, steel_Ep};
+  SolverOptions options;
+  options.density = 7850.0;
+  const ShellModel model = plate();
+  namespace fs = std::filesystem;
+  const std::string folder =
+      (fs::temp_directory_path() / ("sphshell_test_mpi_checkpoint_np" + std::to_string(comm.size()))).string();
+  if (comm.is_root()) fs::create_directories(folder);
+  comm.all_gather(0);  // the folder exists before any rank writes
+  const std::string first = folder + "/at40", second = folder + "/at80";
+
+  // The run that saves: 40 steps, save, 40 steps, save, 40 steps.
+  Distributed<J2> original(comm, model, steel, options);
+  clamped_pressure(original, 2e6);
+  for (int n = 0; n < 40; ++n) original.step();
+  original.save_checkpoint(first);
+  for (int n = 0; n < 40; ++n) original.step();
+  original.save_checkpoint(second);
+  for (int n = 0; n < 40; ++n) original.step();
+  const std::vector<Vector3> positions = original.positions(), velocities = original.velocities();
+  const EnergyReport energy = original.energy();
+
+  // A fresh solver from the first file continues bitwise (80 more steps).
+  Distributed<J2> restarted(comm, model, steel, options);
+  clamped_pressure(restarted, 2e6);
+  restarted.load_checkpoint(first);
+  CHECK(restarted.steps() == 40);
+  for (int n = 0; n < 80; ++n) restarted.step();
+  CHECK(restarted.steps() == original.steps());
+  CHECK(differing_components(restarted.positions(), positions) == 0);
+  CHECK(differing_components(restarted.velocities(), velocities) == 0);
+  const EnergyReport again = restarted.energy();
+  CHECK(again.kinetic == energy.kinetic);
+  CHECK(again.internal == energy.internal);
+  CHECK(again.external_work == energy.external_work);
+  CHECK(energy.plastic_dissipation > 0.01 * energy.internal);  // the plastic states were restored too
+
+  // A file that does not exist: an Error on every rank, the solver still usable.
+  Distributed<J2> fresh(comm, model, steel, options);
+  clamped_pressure(fresh, 2e6);
+  CHECK_THROWS_WITH(fresh.load_checkpoint(folder + "/missing"), Catch::Contains("cannot open"));
+  CHECK_NOTHROW(fresh.step());
+
+  if (comm.size() > 1) {
+    // The files of one rank count loaded on another (each rank alone here).
+    const mpi::Communicator alone(MPI_COMM_SELF);
+    Distributed<J2> single(alone, model, steel, options);
+    CHECK_THROWS_WITH(single.load_checkpoint(first),
+                      Catch::Contains("rank count differ (checkpoint: " + std::to_string(comm.size()) +
+                                      ", this solver: 1)"));
+    // Rank files of different saves: the last rank's file of the first save
+    // replaced by its file of the second.
+    comm.all_gather(0);
+    if (comm.is_root())
+      fs::copy_file(second + ".rank" + std::to_string(comm.size() - 1),
+                    first + ".rank" + std::to_string(comm.size() - 1), fs::copy_options::overwrite_existing);
+    comm.all_gather(0);
+    Distributed<J2> mixed(comm, model, steel, options);
+    clamped_pressure(mixed, 2e6);
+    CHECK_THROWS_WITH(mixed.load_checkpoint(first), Catch::Contains("were written by different saves"));
+    CHECK_THROWS_WITH(mixed.step(), Catch::Contains("loading a checkpoint failed part-way"));
+  }
+  comm.all_gather(0);
+  if (comm.is_root()) fs::remove_all(folder);
 }

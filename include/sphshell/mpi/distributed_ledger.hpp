@@ -103,6 +103,23 @@ class DistributedLedger {
     return report;
   }
 
+  // Checkpoints (DistributedSolver::save_checkpoint): this rank's
+  // accumulators, exactly. The per-particle terms and remembered velocities
+  // are rewritten by every step before use.
+  template <class Writer>
+  void save(Writer& out) const {
+    for (const ExactSum* sum : {&internal_, &previous_internal_, &external_work_, &damping_work_, &kinetic_})
+      out(sum->raw());
+  }
+  template <class Reader>
+  void load(Reader& in) {
+    for (ExactSum* sum : {&internal_, &previous_internal_, &external_work_, &damping_work_, &kinetic_}) {
+      ExactSum::Raw raw{};
+      in(raw);
+      *sum = ExactSum::from_raw(raw);
+    }
+  }
+
   // The serial check (solver::EnergyLedger::check_balance) on the reduced
   // books: every rank decides alike, and when the balance is lost they find
   // the particle of largest kinetic energy together (ties: the lowest global

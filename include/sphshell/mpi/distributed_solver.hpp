@@ -48,15 +48,20 @@
 #include <sphshell/mpi/halo.hpp>
 #include <sphshell/mpi/layout.hpp>
 #include <sphshell/mpi/partition.hpp>
+#include <sphshell/io/binary_stream.hpp>
 #include <sphshell/solver.hpp>
+#include <sphshell/solver/checkpoint.hpp>
 
+#include <array>
 #include <chrono>
+#include <cstring>
 #include <ctime>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <memory>
 #include <optional>
+#include <random>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -273,6 +278,98 @@ class DistributedSolver {
   // One step on every rank (collective). A step that stopped with an Error
   // leaves a half-updated state: later steps refuse with that error.
   void step() { latch_.run(steps_, [&] { advance(); }); }
+  // Checkpoints (collective). Each rank writes its own file, `path` + ".rank"
+  // + its rank (the Solver's format, solver/checkpoint.hpp, replaced
+  // atomically): its particles, forces, rows, section states and exact energy
+  // books, the whole crack set, the step count, Δt, the step latch and the
+  // frame and probe schedules, with a stamp of the save shared by all ranks.
+  // A DistributedSolver of the same policies, model, material, options and
+  // rank count that loads them continues bit for bit as the saving one would
+  // have. An Error on every rank names a file of another rank count, rank,
+  // model, material or options (nothing loaded: the solver stays usable), or
+  // files of different saves, or a damaged file (the solver then refuses to
+  // step). Conditions and loads stay as the loading solver has them; add
+  // probes after loading (their files start at the restart).
+  std::string checkpoint_file(const std::string& path) const { return path + ".rank" + std::to_string(comm_.rank()); }
+
+  void save_checkpoint(const std::string& path) const {
+    std::uint64_t stamp = 0;
+    if (comm_.is_root())
+      stamp = static_cast<std::uint64_t>(std::random_device{}()) << 32 ^
+              static_cast<std::uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count());
+    stamp = comm_.all_gather(stamp).front();
+    collectively(comm_, [&] {
+      io::BinaryWriter out;
+      out.begin_section("IDNT");
+      out(identity());
+      out.end_section();
+      out.begin_section("TIME");
+      out(stamp, start_time_, static_cast<std::int64_t>(steps_), time_step_, time_, forces_current_, latch_.message());
+      out.end_section();
+      out.begin_section("PART");
+      particles_.save(out);
+      out.end_section();
+      out.begin_section("FORC");
+      forces_.save(out);
+      out.end_section();
+      out.begin_section("PNTS");
+      points_->save(out);
+      if constexpr (Crack::enabled) all_points_->save(out);
+      out.end_section();
+      out.begin_section("SECT");
+      states_->save(out);
+      out.end_section();
+      out.begin_section("FRAC");
+      fracture_.save(out);
+      out.end_section();
+      out.begin_section("ENRG");
+      ledger_->save(out);
+      out.end_section();
+      out.begin_section("STEP");
+      if constexpr (!std::is_empty_v<Stepper>) stepper_.save(out);
+      out.end_section();
+      out.begin_section("OUTP");
+      frames_.save(out);
+      out(next_probe_time_);
+      out.end_section();
+      solver::checkpoint::write_file(checkpoint_file(path), policies(), out);
+    });
+  }
+
+  void load_checkpoint(const std::string& path) {
+    const std::string file_path = checkpoint_file(path);
+    // 1. Each rank's file and its identity; nothing changes yet.
+    std::optional<io::BinaryReader> reader;
+    collectively(comm_, [&] {
+      if (!probes_.empty())
+        throw Error("sphshell: load_checkpoint: " + std::to_string(probes_.size()) +
+                    " probe(s) were added before it; a distributed run adds its probes after loading a checkpoint");
+      reader.emplace(solver::checkpoint::read_file(file_path, policies()));
+      solver::checkpoint::Identity file;
+      reader->open_section("IDNT");
+      (*reader)(file);
+      reader->close_section();
+      solver::checkpoint::check_identity(file, identity(), file_path);
+    });
+    // 2. The state; a failure from here on leaves every rank stopped.
+    std::uint64_t stamp = 0;
+    try {
+      collectively(comm_, [&] { load_state(*reader, stamp); });
+      const std::vector<std::uint64_t> stamps = comm_.all_gather(stamp);
+      const std::vector<std::int64_t> steps = comm_.all_gather(static_cast<std::int64_t>(steps_));
+      for (std::size_t r = 1; r < stamps.size(); ++r)
+        if (stamps[r] != stamps[0])
+          throw Error("sphshell: checkpoint files '" + path + ".rank0' (step " + std::to_string(steps[0]) + ") and '" +
+                      path + ".rank" + std::to_string(r) + "' (step " + std::to_string(steps[r]) +
+                      ") were written by different saves");
+    } catch (const Error& error) {
+      latch_.close(std::string("sphshell: loading a checkpoint failed part-way, so this solver's state is mixed and "
+                               "it cannot step; the error was: ") +
+                   error.what());
+      throw;
+    }
+  }
+
   // Steps until t_end, as Solver::run_until (collective).
   void run_until(double t_end) {
     collectively(comm_, [&] {
@@ -364,7 +461,9 @@ class DistributedSolver {
     const DecompositionInput input = decomposition_input(model_, all_points);
     partition_ = partition(input, comm_.size(), weights);
     layout_ = rank_layout(input, partition_, comm_.rank());
-    points_.emplace(all_points.subset(layout_.computed, layout_.local_of, layout_.local_count()));
+    model_point_count_ = all_points.size();
+    model_slot_count_ = all_points.slot_count();
+    points_.emplace(local_points(all_points));
     std::vector<std::size_t> computed_points;
     for (solver::PointGroup group : solver::point_groups) {
       const std::size_t g = solver::index_of(group);
@@ -422,6 +521,78 @@ class DistributedSolver {
     if (steps_ != 0)
       sphshell::detail::invalid_parameter(what, steps_,
                                           "a distributed run takes prescribed motions before its first step");
+  }
+
+  // This rank's rows of the whole model's.
+  Points local_points(const Points& all_points) const {
+    return all_points.subset(layout_.computed, layout_.local_of, layout_.local_count());
+  }
+
+  static std::array<std::string, 5> policies() {
+    return solver::checkpoint::policy_names<Approx, Rule, Material, Crack, Stepper>();
+  }
+  // What a rank's checkpoint file must agree on with the solver loading it:
+  // the Solver's identity (the whole model's counts) and the rank count and rank.
+  solver::checkpoint::Identity identity() const {
+    solver::checkpoint::Identity id;
+    id.counts = {{"rank count", static_cast<std::uint64_t>(comm_.size())},
+                 {"rank", static_cast<std::uint64_t>(comm_.rank())},
+                 {"particle count", static_cast<std::uint64_t>(model_.particle_count())},
+                 {"stress point count", static_cast<std::uint64_t>(model_.stress_point_count())},
+                 {"integration point count", static_cast<std::uint64_t>(model_point_count_)},
+                 {"shape-function slot count", static_cast<std::uint64_t>(model_slot_count_)}};
+    id.model = solver::checkpoint::model_fingerprints(model_);
+    id.material = solver::checkpoint::material_constants(law_);
+    id.options = solver::checkpoint::result_options(options_, time_step_);
+    return id;
+  }
+
+  // The sections after IDNT (load_checkpoint).
+  void load_state(io::BinaryReader& in, std::uint64_t& stamp) {
+    // Rows a crack rebuilt here since construction go back to the model's.
+    bool rebuilt = points_->any_rebuilt();
+    if constexpr (Crack::enabled) rebuilt = rebuilt || all_points_->any_rebuilt();
+    if (rebuilt) {
+      const Points fresh(model_, options_.physics(), options_.particle_integration(), law_.shear_modulus());
+      points_.emplace(local_points(fresh));
+      if constexpr (Crack::enabled) all_points_.emplace(fresh);
+    }
+    assembler_.emplace(options_.nonlinear, *points_);
+    std::int64_t steps = 0;
+    in.open_section("TIME");
+    in(stamp, start_time_, steps, time_step_, time_, forces_current_, latch_.message());
+    in.close_section();
+    steps_ = static_cast<long>(steps);
+    const double time = start_time_ + static_cast<double>(steps_) * time_step_;
+    if (std::memcmp(&time, &time_, sizeof time) != 0)
+      in.fail("its time " + solver::number_text(time_) + " s is not t0 + n dt = " + solver::number_text(time) + " s");
+    in.open_section("PART");
+    particles_.load(in);
+    in.close_section();
+    in.open_section("FORC");
+    forces_.load(in);
+    in.close_section();
+    in.open_section("PNTS");
+    points_->load(in, layout_.local_count());
+    if constexpr (Crack::enabled) all_points_->load(in, model_.particle_count());
+    in.close_section();
+    in.open_section("SECT");
+    states_->load(in);
+    in.close_section();
+    in.open_section("FRAC");
+    fracture_.load(in);
+    in.close_section();
+    in.open_section("ENRG");
+    ledger_->load(in);
+    in.close_section();
+    in.open_section("STEP");
+    if constexpr (!std::is_empty_v<Stepper>) stepper_.load(in);
+    in.close_section();
+    in.open_section("OUTP");
+    frames_.load(in);
+    in(next_probe_time_);
+    in.close_section();
+    if (!in.at_end()) in.fail("there are bytes after its last section");
   }
 
   StepTime now() const { return {steps_, time_}; }
@@ -643,6 +814,7 @@ class DistributedSolver {
   static constexpr double negligible_rotation_sine = 1e-300;
   // As the serial output's probe schedule (solver/output.hpp).
   static constexpr double probe_schedule_tolerance = 1e-9;
+  std::size_t model_point_count_ = 0, model_slot_count_ = 0;  // the whole model's (checkpoint identity)
   double stable_time_step_ = 0.0;
   double time_step_ = 0.0;
   double start_time_ = 0.0;
