@@ -375,8 +375,10 @@ class DistributedSolver {
     collectively(comm_, [&] {
       solver::check_run_end(t_end, solver::RunPosition{time_, time_step_, steps_}, options_.max_steps_per_run);
     });
+    progress_.start_run(now(), t_end);
     while (time_ < t_end - 0.5 * time_step_) step();
     if (frames_.writes_on_schedule() && frames_.last_frame_step() != steps_) write_frame();
+    progress_.end_run();
   }
 
   double time() const { return time_; }
@@ -629,6 +631,11 @@ class DistributedSolver {
       const EnergyReport report = energy();
       ledger_->check_balance(comm_, now(), report, [&](std::size_t i) { return layout_.global_of(i); });
     }
+    // The Solver's progress line, from the reduced books, written by rank 0.
+    if (progress_.is_due(steps_)) {
+      const EnergyReport report = energy();
+      if (comm_.is_root()) progress_.write(now(), report);
+    }
     write_scheduled();
   }
 
@@ -808,6 +815,7 @@ class DistributedSolver {
   ExternalLoads loads_;
   CommunicationCounters counters_;
   DistributedFrames frames_;
+  solver::ProgressReporter progress_{options_.monitoring()};
   std::vector<DistributedProbe> probes_;
   double next_probe_time_ = 0.0;
   // As the Solver's: below this the reference and current directors are parallel.
