@@ -189,11 +189,14 @@ class DistributedFrames {
   double next_frame_time_ = 0.0;
 };
 
-// A particle probe on the rank owning the particle.
+// A probe of a particle or a stress point, its file on the rank owning it.
 struct DistributedProbe {
-  int particle = 0;
+  enum class Kind { particle, stress_point };
+  Kind kind = Kind::particle;
+  int index = 0;  // global particle or stress point index
   std::string path;
   std::unique_ptr<io::CsvProbe> file;  // on the owner only
+  std::size_t local_point = 0;         // a stress point's local point (owner only)
 };
 
 }  // namespace sphshell::mpi

@@ -233,15 +233,33 @@ class DistributedSolver {
   void add_particle_probe(const std::string& csv_path, int particle) {
     collectively(comm_, [&] {
       solver::checked_set({particle}, model_.particle_count());
-      for (const DistributedProbe& probe : probes_)
-        if (probe.path == csv_path)
-          throw Error("sphshell: probe file '" + csv_path + "' is already the file of another probe; give each probe "
-                      "a file of its own");
-      DistributedProbe probe{particle, csv_path, nullptr};
+      require_new_probe_file(csv_path);
+      DistributedProbe probe{DistributedProbe::Kind::particle, particle, csv_path, nullptr};
       if (owns(particle)) {
         probe.file = std::make_unique<io::CsvProbe>(csv_path, solver::ParticleProbe{particle}.columns());
-        probe.file->write_row(solver::ParticleProbe{particle}.row(OwnedView{*this}));
+        write_probe_row(probe);
       }
+      probes_.push_back(std::move(probe));
+    });
+  }
+  // CSV history of one stress point (Solver::add_stress_point_probe's columns
+  // and schedule: t, then the equivalent stress, equivalent plastic strain
+  // and damage at each thickness output point), written by the rank that
+  // owns the stress point. Collective.
+  void add_stress_point_probe(const std::string& csv_path, int stress_point) {
+    collectively(comm_, [&] {
+      if (stress_point < 0 || static_cast<std::size_t>(stress_point) >= model_.stress_point_count())
+        sphshell::detail::invalid_parameter("stress point index", stress_point, "out of range");
+      require_new_probe_file(csv_path);
+      DistributedProbe probe{DistributedProbe::Kind::stress_point, stress_point, csv_path, nullptr};
+      const std::vector<std::size_t>& rows = layout_.computed[solver::index_of(solver::PointGroup::stress_points)];
+      for (std::size_t k = 0; k < rows.size(); ++k)
+        if (rows[k] == static_cast<std::size_t>(stress_point) &&
+            layout_.computed_is_owned[solver::index_of(solver::PointGroup::stress_points)][k]) {
+          probe.local_point = points_->point(solver::PointGroup::stress_points, k);
+          probe.file = std::make_unique<io::CsvProbe>(csv_path, stress_probe(stress_point).columns());
+          write_probe_row(probe);
+        }
       probes_.push_back(std::move(probe));
     });
   }
@@ -649,7 +667,7 @@ class DistributedSolver {
     }
     if (!probes_.empty() && time_ >= next_probe_time_ - probe_schedule_tolerance * time_step_) {
       for (DistributedProbe& probe : probes_)
-        if (probe.file) probe.file->write_row(solver::ParticleProbe{probe.particle}.row(OwnedView{*this}));
+        if (probe.file) write_probe_row(probe);
       next_probe_time_ = time_ + options_.probe_interval;
     }
   }
@@ -679,6 +697,33 @@ class DistributedSolver {
       return axis / sine * std::atan2(sine, from.dot(to));
     }
   };
+  // What solver::StressPointProbe reads, for a stress point owned here.
+  struct StressPointView {
+    const DistributedSolver& solver;
+    std::size_t local_point;
+    double time() const { return solver.time_; }
+    double integral_point_quantity(solver::IntegralPointQuantity quantity, int, int k) const {
+      return solver.states_->quantity(quantity, local_point, k);
+    }
+  };
+  static constexpr int output_points = thickness::Section<Rule, Material>::output_points;
+  static solver::StressPointProbe<output_points> stress_probe(int stress_point) {
+    solver::StressPointProbe<output_points> probe(stress_point);
+    probe.point_names = solver::thickness_point_names<Rule>();
+    return probe;
+  }
+  void write_probe_row(DistributedProbe& probe) const {
+    if (probe.kind == DistributedProbe::Kind::particle)
+      probe.file->write_row(solver::ParticleProbe{probe.index}.row(OwnedView{*this}));
+    else
+      probe.file->write_row(stress_probe(probe.index).row(StressPointView{*this, probe.local_point}));
+  }
+  void require_new_probe_file(const std::string& csv_path) const {
+    for (const DistributedProbe& probe : probes_)
+      if (probe.path == csv_path)
+        throw Error("sphshell: probe file '" + csv_path + "' is already the file of another probe; give each probe "
+                    "a file of its own");
+  }
   bool owns(int global) const {
     const int k = layout_.local_of[static_cast<std::size_t>(global)];
     return k >= 0 && static_cast<std::size_t>(k) < layout_.owned_count();
