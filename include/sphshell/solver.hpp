@@ -157,22 +157,10 @@ class Solver {
   void prescribe_displacement(const ParticleSet& set, DisplacementFunction displacement) {
     static_assert(std::is_invocable_r_v<Vector3, DisplacementFunction, const Vector3&, double>,
                   "prescribe_displacement: the function must be callable as Vector3 u(const Vector3& X, double t)");
-    for (int i : checked(set)) {
-      const Vector3 start = displacement(model_.particle_position[i], time_);
-      if (steps_ == 0 && start.norm() > 0.0)
-        detail::invalid_parameter("prescribed displacement at t = 0, particle " + std::to_string(i),
-                                  start.transpose(), "must be zero: the run starts from the reference configuration");
-      // Added mid-run, u(X, t) must continue from where the particle is: a jump
-      // would be imposed as one step's velocity (a shock).
-      const Vector3 now = particles_.position[i] - model_.particle_position[i];
-      const double allowed = solver::prescribed_jump_tolerance * std::max(now.norm(), model_.minimum_spacing());
-      if (steps_ > 0 && !((start - now).norm() <= allowed))
-        detail::invalid_parameter("prescribed displacement at t = " + solver::number_text(time_) + " s, particle " +
-                                      std::to_string(i),
-                                  start.transpose(),
-                                  "must equal the particle's displacement now (" + solver::vector_text(now) +
-                                      "): a prescribed motion added mid-run continues from the current state");
-    }
+    for (int i : checked(set))
+      solver::check_prescribed_displacement_start(i, displacement(model_.particle_position[i], time_),
+                                                  particles_.position[i] - model_.particle_position[i], time_, steps_,
+                                                  model_.minimum_spacing());
     add_motion(set, std::make_unique<detail::PrescribedDisplacement<DisplacementFunction>>(std::move(displacement)));
   }
   // Prescribed velocity v(X, t) imposed on all three translations of the set.

@@ -338,3 +338,59 @@ TEST_CASE("Distributed progress line: rank 0 writes the Solver's lines with the 
     CHECK(written.empty());
   }
 }
+
+TEST_CASE("Distributed prescribed motions added mid-run: the serial run, and the serial Error on a jump",
+          "[mpi][solver]") {
+  const mpi::Communicator comm;
+  SolverOptions options;
+  options.density = 7850.0;
+  const ShellModel model = plate();
+  Serial<material::Elastic> serial(model, {steel_E, steel_nu}, options);
+  Distributed<material::Elastic> distributed(comm, model, {steel_E, steel_nu}, options);
+  serial.clamp(model.set("x_min"));
+  distributed.clamp("x_min");
+  // At rest for 20 steps, then the far edge pulled from where it is (zero
+  // displacement) and a transverse velocity on the middle row.
+  for (int n = 0; n < 20; ++n) {
+    serial.step();
+    distributed.step();
+  }
+  const double t1 = serial.time();
+  auto pull = [t1](const Vector3&, double t) { return Vector3(0.5 * (t - t1), 0.0, 0.0); };
+  auto lift = [](const Vector3&, double) { return Vector3(0.0, 0.0, 0.3); };
+  ParticleSet middle;
+  for (std::size_t i = 0; i < model.particle_count(); ++i)
+    if (std::abs(model.particle_position[i].y() - 0.25) < 1e-9 && model.particle_position[i].x() > 0.1 &&
+        model.particle_position[i].x() < 0.4)
+      middle.push_back(static_cast<int>(i));
+  REQUIRE(!middle.empty());
+  serial.prescribe_displacement(model.set("x_max"), pull);
+  distributed.prescribe_displacement("x_max", pull);
+  serial.prescribe_velocity(middle, lift);
+  distributed.prescribe_velocity(middle, lift);
+  for (int n = 0; n < 40; ++n) {
+    serial.step();
+    distributed.step();
+  }
+  CHECK(differing_components(distributed.positions(), serial.positions()) == 0);
+  CHECK(differing_components(distributed.velocities(), serial.velocities()) == 0);
+  CHECK(serial.displacement(model.set("x_max").front()).x() > 0.0);
+
+  // A displacement that does not continue from the particles' own (the pulled
+  // edge is not at 1 mm): the serial message on every rank, naming the first
+  // particle of the set.
+  auto jump = [](const Vector3&, double) { return Vector3(1e-3, 0.0, 0.0); };
+  std::string serial_message, message;
+  try {
+    serial.prescribe_displacement(model.set("y_max"), jump);
+  } catch (const Error& error) {
+    serial_message = error.what();
+  }
+  try {
+    distributed.prescribe_displacement("y_max", jump);
+  } catch (const Error& error) {
+    message = error.what();
+  }
+  REQUIRE(!serial_message.empty());
+  CHECK(message == serial_message);
+}

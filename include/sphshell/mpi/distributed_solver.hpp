@@ -143,14 +143,13 @@ class DistributedSolver {
       constraints_.fix_rotation(local, axis);
     });
   }
-  // Prescribed velocity v(X, t) on all three translations (before the first
-  // step; the function is copied, once for the check of the whole set).
+  // Prescribed velocity v(X, t) on all three translations (the function is
+  // copied, once for the check of the whole set).
   template <class VelocityFunction>
   void prescribe_velocity(const ParticleSet& set, VelocityFunction velocity) {
     static_assert(std::is_invocable_r_v<Vector3, VelocityFunction, const Vector3&, double>,
                   "prescribe_velocity: the function must be callable as Vector3 v(const Vector3& X, double t)");
     on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
-      require_start("prescribe_velocity");
       checker_.add_motion(global, std::make_unique<sphshell::detail::PrescribedVelocity<VelocityFunction>>(velocity),
                           model_.particle_position, time_, time_step_);
       constraints_.add_motion(local, std::make_unique<sphshell::detail::PrescribedVelocity<VelocityFunction>>(velocity),
@@ -162,18 +161,36 @@ class DistributedSolver {
     static_assert(std::is_invocable_r_v<Vector3, DisplacementFunction, const Vector3&, double>,
                   "prescribe_displacement: the function must be callable as Vector3 u(const Vector3& X, double t)");
     on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
-      require_start("prescribe_displacement");
-      for (int i : global) {
-        const Vector3 start = displacement(model_.particle_position[i], time_);
-        if (start.norm() > 0.0)
-          sphshell::detail::invalid_parameter("prescribed displacement at t = 0, particle " + std::to_string(i),
-                                              start.transpose(),
-                                              "must be zero: the run starts from the reference configuration");
+      // The Solver's check (solver::check_prescribed_displacement_start), by
+      // the owner of each particle; the failure first in the set's order
+      // wins, as in the serial loop.
+      std::optional<Failure> failure;
+      for (std::size_t k = 0; k < global.size() && !failure; ++k) {
+        const int i = global[k];
+        if (!owns(i)) continue;
+        const auto at = static_cast<std::size_t>(layout_.local_of[static_cast<std::size_t>(i)]);
+        try {
+          solver::check_prescribed_displacement_start(i, displacement(model_.particle_position[i], time_),
+                                                      particles_.position[at] - reference_position_[at], time_,
+                                                      steps_, model_.minimum_spacing());
+        } catch (const Error& error) {
+          failure = Failure{static_cast<long>(k), error.what()};
+        }
       }
+      agree(failure);
       using Motion = sphshell::detail::PrescribedDisplacement<DisplacementFunction>;
       checker_.add_motion(global, std::make_unique<Motion>(displacement), model_.particle_position, time_, time_step_);
       constraints_.add_motion(local, std::make_unique<Motion>(displacement), reference_position_, time_, time_step_);
     });
+  }
+
+  template <class VelocityFunction>
+  void prescribe_velocity(const std::string& set_name, VelocityFunction velocity) {
+    prescribe_velocity(named(set_name), std::move(velocity));
+  }
+  template <class DisplacementFunction>
+  void prescribe_displacement(const std::string& set_name, DisplacementFunction displacement) {
+    prescribe_displacement(named(set_name), std::move(displacement));
   }
 
   // Loads on a set of global ids or a named set (shell/loads.hpp).
@@ -536,11 +553,6 @@ class DistributedSolver {
     ParticleSet members;
     collectively(comm_, [&] { members = model_.set(set_name); });
     return members;
-  }
-  void require_start(const char* what) const {
-    if (steps_ != 0)
-      sphshell::detail::invalid_parameter(what, steps_,
-                                          "a distributed run takes prescribed motions before its first step");
   }
 
   // This rank's rows of the whole model's.
