@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <new>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -328,4 +329,31 @@ TEST_CASE("The progress line goes to the stream the user chose, with the end tim
   for (int n = 0; n < 10; ++n) solver.step();
   CHECK(progress.str().find("step 50  t = ") == 0);
   CHECK(progress.str().find(" of ") == std::string::npos);
+}
+
+TEST_CASE("StepLatch: a step that fails (an Error or out of memory) closes it, later steps refuse", "[core]") {
+  solver::StepLatch latch;
+  long steps = 6;
+  int runs = 0;
+  latch.run(steps, [&] { ++runs; });
+  CHECK(runs == 1);
+  CHECK_FALSE(latch.closed());
+  SECTION("out of memory becomes a named Error") {
+    try {
+      latch.run(steps, [&] { ++steps; throw std::bad_alloc(); });
+      FAIL("no Error");
+    } catch (const Error& error) {
+      CHECK(std::string(error.what()) == "sphshell: out of memory (std::bad_alloc) in step 7");
+    }
+  }
+  SECTION("an Error is rethrown as it is and kept with the step") {
+    CHECK_THROWS_WITH(latch.run(steps, [] { throw Error("unstable"); }), "unstable");
+    CHECK(latch.message() ==
+          "sphshell: the solver stopped at step 6 and cannot go on from its half-updated state; the error was: unstable");
+  }
+  CHECK(latch.closed());
+  const std::string kept = latch.message();
+  CHECK_THROWS_WITH(latch.run(steps, [&] { ++runs; }), kept);
+  CHECK_THROWS_WITH(latch.check(), kept);
+  CHECK(runs == 1);
 }

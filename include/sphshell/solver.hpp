@@ -42,6 +42,7 @@
 #include <sphshell/solver/section_states.hpp>
 #include <sphshell/solver/stable_time_step.hpp>
 #include <sphshell/solver/static_solution.hpp>
+#include <sphshell/solver/step_latch.hpp>
 #include <sphshell/stepper/central_difference.hpp>
 #include <sphshell/stepper/stepper.hpp>
 #include <sphshell/thickness/section.hpp>
@@ -156,22 +157,10 @@ class Solver {
   void prescribe_displacement(const ParticleSet& set, DisplacementFunction displacement) {
     static_assert(std::is_invocable_r_v<Vector3, DisplacementFunction, const Vector3&, double>,
                   "prescribe_displacement: the function must be callable as Vector3 u(const Vector3& X, double t)");
-    for (int i : checked(set)) {
-      const Vector3 start = displacement(model_.particle_position[i], time_);
-      if (steps_ == 0 && start.norm() > 0.0)
-        detail::invalid_parameter("prescribed displacement at t = 0, particle " + std::to_string(i),
-                                  start.transpose(), "must be zero: the run starts from the reference configuration");
-      // Added mid-run, u(X, t) must continue from where the particle is: a jump
-      // would be imposed as one step's velocity (a shock).
-      const Vector3 now = particles_.position[i] - model_.particle_position[i];
-      const double allowed = solver::prescribed_jump_tolerance * std::max(now.norm(), model_.minimum_spacing());
-      if (steps_ > 0 && !((start - now).norm() <= allowed))
-        detail::invalid_parameter("prescribed displacement at t = " + solver::number_text(time_) + " s, particle " +
-                                      std::to_string(i),
-                                  start.transpose(),
-                                  "must equal the particle's displacement now (" + solver::vector_text(now) +
-                                      "): a prescribed motion added mid-run continues from the current state");
-    }
+    for (int i : checked(set))
+      solver::check_prescribed_displacement_start(i, displacement(model_.particle_position[i], time_),
+                                                  particles_.position[i] - model_.particle_position[i], time_, steps_,
+                                                  model_.minimum_spacing());
     add_motion(set, std::make_unique<detail::PrescribedDisplacement<DisplacementFunction>>(std::move(displacement)));
   }
   // Prescribed velocity v(X, t) imposed on all three translations of the set.
@@ -266,17 +255,7 @@ class Solver {
   // (an instability) leaves a half-updated state: every later step() refuses
   // with that error.
   void step() {
-    if (!failure_.empty()) throw Error(failure_);
-    try {
-      advance();
-    } catch (const Error& error) {
-      failure_ = "sphshell: the solver stopped at step " + std::to_string(steps_) +
-                 " and cannot go on from its half-updated state; the error was: " + error.what();
-      throw;
-    } catch (const std::bad_alloc&) {
-      failure_ = "sphshell: out of memory (std::bad_alloc) in step " + std::to_string(steps_);
-      throw Error(failure_);
-    }
+    latch_.run(steps_, [&] { advance(); });
     // Outside the latch: the state is whole, a failed write leaves the solver usable.
     if constexpr (can_checkpoint)
       if (checkpoints_.is_due(steps_)) {
@@ -300,7 +279,7 @@ class Solver {
     out(identity());
     out.end_section();
     out.begin_section("TIME");
-    out(start_time_, static_cast<std::int64_t>(steps_), time_step_, time_, forces_current_, failure_);
+    out(start_time_, static_cast<std::int64_t>(steps_), time_step_, time_, forces_current_, latch_.message());
     out.end_section();
     out.begin_section("PART");
     particles_.save(out);
@@ -358,7 +337,7 @@ class Solver {
       assembler_ = solver::InternalForceAssembler(options_.nonlinear, points_);
       std::int64_t steps = 0;
       in.open_section("TIME");
-      in(start_time_, steps, time_step_, time_, forces_current_, failure_);
+      in(start_time_, steps, time_step_, time_, forces_current_, latch_.message());
       in.close_section();
       steps_ = static_cast<long>(steps);
       const double time = start_time_ + static_cast<double>(steps_) * time_step_;
@@ -390,9 +369,9 @@ class Solver {
       in.close_section();
       if (!in.at_end()) in.fail("there are bytes after its last section");
     } catch (const Error& error) {
-      failure_ = std::string("sphshell: loading a checkpoint failed part-way, so this solver's state is mixed and it "
-                             "cannot step; the error was: ") +
-                 error.what();
+      latch_.close(std::string("sphshell: loading a checkpoint failed part-way, so this solver's state is mixed and "
+                               "it cannot step; the error was: ") +
+                   error.what());
       throw;
     }
     checkpoints_.written(steps_);
@@ -462,7 +441,7 @@ class Solver {
   // parameters) leaves the solver as it was before the call.
   template <class Observer>
   solver::StaticResult solve_static(const solver::StaticParameters& parameters, Observer&& observer) {
-    if (!failure_.empty()) throw Error(failure_);
+    latch_.check();
     solver::validate(parameters);
     const double load_time = std::isnan(parameters.load_time) ? time_ : parameters.load_time;
     const solver::ParticleState start = particles_;
@@ -692,7 +671,7 @@ class Solver {
   double time_ = 0.0;
   long steps_ = 0;
   bool forces_current_ = false;
-  std::string failure_;  // the error that stopped step(); later steps refuse with it
+  solver::StepLatch latch_;  // the error that stopped step(); later steps refuse with it
 };
 
 }  // namespace sphshell

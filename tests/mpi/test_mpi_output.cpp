@@ -1,8 +1,8 @@
 // Output of a distributed run (docs/distributed.md, "Output"): one .vtu piece
 // per rank, a .pvtu per frame and one .pvd series, read back with VTK's own
 // parallel reader (tests/mpi/check_pvtu.py, when a Python with VTK was found
-// at configure time); probe CSVs written by the rank owning the particle,
-// byte for byte the serial Solver's probe of the same particle.
+// at configure time); probe CSVs written by the rank owning the particle or
+// stress point, byte for byte the serial Solver's probe of the same one.
 #include <sphshell/approx/mls.hpp>
 #include <sphshell/kernel/cubic_spline.hpp>
 #include <sphshell/material/elastic.hpp>
@@ -53,12 +53,19 @@ TEST_CASE("Distributed frames and probes", "[mpi][output]") {
   const double end_time = 5e-5;
   // The probed particles: the first particle each rank owns (every one on
   // another rank for all but one rank), and a corner.
-  std::vector<int> probed;
+  std::vector<int> probed, probed_stress_points;
   {
     Distributed layout_only(comm, model, {210e9, 0.3}, options);
     probed = comm.all_gather(layout_only.layout().owned.front());
+    // Likewise the first stress point each rank owns.
+    const mpi::RankLayout& layout = layout_only.layout();
+    int first_owned = -1;
+    for (std::size_t k = 0; k < layout.computed[0].size() && first_owned < 0; ++k)
+      if (layout.computed_is_owned[0][k]) first_owned = static_cast<int>(layout.computed[0][k]);
+    probed_stress_points = comm.all_gather(first_owned);
   }
   probed.push_back(static_cast<int>(model.particle_count()) - 1);
+  probed_stress_points.push_back(static_cast<int>(model.stress_point_count()) - 1);
   std::vector<Vector3> serial_positions;
   {
     Serial serial(model, {210e9, 0.3}, options);
@@ -67,6 +74,10 @@ TEST_CASE("Distributed frames and probes", "[mpi][output]") {
     for (std::size_t k = 0; k < probed.size(); ++k)
       serial.add_particle_probe(directory + "/serial/probe_" + std::to_string(comm.rank()) + "_" + std::to_string(k) + ".csv",
                                 probed[k]);
+    for (std::size_t k = 0; k < probed_stress_points.size(); ++k)
+      serial.add_stress_point_probe(directory + "/serial/stress_probe_" + std::to_string(comm.rank()) + "_" +
+                                        std::to_string(k) + ".csv",
+                                    probed_stress_points[k]);
     serial.run_until(end_time);
     serial_positions = serial.positions();
   }
@@ -79,9 +90,17 @@ TEST_CASE("Distributed frames and probes", "[mpi][output]") {
     distributed.add_uniform_pressure(model.all_particles(), 5e5);
     for (std::size_t k = 0; k < probed.size(); ++k)
       distributed.add_particle_probe(directory + "/probe_" + std::to_string(k) + ".csv", probed[k]);
-    // The same file twice is an Error on every rank.
+    for (std::size_t k = 0; k < probed_stress_points.size(); ++k)
+      distributed.add_stress_point_probe(directory + "/stress_probe_" + std::to_string(k) + ".csv",
+                                         probed_stress_points[k]);
+    // The same file twice, or a stress point out of range, is an Error on every rank.
     CHECK_THROWS_WITH(distributed.add_particle_probe(directory + "/probe_0.csv", 3),
                       Catch::Contains("already the file of another probe"));
+    CHECK_THROWS_WITH(distributed.add_stress_point_probe(directory + "/probe_0.csv", 3),
+                      Catch::Contains("already the file of another probe"));
+    CHECK_THROWS_WITH(distributed.add_stress_point_probe(directory + "/other.csv",
+                                                         static_cast<int>(model.stress_point_count())),
+                      Catch::Contains("stress point index"));
     distributed.run_until(end_time);
     CHECK(distributed.positions() == serial_positions);
   }
@@ -93,6 +112,14 @@ TEST_CASE("Distributed frames and probes", "[mpi][output]") {
     INFO("probe " << k << " of particle " << probed[k]);
     CHECK(!serial.empty());
     CHECK(mine == serial);  // every rank reads the file the owner wrote
+  }
+  for (std::size_t k = 0; k < probed_stress_points.size(); ++k) {
+    const std::string mine = file_text(directory + "/stress_probe_" + std::to_string(k) + ".csv");
+    const std::string serial = file_text(directory + "/serial/stress_probe_" + std::to_string(comm.rank()) + "_" +
+                                         std::to_string(k) + ".csv");
+    INFO("probe " << k << " of stress point " << probed_stress_points[k]);
+    CHECK(serial.find('\n') < serial.size() - 1);  // a header and rows
+    CHECK(mine == serial);
   }
   // Frames at 0, 1e-5, ..., 5e-5 s: six, each with one piece per rank.
   std::size_t pieces = 0;

@@ -14,9 +14,12 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <functional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -225,4 +228,169 @@ TEST_CASE("Distributed solver: an Error on one rank stops every rank with the se
     out_of_range = error.what();
   }
   CHECK(out_of_range.find("out of range") != std::string::npos);
+}
+
+TEST_CASE("Distributed checkpoint: a restart continues bitwise; files of another save or rank count are an Error",
+          "[mpi][solver][checkpoint]") {
+  const mpi::Communicator comm;
+  using J2 = material::J2Plasticity;
+  // A low yield stress, so that the plastic states the file must carry change within the run.
+  const J2::Parameters steel{steel_E, steel_nu, 20e6, steel_Ep};
+  SolverOptions options;
+  options.density = 7850.0;
+  const ShellModel model = plate();
+  namespace fs = std::filesystem;
+  const std::string folder =
+      (fs::temp_directory_path() / ("sphshell_test_mpi_checkpoint_np" + std::to_string(comm.size()))).string();
+  if (comm.is_root()) fs::create_directories(folder);
+  comm.all_gather(0);  // the folder exists before any rank writes
+  const std::string first = folder + "/at40", second = folder + "/at80";
+
+  // The run that saves: 40 steps, save, 40 steps, save, 40 steps.
+  Distributed<J2> original(comm, model, steel, options);
+  clamped_pressure(original, 2e6);
+  for (int n = 0; n < 40; ++n) original.step();
+  original.save_checkpoint(first);
+  for (int n = 0; n < 40; ++n) original.step();
+  original.save_checkpoint(second);
+  for (int n = 0; n < 40; ++n) original.step();
+  const std::vector<Vector3> positions = original.positions(), velocities = original.velocities();
+  const EnergyReport energy = original.energy();
+
+  // A fresh solver from the first file continues bitwise (80 more steps).
+  Distributed<J2> restarted(comm, model, steel, options);
+  clamped_pressure(restarted, 2e6);
+  restarted.load_checkpoint(first);
+  CHECK(restarted.steps() == 40);
+  for (int n = 0; n < 80; ++n) restarted.step();
+  CHECK(restarted.steps() == original.steps());
+  CHECK(differing_components(restarted.positions(), positions) == 0);
+  CHECK(differing_components(restarted.velocities(), velocities) == 0);
+  const EnergyReport again = restarted.energy();
+  CHECK(again.kinetic == energy.kinetic);
+  CHECK(again.internal == energy.internal);
+  CHECK(again.external_work == energy.external_work);
+  CHECK(energy.plastic_dissipation > 0.01 * energy.internal);  // the plastic states were restored too
+
+  // A file that does not exist: an Error on every rank, the solver still usable.
+  Distributed<J2> fresh(comm, model, steel, options);
+  clamped_pressure(fresh, 2e6);
+  CHECK_THROWS_WITH(fresh.load_checkpoint(folder + "/missing"), Catch::Contains("cannot open"));
+  CHECK_NOTHROW(fresh.step());
+
+  if (comm.size() > 1) {
+    // The files of one rank count loaded on another (each rank alone here).
+    const mpi::Communicator alone(MPI_COMM_SELF);
+    Distributed<J2> single(alone, model, steel, options);
+    CHECK_THROWS_WITH(single.load_checkpoint(first),
+                      Catch::Contains("rank count differ (checkpoint: " + std::to_string(comm.size()) +
+                                      ", this solver: 1)"));
+    // Rank files of different saves: the last rank's file of the first save
+    // replaced by its file of the second.
+    comm.all_gather(0);
+    if (comm.is_root())
+      fs::copy_file(second + ".rank" + std::to_string(comm.size() - 1),
+                    first + ".rank" + std::to_string(comm.size() - 1), fs::copy_options::overwrite_existing);
+    comm.all_gather(0);
+    Distributed<J2> mixed(comm, model, steel, options);
+    clamped_pressure(mixed, 2e6);
+    CHECK_THROWS_WITH(mixed.load_checkpoint(first), Catch::Contains("were written by different saves"));
+    CHECK_THROWS_WITH(mixed.step(), Catch::Contains("loading a checkpoint failed part-way"));
+  }
+  comm.all_gather(0);
+  if (comm.is_root()) fs::remove_all(folder);
+}
+
+TEST_CASE("Distributed progress line: rank 0 writes the Solver's lines with the reduced books", "[mpi][solver]") {
+  const mpi::Communicator comm;
+  std::ostringstream serial_lines, lines;
+  SolverOptions options;
+  options.density = 7850.0;
+  options.progress_interval = 10;
+  options.progress_stream = &serial_lines;
+  Serial<material::Elastic> serial(plate(), {steel_E, steel_nu}, options);
+  clamped_pressure(serial, 5e5);
+  options.progress_stream = &lines;
+  Distributed<material::Elastic> distributed(comm, plate(), {steel_E, steel_nu}, options);
+  clamped_pressure(distributed, 5e5);
+  const double end = 50.5 * serial.time_step();
+  serial.run_until(end);
+  distributed.run_until(end);
+  // Each line without its wall-clock part (rate and ETA): step, time, share, books.
+  auto without_clock = [](const std::string& text) {
+    std::istringstream in(text);
+    std::string line, kept;
+    while (std::getline(in, line)) {
+      const std::size_t clock = line.find(" %)");
+      const std::size_t books = line.find("  kinetic");
+      kept += line.substr(0, clock + 3) + line.substr(books) + "\n";
+    }
+    return kept;
+  };
+  const std::string written = lines.str();
+  if (comm.is_root()) {
+    REQUIRE(std::count(written.begin(), written.end(), '\n') == 5);
+    CHECK(written.find("step 50  t = ") != std::string::npos);
+    // The distributed books are the serial ones to within their rounding
+    // (1e-12 relative, printed to 4 digits): the lines agree.
+    CHECK(without_clock(written) == without_clock(serial_lines.str()));
+  } else {
+    CHECK(written.empty());
+  }
+}
+
+TEST_CASE("Distributed prescribed motions added mid-run: the serial run, and the serial Error on a jump",
+          "[mpi][solver]") {
+  const mpi::Communicator comm;
+  SolverOptions options;
+  options.density = 7850.0;
+  const ShellModel model = plate();
+  Serial<material::Elastic> serial(model, {steel_E, steel_nu}, options);
+  Distributed<material::Elastic> distributed(comm, model, {steel_E, steel_nu}, options);
+  serial.clamp(model.set("x_min"));
+  distributed.clamp("x_min");
+  // At rest for 20 steps, then the far edge pulled from where it is (zero
+  // displacement) and a transverse velocity on the middle row.
+  for (int n = 0; n < 20; ++n) {
+    serial.step();
+    distributed.step();
+  }
+  const double t1 = serial.time();
+  auto pull = [t1](const Vector3&, double t) { return Vector3(0.5 * (t - t1), 0.0, 0.0); };
+  auto lift = [](const Vector3&, double) { return Vector3(0.0, 0.0, 0.3); };
+  ParticleSet middle;
+  for (std::size_t i = 0; i < model.particle_count(); ++i)
+    if (std::abs(model.particle_position[i].y() - 0.25) < 1e-9 && model.particle_position[i].x() > 0.1 &&
+        model.particle_position[i].x() < 0.4)
+      middle.push_back(static_cast<int>(i));
+  REQUIRE(!middle.empty());
+  serial.prescribe_displacement(model.set("x_max"), pull);
+  distributed.prescribe_displacement("x_max", pull);
+  serial.prescribe_velocity(middle, lift);
+  distributed.prescribe_velocity(middle, lift);
+  for (int n = 0; n < 40; ++n) {
+    serial.step();
+    distributed.step();
+  }
+  CHECK(differing_components(distributed.positions(), serial.positions()) == 0);
+  CHECK(differing_components(distributed.velocities(), serial.velocities()) == 0);
+  CHECK(serial.displacement(model.set("x_max").front()).x() > 0.0);
+
+  // A displacement that does not continue from the particles' own (the pulled
+  // edge is not at 1 mm): the serial message on every rank, naming the first
+  // particle of the set.
+  auto jump = [](const Vector3&, double) { return Vector3(1e-3, 0.0, 0.0); };
+  std::string serial_message, message;
+  try {
+    serial.prescribe_displacement(model.set("y_max"), jump);
+  } catch (const Error& error) {
+    serial_message = error.what();
+  }
+  try {
+    distributed.prescribe_displacement("y_max", jump);
+  } catch (const Error& error) {
+    message = error.what();
+  }
+  REQUIRE(!serial_message.empty());
+  CHECK(message == serial_message);
 }

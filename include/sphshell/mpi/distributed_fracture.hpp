@@ -70,6 +70,10 @@ class DistributedFracture {
   const ExactSum& released_energy() const { return released_energy_; }
   bool is_fragment(std::size_t) const { return false; }
   std::size_t fragment_count() const { return 0; }
+  template <class Writer>
+  void save(Writer&) const {}
+  template <class Reader>
+  void load(Reader&) {}
 
  private:
   Crack crack_;
@@ -174,6 +178,27 @@ class DistributedFracture<Crack, true> {
   }
   // Whether a stress point still integrates (on any rank).
   bool stress_point_active(std::size_t q) const { return stress_point_active_[q] != 0; }
+
+  // Checkpoints (DistributedSolver::save_checkpoint): the crack set and the
+  // flags, the same on every rank, and this rank's released energy.
+  template <class Writer>
+  void save(Writer& out) const {
+    crack_.save(out);
+    out(fragment_, stress_point_active_, static_cast<std::uint64_t>(damaged_stress_points_),
+        static_cast<std::uint64_t>(precrack_stress_points_), released_energy_.raw());
+  }
+  template <class Reader>
+  void load(Reader& in) {
+    crack_.load(in);
+    in.read_exact(fragment_, "fragment flags");
+    in.read_exact(stress_point_active_, "stress point flags");
+    std::uint64_t damaged = 0, precrack = 0;
+    ExactSum::Raw released{};
+    in(damaged, precrack, released);
+    damaged_stress_points_ = static_cast<std::size_t>(damaged);
+    precrack_stress_points_ = static_cast<std::size_t>(precrack);
+    released_energy_ = ExactSum::from_raw(released);
+  }
 
  private:
   enum class Rebuild : char { skipped, rebuilt, cut_loose };

@@ -31,7 +31,6 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <sstream>
 #include <vector>
 
 namespace sphshell::mpi {
@@ -64,37 +63,18 @@ class DistributedLedger {
       : monitoring_(monitoring),
         round_off_energy_(youngs_modulus * volume * solver::EnergyLedger::round_off_strain_squared) {}
 
-  void remember_velocities(const solver::ParticleState& state) {
-    old_velocity_ = state.velocity;
-    old_angular_velocity_ = state.angular_velocity;
-  }
-  void remember_free_velocities(const solver::ParticleState& state) { free_velocity_ = state.velocity; }
+  void remember_velocities(const solver::ParticleState& state) { terms_.remember_velocities(state); }
+  void remember_free_velocities(const solver::ParticleState& state) { terms_.remember_free_velocities(state); }
 
-  // The serial book_step's terms, owned particles only.
+  // The serial book_step's terms (solver::ParticleEnergyTerms), owned particles only.
   void book_step(const stepper::StepContext& context, const solver::ParticleState& state,
                  const solver::Inertia& inertia, const solver::ParticleForces& forces) {
-    const double dt = context.velocity_step;
-    const double c = context.damping;
-    const std::size_t owned = state.ranges.owned_end;
-    external_term_.resize(owned);
-    damping_term_.resize(owned);
-    kinetic_term_.resize(owned);
-    parallel::for_each(state.ranges.owned_begin, owned, [&](std::size_t i) noexcept {
-      const Vector3 average = 0.5 * (old_velocity_[i] + state.velocity[i]);
-      const Vector3 average_angular = 0.5 * (old_angular_velocity_[i] + state.angular_velocity[i]);
-      const Vector3 reaction = inertia.mass[i] * (state.velocity[i] - free_velocity_[i]) / dt;
-      external_term_[i] = dt * (forces.external[i] + reaction).dot(average) +
-                          dt * forces.external_moment[i].dot(average_angular);
-      damping_term_[i] = dt * c * inertia.mass[i] * average.squaredNorm() +
-                         dt * c * inertia.rotary_inertia[i] * average_angular.squaredNorm();
-      kinetic_term_[i] = 0.5 * inertia.mass[i] * state.velocity[i].squaredNorm() +
-                         0.5 * inertia.rotary_inertia[i] * state.angular_velocity[i].squaredNorm();
-    });
+    terms_.compute(context, state, inertia, forces, state.ranges.owned_begin, state.ranges.owned_end);
     kinetic_ = ExactSum();
-    for (std::size_t i = state.ranges.owned_begin; i < owned; ++i) {
-      external_work_.add(external_term_[i]);
-      damping_work_.add(damping_term_[i]);
-      kinetic_.add(kinetic_term_[i]);
+    for (std::size_t i = state.ranges.owned_begin; i < state.ranges.owned_end; ++i) {
+      external_work_.add(terms_.external()[i]);
+      damping_work_.add(terms_.damping()[i]);
+      kinetic_.add(terms_.kinetic()[i]);
     }
   }
 
@@ -123,43 +103,52 @@ class DistributedLedger {
     return report;
   }
 
+  // Checkpoints (DistributedSolver::save_checkpoint): this rank's
+  // accumulators, exactly. The per-particle terms and remembered velocities
+  // are rewritten by every step before use.
+  template <class Writer>
+  void save(Writer& out) const {
+    for (const ExactSum* sum : {&internal_, &previous_internal_, &external_work_, &damping_work_, &kinetic_})
+      out(sum->raw());
+  }
+  template <class Reader>
+  void load(Reader& in) {
+    for (ExactSum* sum : {&internal_, &previous_internal_, &external_work_, &damping_work_, &kinetic_}) {
+      ExactSum::Raw raw{};
+      in(raw);
+      *sum = ExactSum::from_raw(raw);
+    }
+  }
+
   // The serial check (solver::EnergyLedger::check_balance) on the reduced
   // books: every rank decides alike, and when the balance is lost they find
   // the particle of largest kinetic energy together (ties: the lowest global
   // id, as the serial max_element) and throw the same Error. Collective.
   template <class GlobalId>
   void check_balance(const Communicator& comm, const StepTime& at, const EnergyReport& e, GlobalId&& global_id) const {
-    const double scale = std::max({std::abs(e.external_work), e.kinetic, std::abs(e.internal)});
-    if (!(at.step >= solver::EnergyLedger::first_checked_step && scale > round_off_energy_ &&
-          std::abs(e.balance()) > monitoring_.energy_tolerance * scale))
-      return;
+    if (!solver::EnergyLedger::balance_lost(at, e, monitoring_, round_off_energy_)) return;
     struct Largest {
       double energy;
       std::int64_t particle;
     } mine{-1.0, -1};
-    for (std::size_t i = 0; i < kinetic_term_.size(); ++i)
-      if (kinetic_term_[i] > mine.energy) mine = {kinetic_term_[i], global_id(i)};
+    const std::vector<double>& kinetic = terms_.kinetic();
+    for (std::size_t i = 0; i < kinetic.size(); ++i)
+      if (kinetic[i] > mine.energy) mine = {kinetic[i], global_id(i)};
     Largest largest{-1.0, -1};
     for (const Largest& candidate : comm.all_gather(mine))
       if (candidate.particle >= 0 &&
           (candidate.energy > largest.energy ||
            (candidate.energy == largest.energy && candidate.particle < largest.particle)))
         largest = candidate;
-    std::ostringstream message;
-    message << "energy balance lost (kinetic " << e.kinetic << " J, internal " << e.internal << " J, external work "
-            << e.external_work << " J, balance " << e.balance() << " J); reduce the time step or check the loads";
-    if (largest.particle >= 0)
-      message << "; the largest kinetic energy is at particle " << largest.particle << " (" << largest.energy
-              << " J)";
-    sphshell::detail::fail_unstable(at, message.str());
+    sphshell::detail::fail_unstable(
+        at, solver::EnergyLedger::balance_lost_message(e, static_cast<long long>(largest.particle), largest.energy));
   }
 
  private:
   MonitoringOptions monitoring_;
   double round_off_energy_;
   ExactSum internal_, previous_internal_, external_work_, damping_work_, kinetic_;
-  std::vector<Vector3> old_velocity_, old_angular_velocity_, free_velocity_;
-  std::vector<double> external_term_, damping_term_, kinetic_term_;
+  solver::ParticleEnergyTerms terms_;
 };
 
 }  // namespace sphshell::mpi

@@ -28,6 +28,7 @@
 #include <sphshell/solver/output.hpp>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -79,6 +80,39 @@ class DistributedFrames {
     });
     ++frames_written_;
     last_frame_step_ = step;
+  }
+
+  // Checkpoints (DistributedSolver::save_checkpoint): the schedule and, from
+  // rank 0, the series' entries. A restart in the same output_directory
+  // continues the series from the checkpoint's frames (later ones leave the
+  // series and are overwritten as the run passes them again); in another
+  // folder, or without one when saved, the series starts anew at the next frame.
+  template <class Writer>
+  void save(Writer& out) const {
+    out(static_cast<std::int64_t>(frames_written_), static_cast<std::int64_t>(last_frame_step_), next_frame_time_);
+    out(options_.output_directory.empty() ? std::string() : io::identity_of(options_.output_directory));
+    std::vector<SeriesEntry> entries;
+    if (series_)
+      for (const io::PvdCollection::Entry& entry : series_->entries()) entries.push_back({entry.time, entry.file});
+    out(entries);
+  }
+  template <class Reader>
+  void load(Reader& in) {
+    std::int64_t frames = 0, last_step = 0;
+    double next_frame = 0.0;
+    std::string directory;
+    std::vector<SeriesEntry> entries;
+    in(frames, last_step, next_frame, directory, entries);
+    last_frame_step_ = static_cast<long>(last_step);
+    next_frame_time_ = next_frame;
+    frames_written_ = 0;
+    if (!enabled() || directory != io::identity_of(options_.output_directory)) return;
+    frames_written_ = static_cast<long>(frames);
+    if (series_) {  // rank 0
+      series_.emplace(path("particles.pvd"), false);
+      for (const SeriesEntry& entry : entries) series_->stage(entry.time, path(entry.file));
+      series_->write();
+    }
   }
 
   std::string path(const std::string& file) const { return options_.output_directory + "/" + file; }
@@ -139,6 +173,15 @@ class DistributedFrames {
     file.commit();
   }
 
+  struct SeriesEntry {
+    double time = 0.0;
+    std::string file;  // relative to the output directory
+    template <class S, class F>
+    static void for_each_field(S& self, F&& field) {
+      field(self.time, self.file);
+    }
+  };
+
   OutputOptions options_;
   std::optional<io::PvdCollection> series_;  // rank 0
   long frames_written_ = 0;
@@ -146,11 +189,14 @@ class DistributedFrames {
   double next_frame_time_ = 0.0;
 };
 
-// A particle probe on the rank owning the particle.
+// A probe of a particle or a stress point, its file on the rank owning it.
 struct DistributedProbe {
-  int particle = 0;
+  enum class Kind { particle, stress_point };
+  Kind kind = Kind::particle;
+  int index = 0;  // global particle or stress point index
   std::string path;
   std::unique_ptr<io::CsvProbe> file;  // on the owner only
+  std::size_t local_point = 0;         // a stress point's local point (owner only)
 };
 
 }  // namespace sphshell::mpi

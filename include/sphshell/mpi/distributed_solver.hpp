@@ -48,15 +48,20 @@
 #include <sphshell/mpi/halo.hpp>
 #include <sphshell/mpi/layout.hpp>
 #include <sphshell/mpi/partition.hpp>
+#include <sphshell/io/binary_stream.hpp>
 #include <sphshell/solver.hpp>
+#include <sphshell/solver/checkpoint.hpp>
 
+#include <array>
 #include <chrono>
+#include <cstring>
 #include <ctime>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <memory>
 #include <optional>
+#include <random>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -138,14 +143,13 @@ class DistributedSolver {
       constraints_.fix_rotation(local, axis);
     });
   }
-  // Prescribed velocity v(X, t) on all three translations (before the first
-  // step; the function is copied, once for the check of the whole set).
+  // Prescribed velocity v(X, t) on all three translations (the function is
+  // copied, once for the check of the whole set).
   template <class VelocityFunction>
   void prescribe_velocity(const ParticleSet& set, VelocityFunction velocity) {
     static_assert(std::is_invocable_r_v<Vector3, VelocityFunction, const Vector3&, double>,
                   "prescribe_velocity: the function must be callable as Vector3 v(const Vector3& X, double t)");
     on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
-      require_start("prescribe_velocity");
       checker_.add_motion(global, std::make_unique<sphshell::detail::PrescribedVelocity<VelocityFunction>>(velocity),
                           model_.particle_position, time_, time_step_);
       constraints_.add_motion(local, std::make_unique<sphshell::detail::PrescribedVelocity<VelocityFunction>>(velocity),
@@ -157,18 +161,36 @@ class DistributedSolver {
     static_assert(std::is_invocable_r_v<Vector3, DisplacementFunction, const Vector3&, double>,
                   "prescribe_displacement: the function must be callable as Vector3 u(const Vector3& X, double t)");
     on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
-      require_start("prescribe_displacement");
-      for (int i : global) {
-        const Vector3 start = displacement(model_.particle_position[i], time_);
-        if (start.norm() > 0.0)
-          sphshell::detail::invalid_parameter("prescribed displacement at t = 0, particle " + std::to_string(i),
-                                              start.transpose(),
-                                              "must be zero: the run starts from the reference configuration");
+      // The Solver's check (solver::check_prescribed_displacement_start), by
+      // the owner of each particle; the failure first in the set's order
+      // wins, as in the serial loop.
+      std::optional<Failure> failure;
+      for (std::size_t k = 0; k < global.size() && !failure; ++k) {
+        const int i = global[k];
+        if (!owns(i)) continue;
+        const auto at = static_cast<std::size_t>(layout_.local_of[static_cast<std::size_t>(i)]);
+        try {
+          solver::check_prescribed_displacement_start(i, displacement(model_.particle_position[i], time_),
+                                                      particles_.position[at] - reference_position_[at], time_,
+                                                      steps_, model_.minimum_spacing());
+        } catch (const Error& error) {
+          failure = Failure{static_cast<long>(k), error.what()};
+        }
       }
+      agree(failure);
       using Motion = sphshell::detail::PrescribedDisplacement<DisplacementFunction>;
       checker_.add_motion(global, std::make_unique<Motion>(displacement), model_.particle_position, time_, time_step_);
       constraints_.add_motion(local, std::make_unique<Motion>(displacement), reference_position_, time_, time_step_);
     });
+  }
+
+  template <class VelocityFunction>
+  void prescribe_velocity(const std::string& set_name, VelocityFunction velocity) {
+    prescribe_velocity(named(set_name), std::move(velocity));
+  }
+  template <class DisplacementFunction>
+  void prescribe_displacement(const std::string& set_name, DisplacementFunction displacement) {
+    prescribe_displacement(named(set_name), std::move(displacement));
   }
 
   // Loads on a set of global ids or a named set (shell/loads.hpp).
@@ -228,15 +250,33 @@ class DistributedSolver {
   void add_particle_probe(const std::string& csv_path, int particle) {
     collectively(comm_, [&] {
       solver::checked_set({particle}, model_.particle_count());
-      for (const DistributedProbe& probe : probes_)
-        if (probe.path == csv_path)
-          throw Error("sphshell: probe file '" + csv_path + "' is already the file of another probe; give each probe "
-                      "a file of its own");
-      DistributedProbe probe{particle, csv_path, nullptr};
+      require_new_probe_file(csv_path);
+      DistributedProbe probe{DistributedProbe::Kind::particle, particle, csv_path, nullptr};
       if (owns(particle)) {
         probe.file = std::make_unique<io::CsvProbe>(csv_path, solver::ParticleProbe{particle}.columns());
-        probe.file->write_row(solver::ParticleProbe{particle}.row(OwnedView{*this}));
+        write_probe_row(probe);
       }
+      probes_.push_back(std::move(probe));
+    });
+  }
+  // CSV history of one stress point (Solver::add_stress_point_probe's columns
+  // and schedule: t, then the equivalent stress, equivalent plastic strain
+  // and damage at each thickness output point), written by the rank that
+  // owns the stress point. Collective.
+  void add_stress_point_probe(const std::string& csv_path, int stress_point) {
+    collectively(comm_, [&] {
+      if (stress_point < 0 || static_cast<std::size_t>(stress_point) >= model_.stress_point_count())
+        sphshell::detail::invalid_parameter("stress point index", stress_point, "out of range");
+      require_new_probe_file(csv_path);
+      DistributedProbe probe{DistributedProbe::Kind::stress_point, stress_point, csv_path, nullptr};
+      const std::vector<std::size_t>& rows = layout_.computed[solver::index_of(solver::PointGroup::stress_points)];
+      for (std::size_t k = 0; k < rows.size(); ++k)
+        if (rows[k] == static_cast<std::size_t>(stress_point) &&
+            layout_.computed_is_owned[solver::index_of(solver::PointGroup::stress_points)][k]) {
+          probe.local_point = points_->point(solver::PointGroup::stress_points, k);
+          probe.file = std::make_unique<io::CsvProbe>(csv_path, stress_probe(stress_point).columns());
+          write_probe_row(probe);
+        }
       probes_.push_back(std::move(probe));
     });
   }
@@ -272,23 +312,108 @@ class DistributedSolver {
 
   // One step on every rank (collective). A step that stopped with an Error
   // leaves a half-updated state: later steps refuse with that error.
-  void step() {
-    if (!failure_.empty()) throw Error(failure_);
+  void step() { latch_.run(steps_, [&] { advance(); }); }
+  // Checkpoints (collective). Each rank writes its own file, `path` + ".rank"
+  // + its rank (the Solver's format, solver/checkpoint.hpp, replaced
+  // atomically): its particles, forces, rows, section states and exact energy
+  // books, the whole crack set, the step count, Δt, the step latch and the
+  // frame and probe schedules, with a stamp of the save shared by all ranks.
+  // A DistributedSolver of the same policies, model, material, options and
+  // rank count that loads them continues bit for bit as the saving one would
+  // have. An Error on every rank names a file of another rank count, rank,
+  // model, material or options (nothing loaded: the solver stays usable), or
+  // files of different saves, or a damaged file (the solver then refuses to
+  // step). Conditions and loads stay as the loading solver has them; add
+  // probes after loading (their files start at the restart).
+  std::string checkpoint_file(const std::string& path) const { return path + ".rank" + std::to_string(comm_.rank()); }
+
+  void save_checkpoint(const std::string& path) const {
+    std::uint64_t stamp = 0;
+    if (comm_.is_root())
+      stamp = static_cast<std::uint64_t>(std::random_device{}()) << 32 ^
+              static_cast<std::uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count());
+    stamp = comm_.all_gather(stamp).front();
+    collectively(comm_, [&] {
+      io::BinaryWriter out;
+      out.begin_section("IDNT");
+      out(identity());
+      out.end_section();
+      out.begin_section("TIME");
+      out(stamp, start_time_, static_cast<std::int64_t>(steps_), time_step_, time_, forces_current_, latch_.message());
+      out.end_section();
+      out.begin_section("PART");
+      particles_.save(out);
+      out.end_section();
+      out.begin_section("FORC");
+      forces_.save(out);
+      out.end_section();
+      out.begin_section("PNTS");
+      points_->save(out);
+      if constexpr (Crack::enabled) all_points_->save(out);
+      out.end_section();
+      out.begin_section("SECT");
+      states_->save(out);
+      out.end_section();
+      out.begin_section("FRAC");
+      fracture_.save(out);
+      out.end_section();
+      out.begin_section("ENRG");
+      ledger_->save(out);
+      out.end_section();
+      out.begin_section("STEP");
+      if constexpr (!std::is_empty_v<Stepper>) stepper_.save(out);
+      out.end_section();
+      out.begin_section("OUTP");
+      frames_.save(out);
+      out(next_probe_time_);
+      out.end_section();
+      solver::checkpoint::write_file(checkpoint_file(path), policies(), out);
+    });
+  }
+
+  void load_checkpoint(const std::string& path) {
+    const std::string file_path = checkpoint_file(path);
+    // 1. Each rank's file and its identity; nothing changes yet.
+    std::optional<io::BinaryReader> reader;
+    collectively(comm_, [&] {
+      if (!probes_.empty())
+        throw Error("sphshell: load_checkpoint: " + std::to_string(probes_.size()) +
+                    " probe(s) were added before it; a distributed run adds its probes after loading a checkpoint");
+      reader.emplace(solver::checkpoint::read_file(file_path, policies()));
+      solver::checkpoint::Identity file;
+      reader->open_section("IDNT");
+      (*reader)(file);
+      reader->close_section();
+      solver::checkpoint::check_identity(file, identity(), file_path);
+    });
+    // 2. The state; a failure from here on leaves every rank stopped.
+    std::uint64_t stamp = 0;
     try {
-      advance();
+      collectively(comm_, [&] { load_state(*reader, stamp); });
+      const std::vector<std::uint64_t> stamps = comm_.all_gather(stamp);
+      const std::vector<std::int64_t> steps = comm_.all_gather(static_cast<std::int64_t>(steps_));
+      for (std::size_t r = 1; r < stamps.size(); ++r)
+        if (stamps[r] != stamps[0])
+          throw Error("sphshell: checkpoint files '" + path + ".rank0' (step " + std::to_string(steps[0]) + ") and '" +
+                      path + ".rank" + std::to_string(r) + "' (step " + std::to_string(steps[r]) +
+                      ") were written by different saves");
     } catch (const Error& error) {
-      failure_ = "sphshell: the solver stopped at step " + std::to_string(steps_) +
-                 " and cannot go on from its half-updated state; the error was: " + error.what();
+      latch_.close(std::string("sphshell: loading a checkpoint failed part-way, so this solver's state is mixed and "
+                               "it cannot step; the error was: ") +
+                   error.what());
       throw;
     }
   }
+
   // Steps until t_end, as Solver::run_until (collective).
   void run_until(double t_end) {
     collectively(comm_, [&] {
       solver::check_run_end(t_end, solver::RunPosition{time_, time_step_, steps_}, options_.max_steps_per_run);
     });
+    progress_.start_run(now(), t_end);
     while (time_ < t_end - 0.5 * time_step_) step();
     if (frames_.writes_on_schedule() && frames_.last_frame_step() != steps_) write_frame();
+    progress_.end_run();
   }
 
   double time() const { return time_; }
@@ -373,7 +498,9 @@ class DistributedSolver {
     const DecompositionInput input = decomposition_input(model_, all_points);
     partition_ = partition(input, comm_.size(), weights);
     layout_ = rank_layout(input, partition_, comm_.rank());
-    points_.emplace(all_points.subset(layout_.computed, layout_.local_of, layout_.local_count()));
+    model_point_count_ = all_points.size();
+    model_slot_count_ = all_points.slot_count();
+    points_.emplace(local_points(all_points));
     std::vector<std::size_t> computed_points;
     for (solver::PointGroup group : solver::point_groups) {
       const std::size_t g = solver::index_of(group);
@@ -427,10 +554,77 @@ class DistributedSolver {
     collectively(comm_, [&] { members = model_.set(set_name); });
     return members;
   }
-  void require_start(const char* what) const {
-    if (steps_ != 0)
-      sphshell::detail::invalid_parameter(what, steps_,
-                                          "a distributed run takes prescribed motions before its first step");
+
+  // This rank's rows of the whole model's.
+  Points local_points(const Points& all_points) const {
+    return all_points.subset(layout_.computed, layout_.local_of, layout_.local_count());
+  }
+
+  static std::array<std::string, 5> policies() {
+    return solver::checkpoint::policy_names<Approx, Rule, Material, Crack, Stepper>();
+  }
+  // What a rank's checkpoint file must agree on with the solver loading it:
+  // the Solver's identity (the whole model's counts) and the rank count and rank.
+  solver::checkpoint::Identity identity() const {
+    solver::checkpoint::Identity id;
+    id.counts = {{"rank count", static_cast<std::uint64_t>(comm_.size())},
+                 {"rank", static_cast<std::uint64_t>(comm_.rank())},
+                 {"particle count", static_cast<std::uint64_t>(model_.particle_count())},
+                 {"stress point count", static_cast<std::uint64_t>(model_.stress_point_count())},
+                 {"integration point count", static_cast<std::uint64_t>(model_point_count_)},
+                 {"shape-function slot count", static_cast<std::uint64_t>(model_slot_count_)}};
+    id.model = solver::checkpoint::model_fingerprints(model_);
+    id.material = solver::checkpoint::material_constants(law_);
+    id.options = solver::checkpoint::result_options(options_, time_step_);
+    return id;
+  }
+
+  // The sections after IDNT (load_checkpoint).
+  void load_state(io::BinaryReader& in, std::uint64_t& stamp) {
+    // Rows a crack rebuilt here since construction go back to the model's.
+    bool rebuilt = points_->any_rebuilt();
+    if constexpr (Crack::enabled) rebuilt = rebuilt || all_points_->any_rebuilt();
+    if (rebuilt) {
+      const Points fresh(model_, options_.physics(), options_.particle_integration(), law_.shear_modulus());
+      points_.emplace(local_points(fresh));
+      if constexpr (Crack::enabled) all_points_.emplace(fresh);
+    }
+    assembler_.emplace(options_.nonlinear, *points_);
+    std::int64_t steps = 0;
+    in.open_section("TIME");
+    in(stamp, start_time_, steps, time_step_, time_, forces_current_, latch_.message());
+    in.close_section();
+    steps_ = static_cast<long>(steps);
+    const double time = start_time_ + static_cast<double>(steps_) * time_step_;
+    if (std::memcmp(&time, &time_, sizeof time) != 0)
+      in.fail("its time " + solver::number_text(time_) + " s is not t0 + n dt = " + solver::number_text(time) + " s");
+    in.open_section("PART");
+    particles_.load(in);
+    in.close_section();
+    in.open_section("FORC");
+    forces_.load(in);
+    in.close_section();
+    in.open_section("PNTS");
+    points_->load(in, layout_.local_count());
+    if constexpr (Crack::enabled) all_points_->load(in, model_.particle_count());
+    in.close_section();
+    in.open_section("SECT");
+    states_->load(in);
+    in.close_section();
+    in.open_section("FRAC");
+    fracture_.load(in);
+    in.close_section();
+    in.open_section("ENRG");
+    ledger_->load(in);
+    in.close_section();
+    in.open_section("STEP");
+    if constexpr (!std::is_empty_v<Stepper>) stepper_.load(in);
+    in.close_section();
+    in.open_section("OUTP");
+    frames_.load(in);
+    in(next_probe_time_);
+    in.close_section();
+    if (!in.at_end()) in.fail("there are bytes after its last section");
   }
 
   StepTime now() const { return {steps_, time_}; }
@@ -467,6 +661,11 @@ class DistributedSolver {
       const EnergyReport report = energy();
       ledger_->check_balance(comm_, now(), report, [&](std::size_t i) { return layout_.global_of(i); });
     }
+    // The Solver's progress line, from the reduced books, written by rank 0.
+    if (progress_.is_due(steps_)) {
+      const EnergyReport report = energy();
+      if (comm_.is_root()) progress_.write(now(), report);
+    }
     write_scheduled();
   }
 
@@ -480,7 +679,7 @@ class DistributedSolver {
     }
     if (!probes_.empty() && time_ >= next_probe_time_ - probe_schedule_tolerance * time_step_) {
       for (DistributedProbe& probe : probes_)
-        if (probe.file) probe.file->write_row(solver::ParticleProbe{probe.particle}.row(OwnedView{*this}));
+        if (probe.file) write_probe_row(probe);
       next_probe_time_ = time_ + options_.probe_interval;
     }
   }
@@ -510,6 +709,33 @@ class DistributedSolver {
       return axis / sine * std::atan2(sine, from.dot(to));
     }
   };
+  // What solver::StressPointProbe reads, for a stress point owned here.
+  struct StressPointView {
+    const DistributedSolver& solver;
+    std::size_t local_point;
+    double time() const { return solver.time_; }
+    double integral_point_quantity(solver::IntegralPointQuantity quantity, int, int k) const {
+      return solver.states_->quantity(quantity, local_point, k);
+    }
+  };
+  static constexpr int output_points = thickness::Section<Rule, Material>::output_points;
+  static solver::StressPointProbe<output_points> stress_probe(int stress_point) {
+    solver::StressPointProbe<output_points> probe(stress_point);
+    probe.point_names = solver::thickness_point_names<Rule>();
+    return probe;
+  }
+  void write_probe_row(DistributedProbe& probe) const {
+    if (probe.kind == DistributedProbe::Kind::particle)
+      probe.file->write_row(solver::ParticleProbe{probe.index}.row(OwnedView{*this}));
+    else
+      probe.file->write_row(stress_probe(probe.index).row(StressPointView{*this, probe.local_point}));
+  }
+  void require_new_probe_file(const std::string& csv_path) const {
+    for (const DistributedProbe& probe : probes_)
+      if (probe.path == csv_path)
+        throw Error("sphshell: probe file '" + csv_path + "' is already the file of another probe; give each probe "
+                    "a file of its own");
+  }
   bool owns(int global) const {
     const int k = layout_.local_of[static_cast<std::size_t>(global)];
     return k >= 0 && static_cast<std::size_t>(k) < layout_.owned_count();
@@ -646,19 +872,21 @@ class DistributedSolver {
   ExternalLoads loads_;
   CommunicationCounters counters_;
   DistributedFrames frames_;
+  solver::ProgressReporter progress_{options_.monitoring()};
   std::vector<DistributedProbe> probes_;
   double next_probe_time_ = 0.0;
   // As the Solver's: below this the reference and current directors are parallel.
   static constexpr double negligible_rotation_sine = 1e-300;
   // As the serial output's probe schedule (solver/output.hpp).
   static constexpr double probe_schedule_tolerance = 1e-9;
+  std::size_t model_point_count_ = 0, model_slot_count_ = 0;  // the whole model's (checkpoint identity)
   double stable_time_step_ = 0.0;
   double time_step_ = 0.0;
   double start_time_ = 0.0;
   double time_ = 0.0;
   long steps_ = 0;
   bool forces_current_ = false;
-  std::string failure_;
+  solver::StepLatch latch_;
 };
 
 }  // namespace sphshell::mpi

@@ -20,6 +20,7 @@
 #include <cstddef>
 #include <ostream>
 #include <sstream>
+#include <string>
 #include <vector>
 
 namespace sphshell {
@@ -41,6 +42,54 @@ struct EnergyReport {
 };
 
 namespace solver {
+
+// The per-particle terms of one step's books, for the particles [begin, end)
+// a ledger books (all of them serially, the owned ones on an MPI rank): the
+// work over the step of the external forces and moments with the reactions of
+// the kinematic conditions, f · Δt · (v^{n−½} + v^{n+½})/2 with the reactions
+// m (v − v_free)/Δt; the damping work c m |v̄|²Δt; the kinetic energy at n+½.
+// Each term is written to an array by a parallel loop, so the ledger adds
+// them in index order (identical books for any thread count).
+class ParticleEnergyTerms {
+ public:
+  // v^{n−½} and ω^{n−½}, before the stepper updates them.
+  void remember_velocities(const ParticleState& state) {
+    old_velocity_ = state.velocity;
+    old_angular_velocity_ = state.angular_velocity;
+  }
+  // The velocities the unconstrained update produced, before the kinematic
+  // conditions: their difference is the reactions' impulse.
+  void remember_free_velocities(const ParticleState& state) { free_velocity_ = state.velocity; }
+
+  // The terms of particles [begin, end) (the arrays are sized to end).
+  void compute(const stepper::StepContext& context, const ParticleState& state, const Inertia& inertia,
+               const ParticleForces& forces, std::size_t begin, std::size_t end) {
+    const double dt = context.velocity_step;
+    const double c = context.damping;
+    external_.resize(end);
+    damping_.resize(end);
+    kinetic_.resize(end);
+    parallel::for_each(begin, end, [&](std::size_t i) noexcept {
+      const Vector3 average = 0.5 * (old_velocity_[i] + state.velocity[i]);
+      const Vector3 average_angular = 0.5 * (old_angular_velocity_[i] + state.angular_velocity[i]);
+      const Vector3 reaction = inertia.mass[i] * (state.velocity[i] - free_velocity_[i]) / dt;
+      external_[i] = dt * (forces.external[i] + reaction).dot(average) +
+                     dt * forces.external_moment[i].dot(average_angular);
+      damping_[i] = dt * c * inertia.mass[i] * average.squaredNorm() +
+                    dt * c * inertia.rotary_inertia[i] * average_angular.squaredNorm();
+      kinetic_[i] = 0.5 * inertia.mass[i] * state.velocity[i].squaredNorm() +
+                    0.5 * inertia.rotary_inertia[i] * state.angular_velocity[i].squaredNorm();
+    });
+  }
+
+  const std::vector<double>& external() const { return external_; }
+  const std::vector<double>& damping() const { return damping_; }
+  const std::vector<double>& kinetic() const { return kinetic_; }
+
+ private:
+  std::vector<Vector3> old_velocity_, old_angular_velocity_, free_velocity_;
+  std::vector<double> external_, damping_, kinetic_;
+};
 
 class EnergyLedger {
  public:
@@ -64,41 +113,21 @@ class EnergyLedger {
       : monitoring_(monitoring), round_off_energy_(youngs_modulus * volume * round_off_strain_squared) {}
 
   // v^{n−½} and ω^{n−½}, before the stepper updates them.
-  void remember_velocities(const ParticleState& state) {
-    old_velocity_ = state.velocity;
-    old_angular_velocity_ = state.angular_velocity;
-  }
+  void remember_velocities(const ParticleState& state) { terms_.remember_velocities(state); }
   // The velocities the unconstrained update produced, before the kinematic
   // conditions: their difference is the reactions' impulse.
-  void remember_free_velocities(const ParticleState& state) { free_velocity_ = state.velocity; }
+  void remember_free_velocities(const ParticleState& state) { terms_.remember_free_velocities(state); }
 
-  // Work over the step of each force, f · Δt · (v^{n−½} + v^{n+½})/2, with the
-  // reactions m (v − v_free)/Δt counted as external; damping work c m |v̄|²Δt;
-  // the kinetic energy at n+½.
+  // The step's work of the external forces (reactions included) and of the
+  // damping, and the kinetic energy at n+½ (ParticleEnergyTerms).
   void book_step(const stepper::StepContext& context, const ParticleState& state, const Inertia& inertia,
                  const ParticleForces& forces) {
-    const double dt = context.velocity_step;
-    const double c = context.damping;
-    const std::size_t n = state.size();
-    external_term_.resize(n);
-    damping_term_.resize(n);
-    kinetic_term_.resize(n);
-    parallel::for_each(state.ranges.owned_begin, state.ranges.owned_end, [&](std::size_t i) noexcept {
-      const Vector3 average = 0.5 * (old_velocity_[i] + state.velocity[i]);
-      const Vector3 average_angular = 0.5 * (old_angular_velocity_[i] + state.angular_velocity[i]);
-      const Vector3 reaction = inertia.mass[i] * (state.velocity[i] - free_velocity_[i]) / dt;
-      external_term_[i] = dt * (forces.external[i] + reaction).dot(average) +
-                          dt * forces.external_moment[i].dot(average_angular);
-      damping_term_[i] = dt * c * inertia.mass[i] * average.squaredNorm() +
-                         dt * c * inertia.rotary_inertia[i] * average_angular.squaredNorm();
-      kinetic_term_[i] = 0.5 * inertia.mass[i] * state.velocity[i].squaredNorm() +
-                         0.5 * inertia.rotary_inertia[i] * state.angular_velocity[i].squaredNorm();
-    });
+    terms_.compute(context, state, inertia, forces, state.ranges.owned_begin, state.ranges.owned_end);
     double external = 0.0, damping = 0.0, kinetic = 0.0;
     for (std::size_t i = state.ranges.owned_begin; i < state.ranges.owned_end; ++i) {
-      external += external_term_[i];
-      damping += damping_term_[i];
-      kinetic += kinetic_term_[i];
+      external += terms_.external()[i];
+      damping += terms_.damping()[i];
+      kinetic += terms_.kinetic()[i];
     }
     external_work_ += external;
     damping_work_ += damping;
@@ -150,23 +179,40 @@ class EnergyLedger {
   // Whether step n is one whose balance is checked.
   static bool is_check_step(long step) { return step % check_interval == 0; }
 
-  // Stops the run when |balance| exceeds the tolerance times the largest energy in play.
-  void check_balance(const StepTime& at, const EnergyReport& e) const {
+  // Whether the balance is lost at `at`: |balance| above the tolerance times
+  // the largest energy in play, once the start-up steps are past and the
+  // energies are above round-off.
+  static bool balance_lost(const StepTime& at, const EnergyReport& e, const MonitoringOptions& monitoring,
+                           double round_off_energy) {
     const double scale = std::max({std::abs(e.external_work), e.kinetic, std::abs(e.internal)});
-    if (at.step >= first_checked_step && scale > round_off_energy_ &&
-        std::abs(e.balance()) > monitoring_.energy_tolerance * scale) {
-      std::ostringstream message;
-      message << "energy balance lost (kinetic " << e.kinetic << " J, internal " << e.internal
-              << " J, external work " << e.external_work << " J, balance " << e.balance()
-              << " J); reduce the time step or check the loads";
-      // The particle holding the most kinetic energy is where a run that blows up is going.
-      if (!kinetic_term_.empty()) {
-        const auto largest = std::max_element(kinetic_term_.begin(), kinetic_term_.end());
-        message << "; the largest kinetic energy is at particle " << (largest - kinetic_term_.begin()) << " ("
-                << *largest << " J)";
-      }
-      detail::fail_unstable(at, message.str());
+    return at.step >= first_checked_step && scale > round_off_energy &&
+           std::abs(e.balance()) > monitoring.energy_tolerance * scale;
+  }
+  // The message of a lost balance; largest_particle < 0 when no particle is named.
+  static std::string balance_lost_message(const EnergyReport& e, long long largest_particle, double largest_energy) {
+    std::ostringstream message;
+    message << "energy balance lost (kinetic " << e.kinetic << " J, internal " << e.internal
+            << " J, external work " << e.external_work << " J, balance " << e.balance()
+            << " J); reduce the time step or check the loads";
+    // The particle holding the most kinetic energy is where a run that blows up is going.
+    if (largest_particle >= 0)
+      message << "; the largest kinetic energy is at particle " << largest_particle << " (" << largest_energy << " J)";
+    return message.str();
+  }
+
+  // Stops the run when the balance is lost (balance_lost), naming the particle
+  // of largest kinetic energy.
+  void check_balance(const StepTime& at, const EnergyReport& e) const {
+    if (!balance_lost(at, e, monitoring_, round_off_energy_)) return;
+    const std::vector<double>& kinetic = terms_.kinetic();
+    long long particle = -1;
+    double energy = 0.0;
+    if (!kinetic.empty()) {
+      const auto largest = std::max_element(kinetic.begin(), kinetic.end());
+      particle = largest - kinetic.begin();
+      energy = *largest;
     }
+    detail::fail_unstable(at, balance_lost_message(e, particle, energy));
   }
 
  private:
@@ -174,8 +220,7 @@ class EnergyLedger {
   double round_off_energy_;
   double previous_internal_energy_ = 0.0, internal_energy_ = 0.0;
   double external_work_ = 0.0, damping_work_ = 0.0, kinetic_energy_ = 0.0;
-  std::vector<Vector3> old_velocity_, old_angular_velocity_, free_velocity_;
-  std::vector<double> external_term_, damping_term_, kinetic_term_;
+  ParticleEnergyTerms terms_;
 };
 
 }  // namespace solver

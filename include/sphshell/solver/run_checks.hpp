@@ -11,6 +11,7 @@
 #include <sphshell/shell/model.hpp>
 #include <sphshell/solver/local_spacing.hpp>
 #include <sphshell/solver/options.hpp>
+#include <algorithm>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -130,6 +131,25 @@ void check_memory(const ShellModel& model, const SolverOptions& options) {
     throw Error("sphshell: model too large for the memory available: " + text.str() +
                 " (MemAvailable, the cgroup limit and ulimit -v); use fewer particles or a smaller "
                 "support_radius_factor");
+}
+
+// A prescribed displacement u(X, t) at a particle, added at step `steps`
+// (time `time`): at the start it must be zero (the run starts from the
+// reference configuration); added mid-run it must continue from the
+// particle's displacement now, else the jump would be imposed as one step's
+// velocity (a shock). An Error naming the particle otherwise.
+inline void check_prescribed_displacement_start(int particle, const Vector3& start, const Vector3& now, double time,
+                                                long steps, double minimum_spacing) {
+  if (steps == 0 && start.norm() > 0.0)
+    detail::invalid_parameter("prescribed displacement at t = 0, particle " + std::to_string(particle),
+                              start.transpose(), "must be zero: the run starts from the reference configuration");
+  const double allowed = prescribed_jump_tolerance * std::max(now.norm(), minimum_spacing);
+  if (steps > 0 && !((start - now).norm() <= allowed))
+    detail::invalid_parameter("prescribed displacement at t = " + number_text(time) + " s, particle " +
+                                  std::to_string(particle),
+                              start.transpose(),
+                              "must equal the particle's displacement now (" + vector_text(now) +
+                                  "): a prescribed motion added mid-run continues from the current state");
 }
 
 }  // namespace sphshell::solver
