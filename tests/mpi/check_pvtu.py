@@ -1,6 +1,6 @@
 """Reads a distributed run's frames with VTK's own parallel reader.
 
-    python3 check_pvtu.py FRAMES_DIR RANKS FRAMES REFERENCE_CSV
+    python3 check_pvtu.py FRAMES_DIR RANKS FRAMES REFERENCE_CSV STRESS_REFERENCE_CSV
 
 FRAMES_DIR holds particles.pvd, one particles_NNNNNN.pvtu per frame and one
 piece per rank and frame. The series must list FRAMES frames, each .pvtu RANKS
@@ -8,6 +8,10 @@ pieces; the last frame, read whole by vtkXMLPUnstructuredGridReader, must hold
 every particle once (global_id 0 .. N-1) at the positions of REFERENCE_CSV
 (one "x,y,z" line per particle, the serial run's final positions, written with
 17 significant digits; the frames are Float64, so they must agree exactly).
+Likewise stress_points.pvd: FRAMES frames of RANKS pieces; the last one must
+hold every stress point once (cell array stress_point 0 .. M-1, one vertex cell
+each) at the positions of STRESS_REFERENCE_CSV (the serial run's interpolated
+stress-point positions), with the serial frame's cell arrays.
 Exit status 0 when all holds; the first failure is printed.
 """
 import os
@@ -22,12 +26,12 @@ def fail(message):
     sys.exit(1)
 
 
-def main():
-    frames_dir, ranks, frames, reference_csv = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), sys.argv[4]
-    series = ElementTree.parse(os.path.join(frames_dir, "particles.pvd")).getroot()
+def last_frame(frames_dir, series_name, ranks, frames):
+    """The last frame of a series, read whole, after checking the series' length and pieces."""
+    series = ElementTree.parse(os.path.join(frames_dir, series_name)).getroot()
     files = [d.get("file") for d in series.iter("DataSet")]
     if len(files) != frames:
-        fail("particles.pvd lists %d frames, expected %d" % (len(files), frames))
+        fail("%s lists %d frames, expected %d" % (series_name, len(files), frames))
     for name in files:
         pieces = list(ElementTree.parse(os.path.join(frames_dir, name)).getroot().iter("Piece"))
         if len(pieces) != ranks:
@@ -35,8 +39,41 @@ def main():
     reader = vtk.vtkXMLPUnstructuredGridReader()
     reader.SetFileName(os.path.join(frames_dir, files[-1]))
     reader.Update()
-    grid = reader.GetOutput()
-    reference = [tuple(float(v) for v in line.split(",")) for line in open(reference_csv) if line.strip()]
+    return reader.GetOutput()
+
+
+def read_csv(path):
+    return [tuple(float(v) for v in line.split(",")) for line in open(path) if line.strip()]
+
+
+def check_stress_points(frames_dir, ranks, frames, reference_csv):
+    grid = last_frame(frames_dir, "stress_points.pvd", ranks, frames)
+    reference = read_csv(reference_csv)
+    m = grid.GetNumberOfCells()
+    if m != len(reference) or grid.GetNumberOfPoints() != m:
+        fail("the last stress-point frame has %d cells and %d points, expected %d of each"
+             % (m, grid.GetNumberOfPoints(), len(reference)))
+    index = grid.GetCellData().GetArray("stress_point")
+    ids = [int(index.GetValue(k)) for k in range(m)]
+    if sorted(ids) != list(range(m)):
+        fail("stress_point is not every stress point once")
+    for name, components in (("equivalent_stress", None), ("membrane_force", 3), ("bending_moment", 3),
+                             ("thickness", 1)):
+        array = grid.GetCellData().GetArray(name)
+        if array is None or (components and array.GetNumberOfComponents() != components):
+            fail("stress-point cell array %s missing or of the wrong size" % name)
+    points = grid.GetPoints()
+    for k in range(m):
+        if tuple(points.GetPoint(k)) != reference[ids[k]]:
+            fail("stress point %d at %s, the serial run has %s" % (ids[k], points.GetPoint(k), reference[ids[k]]))
+    return m
+
+
+def main():
+    frames_dir, ranks, frames, reference_csv = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), sys.argv[4]
+    stress_reference_csv = sys.argv[5]
+    grid = last_frame(frames_dir, "particles.pvd", ranks, frames)
+    reference = read_csv(reference_csv)
     n = grid.GetNumberOfPoints()
     if n != len(reference):
         fail("the last frame has %d points, expected %d" % (n, len(reference)))
@@ -53,8 +90,9 @@ def main():
         expected = reference[ids[k]]
         if tuple(points.GetPoint(k)) != expected:
             fail("particle %d at %s, the serial run has %s" % (ids[k], points.GetPoint(k), expected))
-    print("check_pvtu: %d frames, %d pieces each, %d particles in the last frame at the serial positions"
-          % (frames, ranks, n))
+    m = check_stress_points(frames_dir, ranks, frames, stress_reference_csv)
+    print("check_pvtu: %d frames, %d pieces each, %d particles and %d stress points in the last frame at the "
+          "serial positions" % (frames, ranks, n, m))
 
 
 main()

@@ -17,6 +17,8 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -138,7 +140,13 @@ TEST_CASE("Distributed pre-cracked strip separates as the serial one", "[mpi][fr
   serial.add_precrack(precrack);
   serial.clamp(model.set("x_min"));
   serial.prescribe_velocity(model.set("x_max"), pull);
-  Distributed distributed(comm, model, table_3_steel);
+  // Frames of the distributed run: one written at the end (output_interval 0).
+  namespace fs = std::filesystem;
+  const std::string folder =
+      (fs::temp_directory_path() / ("sphshell_test_mpi_strip_np" + std::to_string(comm.size()))).string();
+  SolverOptions options;
+  options.output_directory = folder;
+  Distributed distributed(comm, model, table_3_steel, options);
   distributed.add_precrack(precrack);
   distributed.clamp("x_min");
   distributed.prescribe_velocity(model.set("x_max"), pull);
@@ -146,4 +154,18 @@ TEST_CASE("Distributed pre-cracked strip separates as the serial one", "[mpi][fr
   serial.run_until(2e-4);
   distributed.run_until(2e-4);
   compare("pre-cracked strip", serial, distributed, comm);
+  // The crack frame: rank 0 writes the whole crack set as lines, listed in cracks.pvd.
+  distributed.write_frame();
+  if (comm.is_root()) {
+    std::ifstream frame(folder + "/cracks_000000.vtu"), series(folder + "/cracks.pvd");
+    std::stringstream frame_text, series_text;
+    frame_text << frame.rdbuf();
+    series_text << series.rdbuf();
+    CHECK(frame_text.str().find("NumberOfCells=\"" + std::to_string(serial.crack().segments().size()) + "\"") !=
+          std::string::npos);
+    CHECK(series_text.str().find("cracks_000000.vtu") != std::string::npos);
+    CHECK(fs::exists(folder + "/stress_points_000000.pvtu"));
+  }
+  comm.all_gather(0);
+  if (comm.is_root()) fs::remove_all(folder);
 }

@@ -66,7 +66,7 @@ TEST_CASE("Distributed frames and probes", "[mpi][output]") {
   }
   probed.push_back(static_cast<int>(model.particle_count()) - 1);
   probed_stress_points.push_back(static_cast<int>(model.stress_point_count()) - 1);
-  std::vector<Vector3> serial_positions;
+  std::vector<Vector3> serial_positions, serial_stress_points;
   {
     Serial serial(model, {210e9, 0.3}, options);
     serial.clamp(model.set("boundary"));
@@ -80,6 +80,7 @@ TEST_CASE("Distributed frames and probes", "[mpi][output]") {
                                     probed_stress_points[k]);
     serial.run_until(end_time);
     serial_positions = serial.positions();
+    serial_stress_points = serial.stress_point_positions();
   }
   SolverOptions distributed_options = options;
   distributed_options.output_directory = directory + "/frames";
@@ -121,11 +122,17 @@ TEST_CASE("Distributed frames and probes", "[mpi][output]") {
     CHECK(serial.find('\n') < serial.size() - 1);  // a header and rows
     CHECK(mine == serial);
   }
-  // Frames at 0, 1e-5, ..., 5e-5 s: six, each with one piece per rank.
-  std::size_t pieces = 0;
-  for (const auto& entry : fs::directory_iterator(directory + "/frames"))
-    pieces += entry.path().extension() == ".vtu" ? 1 : 0;
-  CHECK(pieces == 6 * static_cast<std::size_t>(comm.size()));
+  // Frames at 0, 1e-5, ..., 5e-5 s: six, each with a particle and a
+  // stress-point piece per rank.
+  std::size_t particle_pieces = 0, stress_pieces = 0;
+  for (const auto& entry : fs::directory_iterator(directory + "/frames")) {
+    const std::string name = entry.path().filename().string();
+    if (entry.path().extension() != ".vtu") continue;
+    particle_pieces += name.rfind("particles_", 0) == 0 ? 1 : 0;
+    stress_pieces += name.rfind("stress_points_", 0) == 0 ? 1 : 0;
+  }
+  CHECK(particle_pieces == 6 * static_cast<std::size_t>(comm.size()));
+  CHECK(stress_pieces == 6 * static_cast<std::size_t>(comm.size()));
 #ifdef SPHSHELL_VTK_PYTHON
   if (comm.is_root()) {
     {
@@ -135,9 +142,15 @@ TEST_CASE("Distributed frames and probes", "[mpi][output]") {
         std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g\n", x.x(), x.y(), x.z());
         reference << line;
       }
+      std::ofstream stress_reference(directory + "/serial_stress_points.csv");
+      for (const Vector3& x : serial_stress_points) {
+        std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g\n", x.x(), x.y(), x.z());
+        stress_reference << line;
+      }
     }
     const std::string command = std::string(SPHSHELL_VTK_PYTHON) + " " + SPHSHELL_CHECK_PVTU + " " + directory +
-                                "/frames " + std::to_string(comm.size()) + " 6 " + directory + "/serial_positions.csv";
+                                "/frames " + std::to_string(comm.size()) + " 6 " + directory +
+                                "/serial_positions.csv " + directory + "/serial_stress_points.csv";
     CHECK(std::system(command.c_str()) == 0);
   }
 #else

@@ -93,7 +93,7 @@ class DistributedSolver {
       : comm_(comm), model_(std::move(model)), law_(parameters), options_(std::move(options)) {
     collectively(comm_, [&] { set_up(weights); });
     halo_ = HaloPlan(comm_, layout_);
-    frames_ = DistributedFrames(comm_, options_.output());
+    frames_ = DistributedFrames(comm_, options_.output(), Crack::enabled);
   }
 
   // Conditions (shell/constraints.hpp) on a set of global particle ids or on a
@@ -280,8 +280,9 @@ class DistributedSolver {
       probes_.push_back(std::move(probe));
     });
   }
-  // One ParaView frame now (a piece per rank, a .pvtu, the .pvd series);
-  // needs output_directory. Collective.
+  // One ParaView frame now (particle and stress-point pieces per rank, their
+  // .pvtu files, the crack frame, the .pvd series); needs output_directory.
+  // Collective.
   void write_frame() {
     FramePiece piece;
     piece.time = time_;
@@ -294,7 +295,13 @@ class DistributedSolver {
       piece.director.push_back(particles_.director[i]);
       if constexpr (Crack::enabled) piece.fragment.push_back(fragment_flag(layout_.owned[i]));
     }
-    frames_.write(comm_, piece, steps_);
+    const io::VtuGrid stress_points = stress_point_piece();
+    if constexpr (Crack::enabled) {
+      const io::VtuGrid cracks = crack_frame();
+      frames_.write(comm_, piece, stress_points, &cracks, steps_);
+    } else {
+      frames_.write(comm_, piece, stress_points, nullptr, steps_);
+    }
   }
 
   // A pre-crack (Solver::add_precrack), on every rank alike (collective).
@@ -709,6 +716,138 @@ class DistributedSolver {
       return axis / sine * std::atan2(sine, from.dot(to));
     }
   };
+  // The current position of local stress-point row k, interpolated from the
+  // particles (owned and ghosts: current after every step's exchange).
+  Vector3 stress_point_position(std::size_t k) const {
+    const approx::ShapeFunctions& shape = points_->shape(solver::PointGroup::stress_points);
+    Vector3 position = Vector3::Zero();
+    for (std::size_t s = shape.row_begin[k]; s < shape.row_begin[k] + shape.row_size[k]; ++s)
+      position += shape.phi[s] * particles_.position[static_cast<std::size_t>(shape.neighbour[s])];
+    return position;
+  }
+  // Local stress-point rows owned here, in global order.
+  std::vector<std::size_t> owned_stress_rows() const {
+    const std::size_t g = solver::index_of(solver::PointGroup::stress_points);
+    std::vector<std::size_t> rows;
+    for (std::size_t k = 0; k < layout_.computed[g].size(); ++k)
+      if (layout_.computed_is_owned[g][k]) rows.push_back(k);
+    return rows;
+  }
+
+  // This rank's stress-point piece: a vertex cell at each active stress point
+  // it owns, with the serial frame's stress-point cell arrays (integral-point
+  // quantities per thickness output point, resultants, thickness, index).
+  io::VtuGrid stress_point_piece() const {
+    const std::size_t g = solver::index_of(solver::PointGroup::stress_points);
+    const bool deformed = options_.frame_coordinates == FrameCoordinates::deformed;
+    io::VtuGrid grid;
+    grid.time = time_;
+    std::vector<Vector3> displacement;
+    std::vector<std::size_t> drawn;  // local points
+    std::vector<int> index;          // global stress points
+    for (std::size_t k : owned_stress_rows()) {
+      const std::size_t p = points_->point(solver::PointGroup::stress_points, k);
+      if (!states_->active(p)) continue;
+      const auto q = layout_.computed[g][k];
+      const Vector3 current = stress_point_position(k), reference = model_.stress_point_position[q];
+      grid.cells.add_vertex(static_cast<int>(grid.points.size()));
+      grid.points.push_back(deformed ? current : reference);
+      displacement.push_back(current - reference);
+      drawn.push_back(p);
+      index.push_back(static_cast<int>(q));
+    }
+    io::PointField displacement_field{"displacement", 3, {}};
+    for (const Vector3& u : displacement) displacement_field.values.insert(displacement_field.values.end(), {u.x(), u.y(), u.z()});
+    grid.point_fields = {displacement_field};
+    const std::vector<std::string> names = solver::thickness_point_names<Rule>();
+    for (const solver::IntegralPointQuantityInfo& info : solver::integral_point_quantities) {
+      if (info.needs_damage_law && !Material::has_damage) continue;
+      io::CellField field{info.name, output_points, {}, names};
+      for (std::size_t p : drawn)
+        for (int k = 0; k < output_points; ++k) field.values.push_back(states_->quantity(info.quantity, p, k));
+      grid.cell_fields.push_back(std::move(field));
+    }
+    io::CellField membrane{"membrane_force", 3, {}, {"Nxx", "Nyy", "Nxy"}};
+    io::CellField moment{"bending_moment", 3, {}, {"Mxx", "Myy", "Mxy"}};
+    io::CellField thickness{"thickness", 1, {}};
+    io::CellField stress_point{"stress_point", 1, {}, {}, io::FieldValues::integer};
+    for (std::size_t n = 0; n < drawn.size(); ++n) {
+      for (int c = 0; c < 3; ++c) {
+        membrane.values.push_back(states_->membrane_force(drawn[n])[c]);
+        moment.values.push_back(states_->bending_moment(drawn[n])[c]);
+      }
+      thickness.values.push_back(model_.stress_point_thickness(static_cast<std::size_t>(index[n])));
+      stress_point.values.push_back(index[n]);
+    }
+    grid.cell_fields.push_back(std::move(membrane));
+    grid.cell_fields.push_back(std::move(moment));
+    grid.cell_fields.push_back(std::move(thickness));
+    grid.cell_fields.push_back(std::move(stress_point));
+    grid.note = std::string("sphshell frame piece (one rank's owned active stress points, a vertex cell each; "
+                            "stress-point data as cell data), t = ") +
+                io::detail::round_trip_decimal(time_) + " s; points: " + (deformed ? "deformed" : "reference") +
+                " positions";
+    return grid;
+  }
+
+  // The crack segments as lines, as the serial frame draws them: a damaged
+  // stress point's crack point at the stress point's interpolated position, a
+  // pre-crack point moved by its nearest particle's displacement; the owners
+  // place the points and every rank gathers them (a crack has few points).
+  // Collective; the grid is used on rank 0.
+  io::VtuGrid crack_frame() const {
+    const auto& crack = fracture_.crack();
+    const std::vector<Vector3>& reference = crack.points();
+    struct Placed {
+      std::int64_t point;
+      double position[3];
+    };
+    std::vector<Placed> mine;
+    std::vector<char> from_stress_point(reference.size(), 0);
+    for (std::size_t q = 0; q < model_.stress_point_count(); ++q) {
+      const int k = crack.crack_point_of_stress_point(static_cast<int>(q));
+      if (k >= 0) from_stress_point[static_cast<std::size_t>(k)] = 1;
+    }
+    const std::size_t g = solver::index_of(solver::PointGroup::stress_points);
+    for (std::size_t k : owned_stress_rows()) {
+      const int point = crack.crack_point_of_stress_point(static_cast<int>(layout_.computed[g][k]));
+      if (point < 0) continue;
+      const Vector3 x = stress_point_position(k);
+      mine.push_back({point, {x.x(), x.y(), x.z()}});
+    }
+    for (std::size_t k = 0; k < reference.size(); ++k) {
+      if (from_stress_point[k]) continue;
+      const int nearest = model_.nearest_particle(reference[k]);
+      if (!owns(nearest)) continue;
+      const auto i = static_cast<std::size_t>(layout_.local_of[static_cast<std::size_t>(nearest)]);
+      const Vector3 x = reference[k] + (particles_.position[i] - reference_position_[i]);
+      mine.push_back({static_cast<std::int64_t>(k), {x.x(), x.y(), x.z()}});
+    }
+    std::vector<Vector3> current(reference.size(), Vector3::Zero());
+    for (const Placed& placed : comm_.all_gather_v(mine))
+      current[static_cast<std::size_t>(placed.point)] =
+          Vector3(placed.position[0], placed.position[1], placed.position[2]);
+    const bool deformed = options_.frame_coordinates == FrameCoordinates::deformed;
+    io::VtuGrid grid;
+    grid.time = time_;
+    grid.points = deformed ? current : reference;
+    io::PointField displacement{"displacement", 3, {}};
+    for (std::size_t k = 0; k < reference.size(); ++k) {
+      const Vector3 u = current[k] - reference[k];
+      displacement.values.insert(displacement.values.end(), {u.x(), u.y(), u.z()});
+    }
+    io::CellField crack_id{"crack_id", 1, {}, {}, io::FieldValues::integer};
+    for (const auto& segment : crack.segments()) {
+      grid.cells.add_line(segment.start_point, segment.end_point);
+      crack_id.values.push_back(segment.crack_id);
+    }
+    grid.point_fields = {displacement};
+    grid.cell_fields = {crack_id};
+    grid.note = "sphshell frame, t = " + io::detail::round_trip_decimal(time_) +
+                " s: the crack segments as lines (crack_id per segment).";
+    return grid;
+  }
+
   // What solver::StressPointProbe reads, for a stress point owned here.
   struct StressPointView {
     const DistributedSolver& solver;
