@@ -602,9 +602,7 @@ class DistributedSolver {
     in(stamp, start_time_, steps, time_step_, time_, forces_current_, latch_.message());
     in.close_section();
     steps_ = static_cast<long>(steps);
-    const double time = start_time_ + static_cast<double>(steps_) * time_step_;
-    if (std::memcmp(&time, &time_, sizeof time) != 0)
-      in.fail("its time " + solver::number_text(time_) + " s is not t0 + n dt = " + solver::number_text(time) + " s");
+    solver::checkpoint::check_time_of_steps(in, start_time_, steps_, time_step_, time_);
     in.open_section("PART");
     particles_.load(in);
     in.close_section();

@@ -252,6 +252,15 @@ inline void check_identity(const Identity& file, const Identity& here, const std
   compare_values(file.options, here.options, "set of options");
 }
 
+// A TIME section's time must be t0 + n dt bit for bit (the solvers keep time
+// that way); `in` fails naming both otherwise.
+template <class Reader>
+void check_time_of_steps(Reader& in, double start_time, long steps, double time_step, double time) {
+  const double expected = start_time + static_cast<double>(steps) * time_step;
+  if (std::memcmp(&expected, &time, sizeof time) != 0)
+    in.fail("its time " + number_text(time) + " s is not t0 + n dt = " + number_text(expected) + " s");
+}
+
 // The header, the payload and the checksums, written atomically.
 inline void write_file(const std::string& path, const std::array<std::string, 5>& policies,
                        const io::BinaryWriter& payload) {
