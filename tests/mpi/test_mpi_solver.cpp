@@ -230,7 +230,7 @@ TEST_CASE("Distributed solver: an Error on one rank stops every rank with the se
   CHECK(out_of_range.find("out of range") != std::string::npos);
 }
 
-TEST_CASE("Distributed checkpoint: a restart continues bitwise; files of another save or rank count are an Error",
+TEST_CASE("Distributed checkpoint: a restart continues bitwise, files of another save or rank count are an Error",
           "[mpi][solver][checkpoint]") {
   const mpi::Communicator comm;
   using J2 = material::J2Plasticity;
