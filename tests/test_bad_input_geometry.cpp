@@ -3,6 +3,7 @@
 // at construction, instead of a misleading error later or a silent result.
 #include "bad_input_support.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -46,9 +47,22 @@ TEST_CASE("A support too small for the spacing names support_radius_factor", "[b
   options.support_radius_factor = 0.5;
   require_error([&] { ElasticSolver(ShellModel::rectangular_plate(0.1, 0.1, 6, 6, 0.01), steel, options); },
                 {"support_radius_factor", "support radius"});
-  // A plate 10⁴ times longer than wide: √(cell area) is far below the cells' length.
-  require_error([] { ElasticSolver(ShellModel::rectangular_plate(1.0, 1e-4, 11, 11, 1e-5), steel); },
-                {"support_radius_factor", "longer than wide"});
+  // A plate 10⁴ times longer than wide (cells 0.1 m × 10 µm): √(cell area) is
+  // far below the cells' length, but the local spacing takes each stress
+  // point's distance to its farthest corner and each particle's long side
+  // (solver/local_spacing.hpp), so every row reaches particles off its line
+  // and fits linear fields: the strip is legal (with one support radius from
+  // √A it was refused naming support_radius_factor).
+  const ShellModel strip = ShellModel::rectangular_plate(1.0, 1e-4, 11, 11, 1e-5);
+  const SolverOptions defaults;
+  const solver::IntegrationPoints<approx::MLS<kernel::CubicSpline>> points(strip, defaults.physics(),
+                                                                            defaults.particle_integration(), 80e9);
+  for (solver::PointGroup group : solver::point_groups)
+    for (std::size_t row = 0; row < points.count(group); ++row) {
+      CHECK(points.shape(group).shepard[row] == 0);
+      CHECK(points.shape(group).row_size[row] >= 4);
+    }
+  CHECK_NOTHROW(ElasticSolver(strip, steel));
   // 1 m × 1 nm: the particles lie on one line to round-off.
   require_error([] { ShellModel::rectangular_plate(1.0, 1e-9, 11, 11, 1e-10); }, {"one line"});
 }
@@ -99,10 +113,81 @@ TEST_CASE("Area sets that do not cover the surface once are refused", "[bad_inpu
   CHECK(covered == Approx(0.01).epsilon(1e-12));
 }
 
-TEST_CASE("One stress-point area far above the others is refused", "[bad_input][geometry]") {
+TEST_CASE("One stress-point area far above the others without the surface to match is refused",
+          "[bad_input][geometry]") {
+  // The areas no longer cover the surface once: refused by the area sums,
+  // naming the largest area.
   GeneralPlate plate;
   plate.stress_areas[7] *= 1e4;
-  require_error([&] { plate.build(); }, {"stress point 7 area", "times the median", "at most 64"});
+  require_error([&] { plate.build(); },
+                {"sum of the particle areas", "covers the mid-surface once", "stress point 7 area = 4.000000",
+                 "10000.000000 times the median"});
+}
+
+// A legal model with one stress point of 10⁴ times the others' area: a
+// 120 × 120 cell plate whose central 100 × 100 cells are one stress point.
+// The support radius is each point's own: that row covers the plate, every
+// other row keeps its size on the uniform plate (with one global spacing,
+// from the largest area, every row held all 14641 particles).
+TEST_CASE("One stress point with a 1e4 times larger area widens its own row only", "[bad_input][geometry]") {
+  constexpr int cells = 120, block = 100, n = cells + 1;
+  const GeneralPlate uniform(n, 1.2);
+  GeneralPlate graded(n, 1.2);
+  const double s = 1.2 / cells;
+  graded.stress_positions.clear();
+  graded.stress_normals.clear();
+  graded.stress_areas.clear();
+  const int first = (cells - block) / 2;
+  const auto in_block = [&](int k) { return k >= first && k < first + block; };
+  for (int j = 0; j < cells; ++j)
+    for (int i = 0; i < cells; ++i)
+      if (!(in_block(i) && in_block(j))) {
+        graded.stress_positions.emplace_back((i + 0.5) * s, (j + 0.5) * s, 0.0);
+        graded.stress_normals.emplace_back(0.0, 0.0, 1.0);
+        graded.stress_areas.push_back(s * s);
+      }
+  const std::size_t large = graded.stress_positions.size();
+  graded.stress_positions.emplace_back(0.6, 0.6, 0.0);
+  graded.stress_normals.emplace_back(0.0, 0.0, 1.0);
+  graded.stress_areas.push_back(block * block * s * s);
+
+  using Points = solver::IntegrationPoints<approx::MLS<kernel::CubicSpline>>;
+  const SolverOptions options;
+  const Points before(uniform.build(), options.physics(), options.particle_integration(), 80e9);
+  const Points after(graded.build(), options.physics(), options.particle_integration(), 80e9);
+  const auto largest_row = [](const Points& points, solver::PointGroup group, std::size_t skip) {
+    int largest = 0;
+    for (std::size_t row = 0; row < points.count(group); ++row)
+      if (row != skip) largest = std::max(largest, points.shape(group).row_size[row]);
+    return largest;
+  };
+  using solver::PointGroup;
+  const int uniform_stress = largest_row(before, PointGroup::stress_points, before.count(PointGroup::stress_points));
+  const int uniform_particle = largest_row(before, PointGroup::particles, before.count(PointGroup::particles));
+  INFO("rows on the uniform plate: at most " << uniform_stress << " (stress points), " << uniform_particle
+                                             << " (particles); the large point's row "
+                                             << after.shape(PointGroup::stress_points).row_size[large]);
+  CHECK(uniform_stress <= 16);
+  CHECK(uniform_particle <= 16);
+  // Its own row: every particle within 2 × 100 spacings, here all of them.
+  CHECK(after.shape(PointGroup::stress_points).row_size[large] == n * n);
+  CHECK(after.support_radius(PointGroup::stress_points, large) == Approx(2.0 * block * s).epsilon(1e-12));
+  CHECK(largest_row(after, PointGroup::stress_points, large) == uniform_stress);
+  CHECK(largest_row(after, PointGroup::particles, after.count(PointGroup::particles)) == uniform_particle);
+  // So the slots grow by that one row (about 1.0x), not by 1e3x.
+  const double ratio = double(after.slot_count()) / double(before.slot_count());
+  CHECK(ratio < 1.1);
+  // And the solver runs on it.
+  ShellModel model = graded.build();
+  const ParticleSet& edge = model.define_set("edge", [](const Vector3& x) {
+    return x.x() < 1e-9 || x.y() < 1e-9 || x.x() > 1.2 - 1e-9 || x.y() > 1.2 - 1e-9;
+  });
+  ElasticSolver solver(model, steel);
+  solver.clamp(edge);
+  solver.add_uniform_pressure(model.all_particles(), 1e3);
+  CHECK_NOTHROW([&] {
+    for (int k = 0; k < 3; ++k) solver.step();
+  }());
 }
 
 TEST_CASE("Near-coincident particles are refused", "[bad_input][geometry]") {

@@ -28,6 +28,10 @@ namespace sphshell::test_support {
 
 struct PlateGrid {
   int nx, ny;  // particles along x and y (index j * nx + i)
+  // Grid steps between particles perturbed together; 0 takes it from the
+  // support on a uniform grid. A graded grid, whose supports span more steps
+  // where the steps are small, passes its own (max(nx, ny): one at a time).
+  int stride = 0;
 };
 
 // Per-particle bending dofs: w (m), then rotations (rad) about x and y.
@@ -53,7 +57,7 @@ Eigen::SparseMatrix<double> assemble_bending_stiffness(Solver& solver, const Pla
   const std::vector<Vector3> x0 = solver.positions(), d0 = solver.directors();
   const double spacing = solver.model().maximum_spacing();
   const double reach = 2.0 * solver.options().support_radius_factor * spacing;
-  const int stride = static_cast<int>(std::ceil(2.0 * reach / spacing)) + 1;
+  const int stride = grid.stride > 0 ? grid.stride : static_cast<int>(std::ceil(2.0 * reach / spacing)) + 1;
   const int n = static_cast<int>(x0.size());
   std::vector<Eigen::Triplet<double>> entries;
   for (int cy = 0; cy < stride; ++cy)

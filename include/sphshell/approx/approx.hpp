@@ -5,11 +5,13 @@
 //   using kernel_type = Kernel;
 //   static ShapeFunctions build(particles, particle_volumes, eval_positions,
 //                               eval_frames, h, visible = AlwaysVisible{});
+//     with h one smoothing length for every row (double) or one per row
+//     (std::vector<double>, the gather form W(x_j − x_i, h_i));
 //   static void rebuild_row(ShapeFunctions&, row, particles, particle_volumes,
 //                           eval_position, eval_frame, h, visible);
 // build computes Φ_j and ∇Φ_j (in each evaluation point's tangent frame) of
 // every evaluation point from the particles within
-// kernel_type::support_radius_factor · h; rebuild_row recomputes one row in
+// kernel_type::support_radius_factor · h (its own h); rebuild_row recomputes one row in
 // place from the neighbours stored in it (after a crack hides more pairs).
 // `visible(eval_index, particle)` says whether a pair interacts; build calls it
 // from several OpenMP threads at once, so it must be safe to call concurrently
@@ -46,6 +48,17 @@ struct has_build<A, std::enable_if_t<std::is_same_v<
                         ShapeFunctions>>> : std::true_type {};
 
 template <class A, class = void>
+struct has_build_per_row : std::false_type {};
+template <class A>
+struct has_build_per_row<A, std::enable_if_t<std::is_same_v<
+                                decltype(A::build(std::declval<const std::vector<Vector3>&>(),
+                                                  std::declval<const std::vector<double>&>(),
+                                                  std::declval<const std::vector<Vector3>&>(),
+                                                  std::declval<const std::vector<TangentFrame>&>(),
+                                                  std::declval<const std::vector<double>&>(), AlwaysVisible{})),
+                                ShapeFunctions>>> : std::true_type {};
+
+template <class A, class = void>
 struct has_rebuild_row : std::false_type {};
 template <class A>
 struct has_rebuild_row<
@@ -58,7 +71,7 @@ struct has_rebuild_row<
 
 template <class A>
 inline constexpr bool is_approximation_v = detail::has_kernel_type<A>::value &&
-                                           detail::has_build<A>::value &&
+                                           detail::has_build<A>::value && detail::has_build_per_row<A>::value &&
                                            detail::has_rebuild_row<A>::value;
 
 template <class A>
@@ -73,6 +86,10 @@ constexpr bool check_approximation() {
   static_assert(detail::has_build<A>::value,
                 "sphshell approximation: missing the build; add `static ShapeFunctions build(particles, "
                 "particle_volumes, eval_positions, eval_frames, h, visible)`");
+  static_assert(detail::has_build_per_row<A>::value,
+                "sphshell approximation: missing the build with local smoothing lengths; add `static ShapeFunctions "
+                "build(particles, particle_volumes, eval_positions, eval_frames, const std::vector<double>& h, "
+                "visible)` (one h per evaluation point)");
   static_assert(detail::has_rebuild_row<A>::value,
                 "sphshell approximation: missing the row rebuild; add `static void rebuild_row(ShapeFunctions&, "
                 "row, particles, particle_volumes, eval_position, eval_frame, h, visible)`");

@@ -42,6 +42,17 @@ struct MLS {
                                           eval_frames, h, visible);
   }
 
+  // One smoothing length per evaluation point (the solver's local support).
+  template <class Visible = AlwaysVisible>
+  static ShapeFunctions build(const std::vector<Vector3>& particles,
+                              const std::vector<double>& particle_volumes,
+                              const std::vector<Vector3>& eval_positions,
+                              const std::vector<TangentFrame>& eval_frames, const std::vector<double>& h,
+                              Visible visible = {}) {
+    return detail::build_all<Kernel, MLS>(particles, particle_volumes, eval_positions,
+                                          eval_frames, h, visible);
+  }
+
   template <class Visible>
   static void rebuild_row(ShapeFunctions& sf, std::size_t row,
                           const std::vector<Vector3>& particles,

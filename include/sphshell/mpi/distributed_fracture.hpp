@@ -28,6 +28,7 @@
 #include <sphshell/shell/model.hpp>
 #include <sphshell/solver/integration_points.hpp>
 #include <sphshell/solver/internal_forces.hpp>
+#include <sphshell/solver/local_spacing.hpp>
 #include <sphshell/solver/particles.hpp>
 #include <sphshell/solver/section_states.hpp>
 
@@ -85,8 +86,9 @@ class DistributedFracture<Crack, true> {
   template <class Approx>
   void initialize(const ShellModel& model, const solver::IntegrationPoints<Approx>& all_points,
                   const RankLayout& layout) {
+    // As the serial manager: searches bounded by the largest row support.
     crack_.initialize(model.stress_point_position, model.stress_point_normal, model.maximum_spacing(),
-                      all_points.support_radius());
+                      all_points.largest_support_radius());
     fragment_.assign(model.particle_count(), 0);
     stress_point_active_.assign(model.stress_point_count(), 1);
     // The particles around each stress point, as the serial manager finds them.
@@ -95,10 +97,10 @@ class DistributedFracture<Crack, true> {
       for (std::size_t q = 0; q < model.cells().size(); ++q)
         particles_of_stress_point_[q].assign(model.cells()[q].begin(), model.cells()[q].end());
     } else {
-      const double reach = model.maximum_spacing();
-      const approx::CellList cells(model.particle_position, reach);
+      const std::vector<double>& reach = solver::local_spacing(model).stress_point;
+      const approx::CellList cells(model.particle_position, solver::median_of(reach));
       for (std::size_t q = 0; q < model.stress_point_count(); ++q)
-        cells.for_each_within(model.stress_point_position[q], reach,
+        cells.for_each_within(model.stress_point_position[q], reach[q],
                               [&](int i, double) { particles_of_stress_point_[q].push_back(i); });
     }
     stress_points_of_particle_.assign(model.particle_count(), {});
@@ -297,9 +299,9 @@ class DistributedFracture<Crack, true> {
     const std::vector<Vector3>& eval = local_eval_[solver::index_of(group)];
     std::vector<std::size_t> rows = crack_.affected_points(eval, segments);
     if (!new_fragments.empty()) {
-      const double support_radius = parts.all_points.support_radius();
       std::vector<char> near(eval.size(), 0);
       parallel::for_each(std::size_t{0}, eval.size(), [&](std::size_t row) noexcept {
+        const double support_radius = parts.points.support_radius(group, row);  // the local row's own
         for (int particle : new_fragments)
           if ((eval[row] - parts.model.particle_position[particle]).norm() < support_radius) near[row] = 1;
       });

@@ -260,6 +260,12 @@ class ShellModel {
     for (std::size_t p = 1; p < stress_point_count(); ++p) largest = std::max(largest, area_per_particle(p));
     return std::sqrt(largest);
   }
+  // The spacing of stress point p's own cell, √(area per particle) as above;
+  // the solver's local support radius starts from it (solver/local_spacing.hpp).
+  double stress_point_spacing(std::size_t p) const {
+    detail::model_checks::check_index("stress point", p, stress_point_count());
+    return std::sqrt(area_per_particle(p));
+  }
 
   // Cuts (shell/cuts.hpp, docs/method.md §6): a polyline on the mid-surface
   // (reference coordinates) along which the shell is separated from the start,
@@ -411,11 +417,9 @@ class ShellModel {
     normalize_all(stress_point_position, stress_point_normal, stress_point_area, "stress point");
     detail::model_checks::check_spans_a_surface(particle_position, particle_normal, stress_point_normal);
     detail::model_checks::require_thin("thickness", thickness_, extent());
-    detail::model_checks::check_outliers(stress_point_area, "stress point");
-    detail::model_checks::check_outliers(particle_area, "particle");
     detail::model_checks::check_area_sums(particle_area, stress_point_area);
     detail::model_checks::check_orientation(particle_position, particle_normal, stress_point_position,
-                                            stress_point_normal, stress_point_area);
+                                            stress_point_normal, particle_area);
     coincident_particles_ = detail::model_checks::check_separation(particle_position, particle_area, cells_);
   }
   static void normalize_all(const std::vector<Vector3>& positions, std::vector<Vector3>& normals,

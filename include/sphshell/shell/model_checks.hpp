@@ -39,9 +39,6 @@ inline constexpr double coincident_spacing_fraction = 1e-3;
 // The two area sets (particles, stress points) cover the same surface: their
 // sums may differ by at most this fraction.
 inline constexpr double area_sum_tolerance = 0.02;
-// One area this many times the median of its set is an outlier: the support
-// radius follows the largest spacing, so it would widen every row.
-inline constexpr double area_outlier_ratio = 64.0;
 // Particles whose spread across their main line is below this fraction of
 // their extent lie on one line; a sheet flat to this fraction is planar.
 inline constexpr double collinear_fraction = 1e-6;
@@ -152,16 +149,6 @@ inline double median(std::vector<double> values) {
   std::nth_element(values.begin(), middle, values.end());
   return *middle;
 }
-inline void check_outliers(const std::vector<double>& areas, const std::string& what) {
-  const double typical = median(areas);
-  for (std::size_t i = 0; i < areas.size(); ++i)
-    if (areas[i] > area_outlier_ratio * typical)
-      detail::invalid_parameter(what + " " + std::to_string(i) + " area", areas[i],
-                                "is " + std::to_string(areas[i] / typical) + " times the median " +
-                                    std::to_string(typical) + " m²; at most " + std::to_string(area_outlier_ratio) +
-                                    " times: the support radius follows the largest spacing, so one large area "
-                                    "widens every row");
-}
 // The sheet spans a surface: not one line; a flat sheet's normals point out of its plane.
 inline void check_spans_a_surface(const std::vector<Vector3>& particle_position,
                                   const std::vector<Vector3>& particle_normal,
@@ -192,15 +179,18 @@ inline void check_spans_a_surface(const std::vector<Vector3>& particle_position,
 inline void check_orientation(const std::vector<Vector3>& particle_position, const std::vector<Vector3>& particle_normal,
                               const std::vector<Vector3>& stress_point_position,
                               const std::vector<Vector3>& stress_point_normal,
-                              const std::vector<double>& stress_point_area) {
-  // The nearest stress point of a grid lies within 0.71 spacings; a particle
-  // with none within one spacing is not checked.
-  const double reach = std::sqrt(*std::max_element(stress_point_area.begin(), stress_point_area.end()));
-  const approx::CellList stress_points(stress_point_position, reach);
+                              const std::vector<double>& particle_area) {
+  // The nearest stress point of a grid lies within 0.71 spacings (0.71 √A_i
+  // of an inner particle, 1.41 √A_i of a corner one, whose area is a quarter);
+  // a particle with none within two of its own spacings √A_i is not checked.
+  // Cells of the median reach keep a graded sheet's search local.
+  std::vector<double> reach(particle_area.size());
+  for (std::size_t i = 0; i < reach.size(); ++i) reach[i] = 2.0 * std::sqrt(particle_area[i]);
+  const approx::CellList stress_points(stress_point_position, median(reach));
   for (std::size_t i = 0; i < particle_position.size(); ++i) {
     int nearest_point = -1;
     double nearest_distance = std::numeric_limits<double>::infinity();
-    stress_points.for_each_within(particle_position[i], reach, [&](int p, double distance_squared) {
+    stress_points.for_each_within(particle_position[i], reach[i], [&](int p, double distance_squared) {
       if (distance_squared < nearest_distance) nearest_distance = distance_squared, nearest_point = p;
     });
     if (nearest_point >= 0 && particle_normal[i].dot(stress_point_normal[nearest_point]) < 0.0)
@@ -218,11 +208,11 @@ inline void check_orientation(const std::vector<Vector3>& particle_position, con
 inline std::vector<std::pair<int, int>> check_separation(const std::vector<Vector3>& particle_position,
                                                          const std::vector<double>& particle_area,
                                                          const std::vector<Cell>& cells) {
-  // Cells about one spacing wide: a few particles each (cells as narrow as
-  // the tolerance would be mostly empty and slow to search).
-  double reach = 0.0;
-  for (double area : particle_area) reach = std::max(reach, std::sqrt(area));
-  const approx::CellList particles(particle_position, reach);
+  // Cells about one (median) spacing wide: a few particles each (cells as
+  // narrow as the tolerance would be mostly empty and slow to search).
+  std::vector<double> spacing(particle_area.size());
+  for (std::size_t i = 0; i < spacing.size(); ++i) spacing[i] = std::sqrt(particle_area[i]);
+  const approx::CellList particles(particle_position, median(spacing));
   std::vector<std::pair<int, int>> pairs;
   for (std::size_t i = 0; i < particle_position.size(); ++i) {
     const double limit = coincident_spacing_fraction * std::sqrt(particle_area[i]);
@@ -256,11 +246,20 @@ inline void check_area_sums(const std::vector<double>& particle_area, const std:
   double particles = 0.0, stress_points = 0.0;
   for (double area : particle_area) particles += area;
   for (double area : stress_point_area) stress_points += area;
-  if (std::abs(particles - stress_points) > area_sum_tolerance * std::max(particles, stress_points))
+  if (std::abs(particles - stress_points) > area_sum_tolerance * std::max(particles, stress_points)) {
+    // The largest area of the set that covers too much, which is the fault
+    // when one area alone is far off.
+    const bool stress_larger = stress_points > particles;
+    const std::vector<double>& larger = stress_larger ? stress_point_area : particle_area;
+    const auto largest = static_cast<std::size_t>(std::max_element(larger.begin(), larger.end()) - larger.begin());
     detail::invalid_parameter("sum of the particle areas", particles,
                               "must equal the sum of the stress point areas " + std::to_string(stress_points) +
                                   " m² within " + std::to_string(100.0 * area_sum_tolerance) +
-                                  " %: each set of areas covers the mid-surface once");
+                                  " %: each set of areas covers the mid-surface once; the largest is " +
+                                  (stress_larger ? "stress point " : "particle ") + std::to_string(largest) +
+                                  " area = " + std::to_string(larger[largest]) + " m², " +
+                                  std::to_string(larger[largest] / median(larger)) + " times the median of its set");
+  }
 }
 
 inline void require_count(const char* name, int value, int minimum) {

@@ -78,21 +78,24 @@ class FractureManager<Crack, true> {
  public:
   template <class Approx>
   void initialize(const ShellModel& model, const IntegrationPoints<Approx>& points) {
+    // The crack policy bounds its searches by the largest row support: every
+    // row's own support lies within it (rows_near then keeps a fragment's
+    // rebuilds to the rows whose own support reaches it).
     crack_.initialize(model.stress_point_position, model.stress_point_normal, model.maximum_spacing(),
-                      points.support_radius());
+                      points.largest_support_radius());
     fragment_.assign(model.particle_count(), 0);
     // The particles around each stress point: the corners of its cell (quad
-    // or triangle), or, for a model without cells, the particles within one
-    // spacing; and the inverse.
+    // or triangle), or, for a model without cells, the particles within its
+    // own spacing (ShellModel::stress_point_spacing); and the inverse.
     particles_of_stress_point_.assign(model.stress_point_count(), {});
     if (!model.cells().empty()) {
       for (std::size_t q = 0; q < model.cells().size(); ++q)
         particles_of_stress_point_[q].assign(model.cells()[q].begin(), model.cells()[q].end());
     } else {
-      const double reach = model.maximum_spacing();
-      const approx::CellList cells(model.particle_position, reach);
+      const std::vector<double>& reach = local_spacing(model).stress_point;
+      const approx::CellList cells(model.particle_position, median_of(reach));
       for (std::size_t q = 0; q < model.stress_point_count(); ++q)
-        cells.for_each_within(model.stress_point_position[q], reach,
+        cells.for_each_within(model.stress_point_position[q], reach[q],
                               [&](int i, double) { particles_of_stress_point_[q].push_back(i); });
     }
     stress_points_of_particle_.assign(model.particle_count(), {});
@@ -272,9 +275,9 @@ class FractureManager<Crack, true> {
     const std::vector<Vector3>& eval = parts.points.positions(parts.model, group);
     std::vector<std::size_t> rows = crack_.affected_points(eval, segments);
     if (!new_fragments.empty()) {
-      const double support_radius = parts.points.support_radius();
       std::vector<char> near(eval.size(), 0);
       parallel::for_each(std::size_t{0}, eval.size(), [&](std::size_t row) noexcept {
+        const double support_radius = parts.points.support_radius(group, row);
         for (int particle : new_fragments)
           if ((eval[row] - parts.model.particle_position[particle]).norm() < support_radius) near[row] = 1;
       });

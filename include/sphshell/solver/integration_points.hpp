@@ -18,9 +18,11 @@
 #include <sphshell/shell/cuts.hpp>
 #include <sphshell/shell/kinematics.hpp>
 #include <sphshell/shell/model.hpp>
+#include <sphshell/solver/local_spacing.hpp>
 #include <sphshell/solver/options.hpp>
 #include <sphshell/solver/particles.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -46,18 +48,26 @@ class IntegrationPoints {
   // (a share or a shear weight > 0), at the particles.
   IntegrationPoints(const ShellModel& model, const PhysicsOptions& physics,
                     const ParticleIntegrationOptions& particle_integration, double shear_modulus) {
-    const double spacing = model.maximum_spacing();
-    smoothing_length_ = physics.support_radius_factor * spacing / Approx::kernel_type::support_radius_factor;
-    for (const Vector3& normal : model.stress_point_normal) frames_[0].push_back(tangent_frame(normal));
-    for (const Vector3& normal : model.particle_normal) frames_[1].push_back(tangent_frame(normal));
-    cuts_ = shell::CutVisibility(model.cut_geometry(), model.cuts(), support_radius());
-    shape_[0] = Approx::build(model.particle_position, model.particle_area, model.stress_point_position,
-                              frames_[0], smoothing_length_, cut_visibility(model, PointGroup::stress_points));
+    // Each point's support follows its own local spacing (solver/local_spacing.hpp).
+    const LocalSpacing spacing = local_spacing(model);
     const bool particles_integrate = particle_integration.particle_integration_share > 0.0 ||
                                      particle_integration.particle_shear_weight > 0.0;
+    const auto smoothing = [&](double local) {
+      return physics.support_radius_factor * local / Approx::kernel_type::support_radius_factor;
+    };
+    for (double local : spacing.stress_point) smoothing_length_[0].push_back(smoothing(local));
+    if (particles_integrate)
+      for (double local : spacing.particle) smoothing_length_[1].push_back(smoothing(local));
+    for (const Vector3& normal : model.stress_point_normal) frames_[0].push_back(tangent_frame(normal));
+    for (const Vector3& normal : model.particle_normal) frames_[1].push_back(tangent_frame(normal));
+    // The cut test looks for cut pieces within the largest row support (each
+    // row's own support lies within it).
+    cuts_ = shell::CutVisibility(model.cut_geometry(), model.cuts(), largest_support_radius());
+    shape_[0] = Approx::build(model.particle_position, model.particle_area, model.stress_point_position,
+                              frames_[0], smoothing_length_[0], cut_visibility(model, PointGroup::stress_points));
     if (particles_integrate)
       shape_[1] = Approx::build(model.particle_position, model.particle_area, model.particle_position,
-                                frames_[1], smoothing_length_, cut_visibility(model, PointGroup::particles));
+                                frames_[1], smoothing_length_[1], cut_visibility(model, PointGroup::particles));
 
     // A row that fell back to the constant approximation has no gradient: the
     // support is too small for the spacing.
@@ -66,7 +76,9 @@ class IntegrationPoints {
         if (shape(group).shepard[row])
           detail::invalid_parameter("support_radius_factor", physics.support_radius_factor,
                                     std::string("too few neighbours (fewer than 3) at ") + name_of(group) + " " +
-                                        std::to_string(row));
+                                        std::to_string(row) + " within its support radius " +
+                                        std::to_string(support_radius(group, row)) +
+                                        " m (support_radius_factor × its local spacing)");
     const std::size_t stress_points = model.stress_point_count();
     const std::size_t particle_points = particles_integrate ? model.particle_count() : 0;
     offset_ = {0, stress_points};
@@ -98,7 +110,6 @@ class IntegrationPoints {
       return j;
     };
     IntegrationPoints part;
-    part.smoothing_length_ = smoothing_length_;
     for (PointGroup group : point_groups) {
       const std::size_t g = index_of(group);
       const approx::ShapeFunctions& from = shape_[g];
@@ -114,6 +125,7 @@ class IntegrationPoints {
         to.row_begin.push_back(to.neighbour.size());
         to.row_size.push_back(from.row_size[row]);
         to.shepard.push_back(from.shepard[row]);
+        part.smoothing_length_[g].push_back(smoothing_length_[g][row]);
         part.frames_[g].push_back(frames_[g][row]);
         part.rebuilt_[g].push_back(rebuilt_[g][row]);
       }
@@ -188,10 +200,22 @@ class IntegrationPoints {
   static const std::vector<Vector3>& positions(const ShellModel& model, PointGroup group) {
     return group == PointGroup::stress_points ? model.stress_point_position : model.particle_position;
   }
-  double smoothing_length() const { return smoothing_length_; }
+  // A row's own smoothing length h_i and support radius (kernel factor × h_i),
+  // and the largest support radius of all rows.
+  double smoothing_length(PointGroup group, std::size_t row) const {
+    return smoothing_length_[index_of(group)][row];
+  }
+  double support_radius(PointGroup group, std::size_t row) const {
+    return smoothing_length(group, row) * Approx::kernel_type::support_radius_factor;
+  }
+  double largest_support_radius() const {
+    double largest = 0.0;
+    for (const std::vector<double>& lengths : smoothing_length_)
+      for (double h : lengths) largest = std::max(largest, h);
+    return largest * Approx::kernel_type::support_radius_factor;
+  }
   // The model's cuts, as the rows see them.
   const shell::CutVisibility& cuts() const { return cuts_; }
-  double support_radius() const { return smoothing_length_ * Approx::kernel_type::support_radius_factor; }
 
   // Weights: the area share for membrane and bending; area × κs G d (softened
   // at particles) for transverse shear.
@@ -250,7 +274,7 @@ class IntegrationPoints {
     const auto cut_visible = cut_visibility(model, group);
     const auto both = [&](std::size_t r, std::size_t j) { return cut_visible(r, j) && visible(r, j); };
     Approx::rebuild_row(shape_[index_of(group)], row, model.particle_position, model.particle_area,
-                        positions(model, group)[row], frame(group, row), smoothing_length_, both);
+                        positions(model, group)[row], frame(group, row), smoothing_length(group, row), both);
     set_reference(point(group, row), gather(group, row, model.particle_position, model.particle_normal));
   }
 
@@ -441,7 +465,8 @@ class IntegrationPoints {
         if (!found)
           detail::invalid_parameter("support_radius_factor", physics.support_radius_factor,
                                     "too small: corner particle " + std::to_string(corner) + " of cell " +
-                                        std::to_string(row) + " lies outside its stress point's support");
+                                        std::to_string(row) + " lies outside its stress point's support radius " +
+                                        std::to_string(support_radius(PointGroup::stress_points, row)) + " m");
       }
       const double stiffness = physics.shear_correction * shear_modulus * model.stress_point_thickness(row);
       shear_tying_[row] = shell::tie_cell_shear(cell.begin(), static_cast<int>(cell.size()), model.particle_position,
@@ -450,7 +475,7 @@ class IntegrationPoints {
     }
   }
 
-  double smoothing_length_ = 0.0;
+  std::array<std::vector<double>, 2> smoothing_length_;  // h_i per row of each group
   shell::CutVisibility cuts_;  // the model's cuts
   std::vector<shell::CellShearTying> shear_tying_;  // per stress point, or empty
   std::array<approx::ShapeFunctions, 2> shape_;

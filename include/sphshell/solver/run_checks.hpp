@@ -9,6 +9,7 @@
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/shell/model.hpp>
+#include <sphshell/solver/local_spacing.hpp>
 #include <sphshell/solver/options.hpp>
 #include <algorithm>
 #include <sstream>
@@ -105,11 +106,18 @@ template <class SectionState>
 void check_memory(const ShellModel& model, const SolverOptions& options) {
   double covered = 0.0;
   for (double area : model.particle_area) covered += area;
-  const double support = options.support_radius_factor * model.maximum_spacing();
   const bool particles_integrate = options.particle_integration_share > 0.0 || options.particle_shear_weight > 0.0;
   const double particles = static_cast<double>(model.particle_count());
   const double points = static_cast<double>(model.stress_point_count()) + (particles_integrate ? particles : 0.0);
-  const double slots = points * approx::expected_row_size(model.particle_count(), covered, support);
+  // Each row's own support radius: support_radius_factor × its local spacing.
+  const LocalSpacing spacing = local_spacing(model);
+  double slots = 0.0;
+  const auto add_rows = [&](const std::vector<double>& local) {
+    for (double s : local)
+      slots += approx::expected_row_size(model.particle_count(), covered, options.support_radius_factor * s);
+  };
+  add_rows(spacing.stress_point);
+  if (particles_integrate) add_rows(spacing.particle);
   const double needed =
       particles * bytes_per_particle + points * bytes_per_point<SectionState> + slots * approx::bytes_per_slot;
   const double available = approx::available_memory();

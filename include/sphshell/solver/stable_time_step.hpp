@@ -20,12 +20,14 @@
 #include <sphshell/approx/neighbour_search.hpp>
 #include <sphshell/shell/model.hpp>
 #include <sphshell/solver/integration_points.hpp>
+#include <sphshell/solver/local_spacing.hpp>
 #include <sphshell/solver/options.hpp>
 #include <sphshell/solver/section_states.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 namespace sphshell::solver {
@@ -37,12 +39,16 @@ inline constexpr double highest_mode_factor = 9.0;
 // Smallest distance between two particles that interact: on distorted grids
 // (the corners of a spherical cap) it is shorter than the square root of the
 // cell area. Pairs a cut separates (the coincident faces of a slit) do not count.
+// Each particle's nearest neighbour is sought within two of its local
+// spacings (solver/local_spacing.hpp); infinity when none lies that close.
 inline double nearest_particle_distance(const ShellModel& model, const shell::CutVisibility& cuts) {
-  const double reach = 2.0 * model.maximum_spacing();
-  const approx::CellList cells(model.particle_position, reach);
-  double nearest = reach;
+  const std::vector<double>& local = local_spacing(model).particle;
+  std::vector<double> reach(local.size());
+  for (std::size_t i = 0; i < local.size(); ++i) reach[i] = 2.0 * local[i];
+  const approx::CellList cells(model.particle_position, median_of(reach));
+  double nearest = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < model.particle_count(); ++i)
-    cells.for_each_within(model.particle_position[i], reach, [&](int j, double distance_squared) {
+    cells.for_each_within(model.particle_position[i], reach[i], [&](int j, double distance_squared) {
       const auto other = static_cast<std::size_t>(j);
       if (other == i || std::sqrt(distance_squared) >= nearest) return;
       if (!cuts.empty() &&

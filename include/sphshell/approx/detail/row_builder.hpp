@@ -62,8 +62,9 @@ inline constexpr std::size_t expected_neighbours = 16;
   if (candidates == 0)
     message << "no particle lies within the support radius " << support
             << " m; the support is too small for the particle spacing there: raise "
-               "SolverOptions::support_radius_factor (the support radius in units of the spacing √A; allowed: "
-               "enough to reach 3 particles not on one line), or refine cells that are far longer than wide";
+               "SolverOptions::support_radius_factor (the support radius in units of the point's local spacing √A; "
+               "allowed: enough to reach 3 particles not on one line), or refine cells that are far longer than "
+               "wide";
   else
     message << "all " << candidates << " particles within the support radius " << support
             << " m are hidden (cut off by cracks)";
@@ -173,6 +174,49 @@ void compute_row(ShapeFunctions& sf, std::size_t row, const std::vector<Vector3>
   sf.shepard[row] = linear ? 0 : 1;
 }
 
+// The smoothing lengths of a build: one for every row (uniform sheets, the
+// approximation tests) or one per row (the solver's local support radius,
+// docs/method.md "Support radius"). Rows use the gather form W(x_j − x_i, h_i).
+class RowSmoothingLengths {
+ public:
+  RowSmoothingLengths(double h) : uniform_(h) {}
+  RowSmoothingLengths(const std::vector<double>& h) : per_row_(&h) {}
+  bool per_row() const { return per_row_ != nullptr; }
+  double operator[](std::size_t row) const { return per_row_ ? (*per_row_)[row] : uniform_; }
+
+  // Each h finite and > 0, one per row; then the smallest, the median and the
+  // largest are known.
+  void check(std::size_t rows) {
+    if (!per_row_) {
+      require_positive("h", uniform_);
+      smallest_ = median_ = largest_ = uniform_;
+      return;
+    }
+    if (per_row_->size() != rows) {
+      std::ostringstream value;
+      value << per_row_->size() << " smoothing lengths for " << rows << " evaluation points";
+      invalid_parameter("h.size()", value.str(), "one smoothing length per evaluation point");
+    }
+    for (std::size_t row = 0; row < rows; ++row)
+      if (!((*per_row_)[row] > 0.0) || !std::isfinite((*per_row_)[row]))
+        invalid_parameter("h of evaluation point " + std::to_string(row), (*per_row_)[row], "must be finite and > 0");
+    if (rows == 0) return;
+    std::vector<double> sorted = *per_row_;
+    const auto middle = sorted.begin() + static_cast<std::ptrdiff_t>(rows / 2);
+    std::nth_element(sorted.begin(), middle, sorted.end());
+    median_ = *middle;
+    smallest_ = *std::min_element(per_row_->begin(), per_row_->end());
+    largest_ = *std::max_element(per_row_->begin(), per_row_->end());
+  }
+  double smallest() const { return smallest_; }
+  double median() const { return median_; }
+
+ private:
+  double uniform_ = 0.0;
+  const std::vector<double>* per_row_ = nullptr;
+  double smallest_ = 0.0, median_ = 0.0, largest_ = 0.0;
+};
+
 // Coincident particles would act as one particle of twice the volume, and
 // coincident evaluation points as one point counted twice: both are refused
 // unless the visibility predicate separates them, i.e. no row sees both
@@ -219,10 +263,16 @@ template <class Kernel, class Method, class Visible>
 ShapeFunctions build_all_unguarded(const std::vector<Vector3>& particles,
                                    const std::vector<double>& volumes,
                                    const std::vector<Vector3>& eval_positions,
-                                   const std::vector<TangentFrame>& eval_frames, double h, Visible& visible) {
+                                   const std::vector<TangentFrame>& eval_frames, RowSmoothingLengths h,
+                                   Visible& visible) {
   static_assert(kernel::check_kernel<Kernel>());
-  require_positive("h", h);
+  h.check(eval_positions.size());
   check_sizes(particles.size(), volumes.size(), eval_positions.size(), eval_frames.size());
+  if (h.per_row() && eval_positions.empty()) {  // no rows, and no length to search the particles with
+    ShapeFunctions none;
+    none.row_begin.assign(1, 0);
+    return none;
+  }
   check_volumes(volumes);
   for (std::size_t i = 0; i < eval_positions.size(); ++i) {
     if (!eval_positions[i].allFinite()) {
@@ -233,14 +283,16 @@ ShapeFunctions build_all_unguarded(const std::vector<Vector3>& particles,
     check_frame(eval_frames[i], i);
   }
 
-  const double support = Kernel::support_radius_factor * h;
-  const double tolerance = coincidence_tolerance_factor * h;
-  const CellList particle_cells(particles, support);
+  // Cells as wide as the median support: a row with a wider one searches more
+  // layers of them, so one large support does not slow every row's search.
+  const double cell_width = Kernel::support_radius_factor * h.median();
+  const double tolerance = coincidence_tolerance_factor * h.smallest();
+  const CellList particle_cells(particles, cell_width);
   // Points at one place are refused unless visibility tells them apart (a cut
   // between the two edges of a slit): checked once the rows are built.
   const std::vector<std::pair<int, int>> coincident_particles = particle_cells.coincident_pairs(tolerance);
   const std::vector<std::pair<int, int>> coincident_evaluation_points =
-      CellList(eval_positions, support).coincident_pairs(tolerance);
+      CellList(eval_positions, cell_width).coincident_pairs(tolerance);
 
   const std::size_t rows = eval_positions.size();
   ShapeFunctions sf;
@@ -267,7 +319,7 @@ ShapeFunctions build_all_unguarded(const std::vector<Vector3>& particles,
     list.reserve((last - block_first_row(block)) * expected_neighbours);
     for (std::size_t row = block_first_row(block); row < last; ++row) {
       const std::size_t first = list.size();
-      particle_cells.for_each_within(eval_positions[row], support,
+      particle_cells.for_each_within(eval_positions[row], Kernel::support_radius_factor * h[row],
                                      [&list](int j, double) { list.push_back(j); });
       std::sort(list.begin() + static_cast<std::ptrdiff_t>(first), list.end());
       sf.row_begin[row + 1] = list.size() - first;
@@ -298,7 +350,7 @@ ShapeFunctions build_all_unguarded(const std::vector<Vector3>& particles,
       const auto row = static_cast<std::size_t>(i);
       try {
         compute_row<Kernel, Method>(sf, row, particles, volumes, eval_positions[row],
-                                    eval_frames[row], h, visible, ws);
+                                    eval_frames[row], h[row], visible, ws);
       } catch (...) {
         SPHSHELL_OMP("omp critical(sphshell_approx_error)")
         if (i < error_row) {
@@ -319,14 +371,15 @@ ShapeFunctions build_all_unguarded(const std::vector<Vector3>& particles,
 template <class Kernel, class Method, class Visible>
 ShapeFunctions build_all(const std::vector<Vector3>& particles, const std::vector<double>& volumes,
                          const std::vector<Vector3>& eval_positions, const std::vector<TangentFrame>& eval_frames,
-                         double h, Visible& visible) {
+                         RowSmoothingLengths h, Visible& visible) {
   try {
     return build_all_unguarded<Kernel, Method>(particles, volumes, eval_positions, eval_frames, h, visible);
   } catch (const std::bad_alloc&) {
     double covered = 0.0;
     for (double volume : volumes) covered += volume;
-    const double slots = static_cast<double>(eval_positions.size()) *
-                         expected_row_size(particles.size(), covered, Kernel::support_radius_factor * h);
+    double slots = 0.0;
+    for (std::size_t row = 0; row < eval_positions.size(); ++row)
+      slots += expected_row_size(particles.size(), covered, Kernel::support_radius_factor * h[row]);
     std::ostringstream message;
     message << "sphshell: out of memory building the shape functions of " << eval_positions.size()
             << " evaluation points over " << particles.size() << " particles (std::bad_alloc): about " << slots
