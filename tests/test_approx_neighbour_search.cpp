@@ -56,7 +56,14 @@ TEST_CASE("Cell list finds exactly the points a brute-force search finds", "[app
     CHECK(cell_list_query(cells, q, 0.5 * radius) == brute_force(points, q, 0.5 * radius));
   }
   CHECK(total > queries.size());  // the comparison is not vacuous
-  CHECK_THROWS_AS(cells.for_each_within(Vector3::Zero(), 2 * radius, [](int, double) {}), Error);
+  // A radius above the cells' own visits more layers of cells (a row whose
+  // local support is wider than the median's): still exactly the brute-force set.
+  for (std::size_t k = 0; k < queries.size(); k += 7) {
+    CHECK(cell_list_query(cells, queries[k], 2 * radius) == brute_force(points, queries[k], 2 * radius));
+    CHECK(cell_list_query(cells, queries[k], 3.5 * radius) == brute_force(points, queries[k], 3.5 * radius));
+  }
+  CHECK_THROWS_AS(cells.for_each_within(Vector3::Zero(), -radius, [](int, double) {}), Error);
+  CHECK_THROWS_AS(cells.for_each_within(Vector3::Zero(), std::nan(""), [](int, double) {}), Error);
 }
 
 TEST_CASE("Cell list over a flat jittered sheet uses dense cells and finds the same points",
