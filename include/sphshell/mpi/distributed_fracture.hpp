@@ -18,7 +18,6 @@
 // The released energy is counted by the owners of the removed points, in an
 // exact accumulator (mpi/exact_sum.hpp), reduced with the other books.
 
-#include <sphshell/approx/neighbour_search.hpp>
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/parallel.hpp>
 #include <sphshell/core/types.hpp>
@@ -27,8 +26,8 @@
 #include <sphshell/mpi/layout.hpp>
 #include <sphshell/shell/model.hpp>
 #include <sphshell/solver/integration_points.hpp>
+#include <sphshell/solver/fracture.hpp>
 #include <sphshell/solver/internal_forces.hpp>
-#include <sphshell/solver/local_spacing.hpp>
 #include <sphshell/solver/particles.hpp>
 #include <sphshell/solver/section_states.hpp>
 
@@ -36,7 +35,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
-#include <sstream>
+#include <utility>
 #include <vector>
 
 namespace sphshell::mpi {
@@ -92,20 +91,10 @@ class DistributedFracture<Crack, true> {
     fragment_.assign(model.particle_count(), 0);
     stress_point_active_.assign(model.stress_point_count(), 1);
     // The particles around each stress point, as the serial manager finds them.
-    particles_of_stress_point_.assign(model.stress_point_count(), {});
-    if (!model.cells().empty()) {
-      for (std::size_t q = 0; q < model.cells().size(); ++q)
-        particles_of_stress_point_[q].assign(model.cells()[q].begin(), model.cells()[q].end());
-    } else {
-      const std::vector<double>& reach = solver::local_spacing(model).stress_point;
-      const approx::CellList cells(model.particle_position, solver::median_of(reach));
-      for (std::size_t q = 0; q < model.stress_point_count(); ++q)
-        cells.for_each_within(model.stress_point_position[q], reach[q],
-                              [&](int i, double) { particles_of_stress_point_[q].push_back(i); });
-    }
-    stress_points_of_particle_.assign(model.particle_count(), {});
-    for (std::size_t q = 0; q < particles_of_stress_point_.size(); ++q)
-      for (int i : particles_of_stress_point_[q]) stress_points_of_particle_[i].push_back(static_cast<int>(q));
+    solver::fracture_detail::StressPointNeighbourhoods maps =
+        solver::fracture_detail::stress_point_neighbourhoods(model);
+    particles_of_stress_point_ = std::move(maps.particles_of_stress_point);
+    stress_points_of_particle_ = std::move(maps.stress_points_of_particle);
     // The local rows of each group: their evaluation points and the local
     // point of each global row.
     for (solver::PointGroup group : solver::point_groups) {
@@ -156,7 +145,7 @@ class DistributedFracture<Crack, true> {
   // A pre-crack (Solver::add_precrack), on every rank alike. Collective.
   template <class Parts>
   void add_precrack(const std::vector<Vector3>& polyline, const Parts& parts) {
-    reject_particles_on(polyline, parts.model);
+    solver::fracture_detail::reject_particles_on(crack_, polyline, parts.model);
     const std::vector<int> absorbed = crack_.add_precrack(polyline);
     std::vector<int> new_fragments;
     for (int q : absorbed) {
@@ -244,21 +233,6 @@ class DistributedFracture<Crack, true> {
     const std::vector<int>& around = stress_points_of_particle_[particle];
     return !around.empty() &&
            std::all_of(around.begin(), around.end(), [&](int q) { return stress_point_active_[q] == 0; });
-  }
-
-  void reject_particles_on(const std::vector<Vector3>& polyline, const ShellModel& model) const {
-    const double tolerance = Crack::on_precrack_in_spacings * crack_.spacing();
-    for (std::size_t k = 0; k + 1 < polyline.size(); ++k)
-      for (std::size_t i = 0; i < model.particle_count(); ++i)
-        if (Crack::distance_to_precrack_piece(model.particle_position[i], polyline[k], polyline[k + 1]) <=
-            tolerance) {
-          std::ostringstream message;
-          message << "sphshell: the pre-crack passes through particle " << i << " at ("
-                  << model.particle_position[i].transpose()
-                  << "); a particle on a crack would tie its faces together: move the pre-crack off the particles "
-                     "(along a row of stress points, or a fraction of the spacing aside)";
-          throw Error(message.str());
-        }
   }
 
   // The serial rebuild_near on this rank's rows; then the stress points cut

@@ -71,6 +71,50 @@ template <class Policy, class Writer>
 struct has_checkpoint_members<Policy, Writer,
                               std::void_t<decltype(std::declval<const Policy&>().save(std::declval<Writer&>()))>>
     : std::true_type {};
+
+// The particles around each stress point (the corners of its cell, quad or
+// triangle, or, for a model without cells, the particles within its own
+// spacing, ShellModel::stress_point_spacing) and the inverse; shared with
+// mpi::DistributedFracture, which needs the same maps on every rank.
+struct StressPointNeighbourhoods {
+  std::vector<std::vector<int>> particles_of_stress_point, stress_points_of_particle;
+};
+inline StressPointNeighbourhoods stress_point_neighbourhoods(const ShellModel& model) {
+  StressPointNeighbourhoods maps;
+  maps.particles_of_stress_point.assign(model.stress_point_count(), {});
+  if (!model.cells().empty()) {
+    for (std::size_t q = 0; q < model.cells().size(); ++q)
+      maps.particles_of_stress_point[q].assign(model.cells()[q].begin(), model.cells()[q].end());
+  } else {
+    const std::vector<double>& reach = local_spacing(model).stress_point;
+    const approx::CellList cells(model.particle_position, median_of(reach));
+    for (std::size_t q = 0; q < model.stress_point_count(); ++q)
+      cells.for_each_within(model.stress_point_position[q], reach[q],
+                            [&](int i, double) { maps.particles_of_stress_point[q].push_back(i); });
+  }
+  maps.stress_points_of_particle.assign(model.particle_count(), {});
+  for (std::size_t q = 0; q < maps.particles_of_stress_point.size(); ++q)
+    for (int i : maps.particles_of_stress_point[q]) maps.stress_points_of_particle[i].push_back(static_cast<int>(q));
+  return maps;
+}
+
+// A particle on a crack line would see both faces and tie them together: an
+// Error naming it (a pre-crack, serial or distributed).
+template <class Crack>
+void reject_particles_on(const Crack& crack, const std::vector<Vector3>& polyline, const ShellModel& model) {
+  const double tolerance = Crack::on_precrack_in_spacings * crack.spacing();
+  for (std::size_t k = 0; k + 1 < polyline.size(); ++k)
+    for (std::size_t i = 0; i < model.particle_count(); ++i)
+      if (Crack::distance_to_precrack_piece(model.particle_position[i], polyline[k], polyline[k + 1]) <= tolerance) {
+        std::ostringstream message;
+        message << "sphshell: the pre-crack passes through particle " << i << " at ("
+                << model.particle_position[i].transpose()
+                << "); a particle on a crack would tie its faces together: move the pre-crack off the particles "
+                   "(along a row of stress points, or a fraction of the spacing aside)";
+        throw Error(message.str());
+      }
+}
+
 }  // namespace fracture_detail
 
 template <class Crack>
@@ -84,23 +128,9 @@ class FractureManager<Crack, true> {
     crack_.initialize(model.stress_point_position, model.stress_point_normal, model.maximum_spacing(),
                       points.largest_support_radius());
     fragment_.assign(model.particle_count(), 0);
-    // The particles around each stress point: the corners of its cell (quad
-    // or triangle), or, for a model without cells, the particles within its
-    // own spacing (ShellModel::stress_point_spacing); and the inverse.
-    particles_of_stress_point_.assign(model.stress_point_count(), {});
-    if (!model.cells().empty()) {
-      for (std::size_t q = 0; q < model.cells().size(); ++q)
-        particles_of_stress_point_[q].assign(model.cells()[q].begin(), model.cells()[q].end());
-    } else {
-      const std::vector<double>& reach = local_spacing(model).stress_point;
-      const approx::CellList cells(model.particle_position, median_of(reach));
-      for (std::size_t q = 0; q < model.stress_point_count(); ++q)
-        cells.for_each_within(model.stress_point_position[q], reach[q],
-                              [&](int i, double) { particles_of_stress_point_[q].push_back(i); });
-    }
-    stress_points_of_particle_.assign(model.particle_count(), {});
-    for (std::size_t q = 0; q < particles_of_stress_point_.size(); ++q)
-      for (int i : particles_of_stress_point_[q]) stress_points_of_particle_[i].push_back(static_cast<int>(q));
+    fracture_detail::StressPointNeighbourhoods maps = fracture_detail::stress_point_neighbourhoods(model);
+    particles_of_stress_point_ = std::move(maps.particles_of_stress_point);
+    stress_points_of_particle_ = std::move(maps.stress_points_of_particle);
   }
 
   // Per step: the failed points leave, the new crack segments and fragments
@@ -133,7 +163,7 @@ class FractureManager<Crack, true> {
   // crack points and leave the integration.
   template <class Parts>
   void add_precrack(const std::vector<Vector3>& polyline, const Parts& parts) {
-    reject_particles_on(polyline, parts.model);
+    fracture_detail::reject_particles_on(crack_, polyline, parts.model);
     const std::vector<int> absorbed = crack_.add_precrack(polyline);
     std::vector<int> new_fragments;
     for (int p : absorbed) {
@@ -220,22 +250,6 @@ class FractureManager<Crack, true> {
     return !around.empty() && std::all_of(around.begin(), around.end(), [&](int q) {
              return !parts.states.active(static_cast<std::size_t>(q));
            });
-  }
-
-  // A particle on a crack line would see both faces and tie them together.
-  void reject_particles_on(const std::vector<Vector3>& polyline, const ShellModel& model) const {
-    const double tolerance = Crack::on_precrack_in_spacings * crack_.spacing();
-    for (std::size_t k = 0; k + 1 < polyline.size(); ++k)
-      for (std::size_t i = 0; i < model.particle_count(); ++i)
-        if (Crack::distance_to_precrack_piece(model.particle_position[i], polyline[k], polyline[k + 1]) <=
-            tolerance) {
-          std::ostringstream message;
-          message << "sphshell: the pre-crack passes through particle " << i << " at ("
-                  << model.particle_position[i].transpose()
-                  << "); a particle on a crack would tie its faces together: move the pre-crack off the particles "
-                     "(along a row of stress points, or a fraction of the spacing aside)";
-          throw Error(message.str());
-        }
   }
 
   // How a point's rebuild ended.
