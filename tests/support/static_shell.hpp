@@ -28,6 +28,7 @@
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/shell/cell.hpp>
+#include <sphshell/solver/local_spacing.hpp>
 
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
@@ -112,7 +113,11 @@ class StaticShell {
     const std::size_t n = solver_.particle_count();
     if (conditions_.force.size() != n) throw std::invalid_argument("StaticShell: conditions sized for another model");
     const double spacing = solver_.model().maximum_spacing();
-    reach_ = 2.0 * solver_.options().support_radius_factor * spacing;
+    // A particle moves the stress and particle points within one support
+    // radius of it, and each of those the particles within its own radius:
+    // twice the largest radius of any point (every point's follows its own
+    // local spacing, solver/local_spacing.hpp).
+    reach_ = 2.0 * solver_.options().support_radius_factor * solver::local_spacing(solver_.model()).largest();
     translation_step_ = options_.translation_step * spacing;
     colour_particles();
   }
