@@ -90,10 +90,13 @@ TEST_CASE("Benchmark: Scordelis-Lo roof (linear)", "[validation][benchmarks]") {
 
 TEST_CASE("Benchmark: pinched hemisphere with an 18 degree hole (linear)", "[validation][benchmarks]") {
   // Reference 0.094 (MacNeal & Harder 1985); point loads applied consistently
-  // through the shape functions. Measured −0.34 % at 33 x 33 (−1.87 % at 25).
+  // through the shape functions. Measured −1.24 % at 33 x 33 (−3.06 % at 25):
+  // the cells near the hole are up to 3.2 : 1, their rows thin along the long
+  // side (docs/method.md, "Support radius"; −0.34 / −1.87 % when every row took
+  // the largest cell's spacing).
   const double error = linear_convergence(
       "Pinched hemisphere", [](int n) { return pinched_hemisphere(n, PointLoad::shape_functions); }, {25, 33});
-  CHECK(std::abs(error) < 0.6);
+  CHECK(std::abs(error) < 1.5);
 }
 
 TEST_CASE("Benchmark: pinched cylinder with rigid diaphragms (linear, a known miss)", "[validation][benchmarks]") {
@@ -158,7 +161,9 @@ TEST_CASE("Benchmark: slit annular plate under end shear (Sze, Liu & Lo 2004, no
   // W_A (inner) and W_B (outer) of the loaded face against the paper's table
   // (§3.3) at P/P_max = 0.025, 0.1 … 1; the slit is a cut between duplicated
   // particles. Here 9 x 46 particles up to P_max / 2 (the whole path takes
-  // ≈ 5 min): measured largest error −1.99 % (W_B at P_max / 2); to P_max it
+  // ≈ 5 min): measured largest error −2.41 % (W_B at P_max / 2; −1.99 % when
+  // every row took the largest cell's spacing, docs/method.md "Support
+  // radius"); with that former spacing, to P_max it
   // grows to −3.16 % (W_A), and at 11 x 61 the error at P_max / 2 is −0.87 %
   // (README, shell_benchmarks).
   constexpr int radial = 9, circumferential = 46;
@@ -175,5 +180,5 @@ TEST_CASE("Benchmark: slit annular plate under end shear (Sze, Liu & Lo 2004, no
               "error over the table %.2f %%; %d Newton iterations\n",
               radial, circumferential, last.load_factor, last.first, error_percent(last.first, reference.first),
               last.second, error_percent(last.second, reference.second), worst, run.report.iterations);
-  CHECK(worst < 2.3);
+  CHECK(worst < 2.6);
 }

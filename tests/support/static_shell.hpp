@@ -28,7 +28,8 @@
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/shell/cell.hpp>
-#include <sphshell/solver/local_spacing.hpp>
+#include <sphshell/solver/integration_points.hpp>
+#include <sphshell/solver/static_solution.hpp>
 
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
@@ -113,11 +114,6 @@ class StaticShell {
     const std::size_t n = solver_.particle_count();
     if (conditions_.force.size() != n) throw std::invalid_argument("StaticShell: conditions sized for another model");
     const double spacing = solver_.model().maximum_spacing();
-    // A particle moves the stress and particle points within one support
-    // radius of it, and each of those the particles within its own radius:
-    // twice the largest radius of any point (every point's follows its own
-    // local spacing, solver/local_spacing.hpp).
-    reach_ = 2.0 * solver_.options().support_radius_factor * solver::local_spacing(solver_.model()).largest();
     translation_step_ = options_.translation_step * spacing;
     colour_particles();
   }
@@ -251,55 +247,24 @@ class StaticShell {
       x += amount * dofs.direction[k];
   }
 
+  // The colours of the coupling graph of the solver's own rows (the library's
+  // static_detail::coupling and distance-2 colouring, as solve_static uses):
+  // each particle's near_ lists the particles whose forces its motion
+  // changes, and no particle is near two of one colour. Every point's support
+  // follows its own spacing, so a distance bound would have to take the
+  // largest radius everywhere.
   void colour_particles() {
-    const std::vector<Vector3>& X = solver_.model().particle_position;
-    const int n = static_cast<int>(X.size());
-    // Neighbours within reach (the owners' search) and within twice that
-    // plus a margin (the colouring's conflicts), by a cell grid.
-    const double conflict = 2.0 * reach_ * 1.05;
-    const double cell = conflict;
-    Vector3 lower = X[0];
-    for (const Vector3& x : X) lower = lower.cwiseMin(x);
-    auto key = [&](const Vector3& x) {
-      return Eigen::Vector3i(static_cast<int>(std::floor((x.x() - lower.x()) / cell)),
-                             static_cast<int>(std::floor((x.y() - lower.y()) / cell)),
-                             static_cast<int>(std::floor((x.z() - lower.z()) / cell)));
-    };
-    std::vector<std::pair<long long, int>> keyed(n);
-    auto code = [](const Eigen::Vector3i& c) {
-      return (static_cast<long long>(c.x()) * 4096 + c.y()) * 4096 + c.z();
-    };
-    for (int i = 0; i < n; ++i) keyed[i] = {code(key(X[i])), i};
-    std::sort(keyed.begin(), keyed.end());
-    auto for_near = [&](int i, double radius, auto&& visit) {
-      const Eigen::Vector3i c = key(X[i]);
-      for (int a = -1; a <= 1; ++a)
-        for (int b = -1; b <= 1; ++b)
-          for (int e = -1; e <= 1; ++e) {
-            const long long k = code(c + Eigen::Vector3i(a, b, e));
-            auto it = std::lower_bound(keyed.begin(), keyed.end(), std::make_pair(k, -1));
-            for (; it != keyed.end() && it->first == k; ++it)
-              if (it->second != i && (X[it->second] - X[i]).norm() <= radius) visit(it->second);
-          }
-    };
-    near_.assign(n, {});
-    std::vector<int> colour(n, -1);
-    for (int i = 0; i < n; ++i) {
-      std::vector<char> used;
-      for_near(i, conflict, [&](int j) {
-        if (colour[j] >= 0) {
-          if (static_cast<int>(used.size()) <= colour[j]) used.resize(colour[j] + 1, 0);
-          used[colour[j]] = 1;
-        }
-      });
-      int c = 0;
-      while (c < static_cast<int>(used.size()) && used[c]) ++c;
-      if (options_.one_particle_per_colour) c = i;
-      colour[i] = c;
-      if (static_cast<int>(colours_.size()) <= c) colours_.resize(c + 1);
-      colours_[c].push_back(i);
-      for_near(i, reach_ * 1.05, [&](int j) { near_[i].push_back(j); });
-      near_[i].push_back(i);
+    using Approx = typename Solver::approximation_type;
+    const ShellModel& model = solver_.model();
+    const SolverOptions& options = solver_.options();
+    const solver::IntegrationPoints<Approx> points(model, options.physics(), options.particle_integration(),
+                                                   solver_.material().shear_modulus());
+    near_ = solver::static_detail::coupling(points, model.particle_count());
+    if (options_.one_particle_per_colour) {
+      colours_.clear();
+      for (int i = 0; i < static_cast<int>(near_.size()); ++i) colours_.push_back({i});
+    } else {
+      colours_ = solver::static_detail::colour(near_);
     }
   }
 
@@ -431,7 +396,6 @@ class StaticShell {
   Solver& solver_;
   StaticConditions conditions_;
   NewtonOptions options_;
-  double reach_ = 0.0;
   double translation_step_ = 0.0;
   double lambda_ = 0.0;
   struct Converged {
@@ -439,7 +403,7 @@ class StaticShell {
     double lambda = 0.0;
   } previous_;  // the converged state before the current one
   std::vector<std::vector<int>> colours_;
-  std::vector<std::vector<int>> near_;  // particles within reach of each particle (itself included)
+  std::vector<std::vector<int>> near_;  // per particle: the particles it is coupled to (itself included)
   NewtonReport report_;
 };
 

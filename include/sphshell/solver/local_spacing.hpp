@@ -3,28 +3,32 @@
 // length h = support_radius_factor · Δ / kernel support factor follows
 // (docs/method.md, "Support radius"), so that one large cell widens its own
 // row and not every row of the sheet:
-//   stress point q: the largest of its cell's √(area per particle) (the
-//     quad's area, twice a triangle's; ShellModel::stress_point_spacing), its
-//     cell's longest side and its distance to its cell's farthest corner;
+//   stress point q: Δ_q = √(area per particle of its own cell) (the quad's
+//     area, twice a triangle's; ShellModel::stress_point_spacing), or its
+//     distance to its cell's farthest corner if that is larger. The second
+//     term keeps the cell's corners inside the row (the edge-tied shear needs
+//     them) on a distorted cell: the corner cells of ShellModel::spherical_cap
+//     (an interior angle near 175°) have their corners at 2.02 √A; on a
+//     square cell the farthest corner lies at 0.71 √A, on the O-grid cap's
+//     cells at most 0.94 √A, so it changes nothing there;
 //   particle i of a model with cells: the largest, over the cells it is a
-//     corner of, of the cell's √(area per particle), its longest side and its
-//     distance from i to the cell's farthest corner over √2;
+//     corner of, of the cell's √(area per particle) and of its distance to
+//     the cell's farthest corner over √2. The second term is the spacing
+//     along the cell's long side for cells longer than wide (a 4 × 1 cell's
+//     √A is 2, its long side 4: the corner particle's row would hold its
+//     neighbours along the short side only, on one line); on a square cell
+//     both terms are the side;
 //   particle i of a model without cells (the general constructor): the
 //     largest √A_j of the particles j with |x_j − x_i| < particle_spacing_reach
 //     · √A_j, itself included. Its own area is a half or a quarter of its
 //     neighbours' on an edge or at a corner; the neighbours' keeps its row as
 //     wide as the inner rows there.
-// Why the longest side and not √A alone: on a cell longer than wide (a 3 × 1
-// cell's √A is 1.7, its long side 3) a radius from √A reaches only the cell's
-// own two corners along the long side, so the row cannot tell a linear from a
-// curved field in that direction (the pinched hemisphere's cells near its hole
-// and the slit annular plate's outer cells, aspect ≈ 3 : 1). The corner terms
-// keep a distorted cell's corners inside the row (the edge-tied shear needs
-// them): the corner cells of ShellModel::spherical_cap (an interior angle near
-// 175°) have their corners at 2.02 √A. On a square cell every term is the side
-// or less (the farthest corner at 0.71 side, the diagonal over √2 the side),
-// so a uniform sheet keeps the single global spacing it had. A particle's Δ
-// comes from the particles and cells it touches, never from a stress point's
+// On cells longer than wide the rows are thin along the long side (first-order
+// consistent still); docs/method.md, "Support radius", says what that costs a
+// curved shell meshed so and why the long side is not used instead.
+// On a uniform sheet every Δ is the sheet's spacing (up to the rounding of
+// the cell areas), as the single global spacing was. A particle's Δ comes
+// from the particles and cells it touches, never from a stress point's
 // integration area, so one stress point standing for a large area widens its
 // own row only.
 
@@ -74,11 +78,7 @@ inline LocalSpacing local_spacing(const ShellModel& model) {
     const double sqrt2 = std::sqrt(2.0);
     for (std::size_t c = 0; c < model.cells().size(); ++c) {
       const Cell& cell = model.cells()[c];
-      double cell_spacing = model.stress_point_spacing(c);
-      for (std::size_t k = 0; k < cell.size(); ++k) {
-        const std::size_t a = static_cast<std::size_t>(cell[k]), b = static_cast<std::size_t>(cell[(k + 1) % cell.size()]);
-        cell_spacing = std::max(cell_spacing, (model.particle_position[a] - model.particle_position[b]).norm());
-      }
+      const double cell_spacing = model.stress_point_spacing(c);
       double corner_reach = 0.0;
       for (int k : cell)
         corner_reach = std::max(
