@@ -11,6 +11,8 @@
 #include <sphshell/solver/options.hpp>
 
 #include <cmath>
+#include <cstring>
+#include <vector>
 #include <memory>
 #include <string>
 
@@ -31,6 +33,17 @@ struct Case {
   std::unique_ptr<Points> points;
   sphshell::mpi::DecompositionInput input() const { return sphshell::mpi::decomposition_input(model, *points); }
 };
+
+// How many components of two vector lists differ bitwise (the size mismatch
+// counts every component): a distributed run must reproduce the serial one
+// exactly, not within a tolerance.
+inline std::size_t differing_components(const std::vector<sphshell::Vector3>& a, const std::vector<sphshell::Vector3>& b) {
+  if (a.size() != b.size()) return a.size() + b.size();
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    for (int c = 0; c < 3; ++c) count += std::memcmp(&a[i][c], &b[i][c], sizeof(double)) != 0 ? 1 : 0;
+  return count;
+}
 
 inline Case make_case(std::string name, sphshell::ShellModel model) {
   const sphshell::SolverOptions options;

@@ -12,6 +12,8 @@
 #include <sphshell/solver.hpp>
 #include <sphshell/thickness/gauss.hpp>
 
+#include "mpi_test_support.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -31,21 +33,13 @@ using Serial = Solver<Approximation, thickness::Gauss<3>, material::LemaitreDama
 using Distributed = mpi::DistributedSolver<Approximation, thickness::Gauss<3>, material::LemaitreDamage, crack::LineSegments>;
 const material::LemaitreDamage::Parameters table_3_steel{210e9, 0.3, 235e6, 0.0, 0.02, 0.37, 0.24};
 
-std::size_t differing_components(const std::vector<Vector3>& a, const std::vector<Vector3>& b) {
-  if (a.size() != b.size()) return a.size() + b.size();
-  std::size_t count = 0;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    for (int c = 0; c < 3; ++c) count += std::memcmp(&a[i][c], &b[i][c], sizeof(double)) != 0 ? 1 : 0;
-  return count;
-}
-
 void compare(const std::string& label, const Serial& serial, Distributed& distributed, const mpi::Communicator& comm) {
   INFO(label << " on " << comm.size() << " ranks, rank " << comm.rank() << ", step " << serial.steps());
   CHECK(distributed.steps() == serial.steps());
-  CHECK(differing_components(distributed.positions(), serial.positions()) == 0);
-  CHECK(differing_components(distributed.directors(), serial.directors()) == 0);
-  CHECK(differing_components(distributed.velocities(), serial.velocities()) == 0);
-  CHECK(differing_components(distributed.angular_velocities(), serial.angular_velocities()) == 0);
+  CHECK(mpi_test::differing_components(distributed.positions(), serial.positions()) == 0);
+  CHECK(mpi_test::differing_components(distributed.directors(), serial.directors()) == 0);
+  CHECK(mpi_test::differing_components(distributed.velocities(), serial.velocities()) == 0);
+  CHECK(mpi_test::differing_components(distributed.angular_velocities(), serial.angular_velocities()) == 0);
   CHECK(distributed.crack().segments() == serial.crack().segments());
   CHECK(distributed.crack().points() == serial.crack().points());
   CHECK(distributed.damaged_stress_point_count() == serial.damaged_stress_point_count());

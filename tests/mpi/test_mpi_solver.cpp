@@ -12,6 +12,8 @@
 #include <sphshell/solver.hpp>
 #include <sphshell/thickness/gauss.hpp>
 
+#include "mpi_test_support.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -38,14 +40,6 @@ template <class Material>
 using Distributed = mpi::DistributedSolver<Approximation, thickness::Gauss<3>, Material>;
 
 // How many components of two fields differ in their bits.
-std::size_t differing_components(const std::vector<Vector3>& a, const std::vector<Vector3>& b) {
-  if (a.size() != b.size()) return a.size() + b.size();
-  std::size_t count = 0;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    for (int c = 0; c < 3; ++c) count += std::memcmp(&a[i][c], &b[i][c], sizeof(double)) != 0 ? 1 : 0;
-  return count;
-}
-
 double relative(double a, double b) {
   const double scale = std::max(std::abs(a), std::abs(b));
   return scale == 0.0 ? 0.0 : std::abs(a - b) / scale;
@@ -69,10 +63,10 @@ void compare_runs(const std::string& label, const ShellModel& model, const typen
     serial.step();
     distributed.step();
   }
-  const std::size_t positions = differing_components(distributed.positions(), serial.positions());
-  const std::size_t directors = differing_components(distributed.directors(), serial.directors());
-  const std::size_t velocities = differing_components(distributed.velocities(), serial.velocities());
-  const std::size_t angular = differing_components(distributed.angular_velocities(), serial.angular_velocities());
+  const std::size_t positions = mpi_test::differing_components(distributed.positions(), serial.positions());
+  const std::size_t directors = mpi_test::differing_components(distributed.directors(), serial.directors());
+  const std::size_t velocities = mpi_test::differing_components(distributed.velocities(), serial.velocities());
+  const std::size_t angular = mpi_test::differing_components(distributed.angular_velocities(), serial.angular_velocities());
   const EnergyReport e = distributed.energy(), s = serial.energy();
   INFO(label << " on " << comm.size() << " ranks, " << steps << " steps; rank " << comm.rank() << " owns "
              << distributed.layout().owned_count() << " particles, " << distributed.layout().ghost_count()
@@ -264,8 +258,8 @@ TEST_CASE("Distributed checkpoint: a restart continues bitwise, files of another
   CHECK(restarted.steps() == 40);
   for (int n = 0; n < 80; ++n) restarted.step();
   CHECK(restarted.steps() == original.steps());
-  CHECK(differing_components(restarted.positions(), positions) == 0);
-  CHECK(differing_components(restarted.velocities(), velocities) == 0);
+  CHECK(mpi_test::differing_components(restarted.positions(), positions) == 0);
+  CHECK(mpi_test::differing_components(restarted.velocities(), velocities) == 0);
   const EnergyReport again = restarted.energy();
   CHECK(again.kinetic == energy.kinetic);
   CHECK(again.internal == energy.internal);
@@ -372,8 +366,8 @@ TEST_CASE("Distributed prescribed motions added mid-run: the serial run, and the
     serial.step();
     distributed.step();
   }
-  CHECK(differing_components(distributed.positions(), serial.positions()) == 0);
-  CHECK(differing_components(distributed.velocities(), serial.velocities()) == 0);
+  CHECK(mpi_test::differing_components(distributed.positions(), serial.positions()) == 0);
+  CHECK(mpi_test::differing_components(distributed.velocities(), serial.velocities()) == 0);
   CHECK(serial.displacement(model.set("x_max").front()).x() > 0.0);
 
   // A displacement that does not continue from the particles' own (the pulled

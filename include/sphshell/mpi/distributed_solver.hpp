@@ -270,9 +270,8 @@ class DistributedSolver {
       require_new_probe_file(csv_path);
       DistributedProbe probe{DistributedProbe::Kind::stress_point, stress_point, csv_path, nullptr};
       const std::vector<std::size_t>& rows = layout_.computed[solver::index_of(solver::PointGroup::stress_points)];
-      for (std::size_t k = 0; k < rows.size(); ++k)
-        if (rows[k] == static_cast<std::size_t>(stress_point) &&
-            layout_.computed_is_owned[solver::index_of(solver::PointGroup::stress_points)][k]) {
+      for (std::size_t k : owned_stress_rows())
+        if (rows[k] == static_cast<std::size_t>(stress_point)) {
           probe.local_point = points_->point(solver::PointGroup::stress_points, k);
           probe.file = std::make_unique<io::CsvProbe>(csv_path, stress_probe(stress_point).columns());
           write_probe_row(probe);
