@@ -177,6 +177,12 @@ inline constexpr int max_step_halvings = 12;
 // The tangent counts as symmetric when ‖K − Kᵀ‖ is below this share of ‖K‖
 // (one-sided differences leave an asymmetry of the order of the perturbation).
 inline constexpr double symmetric_tangent_tolerance = 1e-4;
+// Entries of a finite-difference tangent column below this share of the
+// column's largest are round-off and are left out. On the 21 x 21 plate the
+// entries that are zero in the exact tangent come out below 1e-15 of its
+// largest entry (161 000 of its 250 000; 3 lie between 1e-15 and 1e-13),
+// and kept they made the solve of the Newton step 6-7 times slower.
+inline constexpr double negligible_tangent_entry = 1e-12;
 // m_a = gershgorin_mass_factor × h² Σ_b |K_ab| (see the relaxation below).
 inline constexpr double gershgorin_mass_factor = 0.5;
 // Underwood's damping c = 2 ω₀ with the pseudo step h = 1 is stable for c h < 2.
@@ -484,7 +490,7 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
   };
   // The tangent K = −∂r/∂q by one-sided differences, colour by colour.
   auto tangent = [&](double lambda, const Eigen::VectorXd& r0) {
-    std::vector<Eigen::Triplet<double>> entries;
+    std::vector<Eigen::Triplet<double>> entries, column_entries;
     const std::vector<Vector3> x0 = particles.position, d0 = particles.director;
     for (const std::vector<int>& members : colours)
       for (int a = 0; a < max_dofs; ++a) {
@@ -512,13 +518,18 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
           if (!perturbed) continue;
           const int column = basis.offset[jj] + (a < max_translations ? a : basis.translations[jj] + a - max_translations);
           const double h = a < max_translations ? step_translation : step_rotation * lever;
+          column_entries.clear();
+          double largest = 0.0;
           for (int i : coupled[jj]) {
             const auto ii = static_cast<std::size_t>(i);
             for (int row = basis.offset[ii]; row < basis.offset[ii + 1]; ++row) {
               const double k = -(r[row] - r0[row]) / h;
-              if (k != 0.0) entries.emplace_back(row, column, k);
+              largest = std::max(largest, std::abs(k));
+              column_entries.emplace_back(row, column, k);
             }
           }
+          for (const Eigen::Triplet<double>& entry : column_entries)
+            if (std::abs(entry.value()) > negligible_tangent_entry * largest) entries.push_back(entry);
           particles.position[jj] = x0[jj];
           particles.director[jj] = d0[jj];
         }

@@ -1,0 +1,290 @@
+// Static solutions against the hand-tuned damped explicit runs they replace
+// (project issue 11: "at least 10x faster at the same accuracy"), both
+// measured in one run:
+//  - clamped_plate_*: the clamped square plate of tests/test_solver_plate.cpp
+//    (L = 1 m, L/d = 50, 21 x 21 particles, Gauss<2>, q = 1 kPa, linear),
+//    against Mindlin's w D/(q L^4) = 0.0012754;
+//  - cantilever_*: the cantilever strip under a fixed end shear of
+//    tests/test_solver_shells.cpp (L = 0.5 m, 0.1 m wide, d = 0.02 m, nu = 0,
+//    21 x 5 particles, Gauss<3>, nonlinear), the argument PL^2/EI = 1 or 2,
+//    against the elastica's tip deflection w/L = 0.30172 and 0.49346
+//    (Bisshopp & Drucker 1945; Mattiasson 1981), the values the test uses.
+// *_damped is the test's explicit run exactly (mass-proportional damping,
+// run_until the test's end time); *_static is Solver::solve_static with the
+// parameters named below. The time is the wall time of run_until /
+// solve_static alone (the set-up, the same for both and a few ms, is the
+// counter setup_s).
+// Counters: the deflection each reaches (wDqL4, tip_w_over_L), its error in %
+// of the reference (error_pct), the explicit steps or the force evaluations
+// it took, the damped run's relative change over its last period.
+// After the run the program prints, per case, the median wall and CPU times
+// of both over the repetitions, their ratio (damped / static), and the
+// difference of the static deflection from the damped one.
+// Each benchmark runs its solve once per repetition; with
+//   OMP_NUM_THREADS=1 ./bench_static --benchmark_repetitions=3
+//   --benchmark_enable_random_interleaving=true
+// (one command line) the repetitions of all of them interleave, so a change
+// of the machine's load hits both variants alike.
+#include <sphshell/sphshell.hpp>
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <time.h>
+
+using namespace sphshell;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// CPU time of the process (one thread: OMP_NUM_THREADS=1).
+double cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+// Wall times and answers measured so far, per case ("plate", "cantilever 1", ...).
+struct Measured {
+  std::vector<double> damped_seconds, static_seconds, damped_cpu, static_cpu;
+  double damped_answer = std::numeric_limits<double>::quiet_NaN(), static_answer = damped_answer;
+};
+std::map<std::string, Measured>& measured() {
+  static std::map<std::string, Measured> cases;
+  return cases;
+}
+
+void report_damped(const std::string& name, double seconds, double cpu, double answer) {
+  Measured& m = measured()[name];
+  m.damped_seconds.push_back(seconds);
+  m.damped_cpu.push_back(cpu);
+  m.damped_answer = answer;
+}
+
+void report_static(const std::string& name, double seconds, double cpu, double answer) {
+  Measured& m = measured()[name];
+  m.static_seconds.push_back(seconds);
+  m.static_cpu.push_back(cpu);
+  m.static_answer = answer;
+}
+
+// ---------------------------------------------------------------- clamped plate
+
+using PlateSolver = Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<2>, material::Elastic>;
+
+constexpr double plate_L = 1.0, plate_slenderness = 50.0, plate_d = plate_L / plate_slenderness, plate_E = 210e9,
+                 plate_nu = 0.3, plate_rho = 7850.0, plate_q = 1e3;
+constexpr double plate_D = plate_E * plate_d * plate_d * plate_d / (12 * (1 - plate_nu * plate_nu));
+constexpr double mindlin_50 = 0.0012754;  // w D / (q L^4), the value test_solver_plate checks against
+// The damped run's fundamental frequency and its number of periods (test_solver_plate, clamped).
+const double plate_omega = 35.99 / (plate_L * plate_L) * std::sqrt(plate_D / (plate_rho * plate_d));
+constexpr int plate_periods = 6;
+
+// The test's set-up: damped options for the explicit run, plain ones for the static solve
+// (the static answer depends on neither density nor damping).
+PlateSolver clamped_plate(bool damped) {
+  SolverOptions options;
+  options.nonlinear = false;
+  options.density = plate_rho;
+  if (damped) {
+    options.damping = 2 * plate_omega;
+    options.rotary_inertia_scale = std::max(3.0, 3.0 * (plate_slenderness / 50.0) * (plate_slenderness / 50.0));
+  }
+  PlateSolver solver(ShellModel::rectangular_plate(plate_L, plate_L, 21, 21, plate_d), {plate_E, plate_nu}, options);
+  solver.clamp(solver.model().set("boundary"));
+  solver.add_uniform_pressure(solver.model().all_particles(), plate_q, time_function::Step{},
+                              PressureDirection::fixed);
+  return solver;
+}
+
+double plate_coefficient(const PlateSolver& solver) {
+  return -solver.displacement(solver.model().set("centre")[0]).z() * plate_D / (plate_q * std::pow(plate_L, 4));
+}
+
+void clamped_plate_damped(benchmark::State& state) {
+  for (auto _ : state) {
+    const auto setup_start = Clock::now();
+    PlateSolver solver = clamped_plate(true);
+    const double setup = seconds_since(setup_start);
+    const double period = 2 * M_PI / plate_omega;
+    const auto start = Clock::now();
+    const double cpu_start = cpu_seconds();
+    solver.run_until((plate_periods - 1) * period);
+    const double before = plate_coefficient(solver);
+    solver.run_until(plate_periods * period);
+    const double seconds = seconds_since(start);
+    const double cpu = cpu_seconds() - cpu_start;
+    const double coefficient = plate_coefficient(solver);
+    state.SetIterationTime(seconds);
+    report_damped("plate", seconds, cpu, coefficient);
+    state.counters["setup_s"] = setup;
+    state.counters["steps"] = double(solver.steps());
+    state.counters["wDqL4"] = coefficient;
+    state.counters["error_pct"] = 100.0 * (coefficient / mindlin_50 - 1.0);
+    state.counters["last_period_change"] = std::abs(coefficient - before) / coefficient;
+  }
+}
+
+// Newton (StaticMass::tangent), one load step, ||r|| <= 1e-6 ||f||.
+void clamped_plate_static(benchmark::State& state) {
+  for (auto _ : state) {
+    const auto setup_start = Clock::now();
+    PlateSolver solver = clamped_plate(false);
+    const double setup = seconds_since(setup_start);
+    solver::StaticParameters parameters;
+    parameters.mass = solver::StaticMass::tangent;
+    const auto start = Clock::now();
+    const double cpu_start = cpu_seconds();
+    const solver::StaticResult result = solver.solve_static(parameters);
+    const double seconds = seconds_since(start);
+    const double cpu = cpu_seconds() - cpu_start;
+    const double coefficient = plate_coefficient(solver);
+    state.SetIterationTime(seconds);
+    report_static("plate", seconds, cpu, coefficient);
+    state.counters["setup_s"] = setup;
+    state.counters["force_evaluations"] = double(result.force_evaluations);
+    state.counters["iterations"] = double(result.iterations);
+    state.counters["residual"] = result.residual;
+    state.counters["wDqL4"] = coefficient;
+    state.counters["error_pct"] = 100.0 * (coefficient / mindlin_50 - 1.0);
+  }
+}
+
+// ---------------------------------------------------------------- cantilever under end shear
+
+using StripSolver = Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<3>, material::Elastic>;
+
+constexpr double strip_L = 0.5, strip_width = 0.1, strip_d = 0.02, strip_E = 210e9, strip_rho = 7850.0;
+constexpr double strip_EI = strip_E * strip_width * strip_d * strip_d * strip_d / 12.0;
+const double strip_omega = 3.516 * std::sqrt(strip_EI / (strip_rho * strip_width * strip_d)) / (strip_L * strip_L);
+constexpr int strip_periods = 12;
+
+// The elastica's tip deflection w/L under P L^2/EI = alpha (the tabulated values test_solver_shells uses).
+double elastica_tip(long alpha) { return alpha == 1 ? 0.30172 : 0.49346; }
+
+StripSolver cantilever(bool damped, double alpha) {
+  SolverOptions options;
+  options.nonlinear = true;
+  options.density = strip_rho;
+  if (damped) {
+    options.damping = 1.5 * strip_omega;
+    options.rotary_inertia_scale = 4.0;
+  }
+  StripSolver solver(ShellModel::rectangular_plate(strip_L, strip_width, 21, 5, strip_d), {strip_E, 0.0}, options);
+  solver.clamp(solver.model().set("x_min"));
+  const ParticleSet& tip = solver.model().set("x_max");
+  const double load = alpha * strip_EI / (strip_L * strip_L);
+  solver.add_point_force(tip, Vector3(0, 0, -load / static_cast<double>(tip.size())));
+  return solver;
+}
+
+double tip_deflection(const StripSolver& solver) {
+  const ParticleSet& tip = solver.model().set("x_max");
+  double w = 0.0;
+  for (int i : tip) w += -solver.displacement(i).z() / static_cast<double>(tip.size());
+  return w / strip_L;
+}
+
+std::string cantilever_case(long alpha) { return "cantilever PL^2/EI=" + std::to_string(alpha); }
+
+void cantilever_damped(benchmark::State& state) {
+  const long alpha = state.range(0);
+  for (auto _ : state) {
+    const auto setup_start = Clock::now();
+    StripSolver solver = cantilever(true, double(alpha));
+    const double setup = seconds_since(setup_start);
+    const double period = 2 * M_PI / strip_omega;
+    const auto start = Clock::now();
+    const double cpu_start = cpu_seconds();
+    solver.run_until((strip_periods - 1) * period);
+    const double before = tip_deflection(solver);
+    solver.run_until(strip_periods * period);
+    const double seconds = seconds_since(start);
+    const double cpu = cpu_seconds() - cpu_start;
+    const double w = tip_deflection(solver);
+    state.SetIterationTime(seconds);
+    report_damped(cantilever_case(alpha), seconds, cpu, w);
+    state.counters["setup_s"] = setup;
+    state.counters["steps"] = double(solver.steps());
+    state.counters["tip_w_over_L"] = w;
+    state.counters["error_pct"] = 100.0 * (w / elastica_tip(alpha) - 1.0);
+    state.counters["last_period_change"] = std::abs(w - before) / w;
+  }
+}
+
+// Adaptive dynamic relaxation (the default StaticMass::particle_bound, viscous
+// damping) in one load step, ||r|| <= 1e-6 ||f|| (the default tolerance).
+// test_static_solution takes two load steps {0.5, 1}: 2.2-2.8 times the
+// evaluations of one, with the same answer. Newton (StaticMass::tangent)
+// stalls on this strip (static_solution.hpp, "Known limit"): its line search
+// on ||r|| rejects the full steps.
+void cantilever_static(benchmark::State& state) {
+  const long alpha = state.range(0);
+  for (auto _ : state) {
+    const auto setup_start = Clock::now();
+    StripSolver solver = cantilever(false, double(alpha));
+    const double setup = seconds_since(setup_start);
+    solver::StaticParameters parameters;
+    parameters.load_factors = {1.0};
+    const auto start = Clock::now();
+    const double cpu_start = cpu_seconds();
+    const solver::StaticResult result = solver.solve_static(parameters);
+    const double seconds = seconds_since(start);
+    const double cpu = cpu_seconds() - cpu_start;
+    const double w = tip_deflection(solver);
+    state.SetIterationTime(seconds);
+    report_static(cantilever_case(alpha), seconds, cpu, w);
+    state.counters["setup_s"] = setup;
+    state.counters["force_evaluations"] = double(result.force_evaluations);
+    state.counters["iterations"] = double(result.iterations);
+    state.counters["residual"] = result.residual;
+    state.counters["tip_w_over_L"] = w;
+    state.counters["error_pct"] = 100.0 * (w / elastica_tip(alpha) - 1.0);
+  }
+}
+
+}  // namespace
+
+BENCHMARK(clamped_plate_damped)->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(clamped_plate_static)->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(cantilever_damped)->Arg(1)->Arg(2)->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(cantilever_static)->Arg(1)->Arg(2)->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  double load1 = 0.0;
+  if (getloadavg(&load1, 1) != 1) load1 = -1.0;
+  std::printf("\nmedians over the repetitions, damped / static (1-minute load average at the end %.2f):\n", load1);
+  for (const auto& [name, m] : measured()) {
+    if (m.damped_seconds.empty() || m.static_seconds.empty()) continue;
+    const double damped = median(m.damped_seconds), fast = median(m.static_seconds);
+    const double damped_cpu = median(m.damped_cpu), fast_cpu = median(m.static_cpu);
+    std::printf("  %-22s wall %7.3f s / %7.3f s = %5.1f   cpu %7.3f s / %7.3f s = %5.1f   static - damped %+.2e %%\n",
+                name.c_str(), damped, fast, damped / fast, damped_cpu, fast_cpu, damped_cpu / fast_cpu,
+                100.0 * (m.static_answer / m.damped_answer - 1.0));
+  }
+  return 0;
+}
