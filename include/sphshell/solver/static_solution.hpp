@@ -178,10 +178,9 @@ inline constexpr int max_step_halvings = 12;
 // (one-sided differences leave an asymmetry of the order of the perturbation).
 inline constexpr double symmetric_tangent_tolerance = 1e-4;
 // Entries of a finite-difference tangent column below this share of the
-// column's largest are round-off and are left out. On the 21 x 21 plate the
-// entries that are zero in the exact tangent come out below 1e-15 of its
-// largest entry (161 000 of its 250 000; 3 lie between 1e-15 and 1e-13),
-// and kept they made the solve of the Newton step 6-7 times slower.
+// column's largest are round-off (the exact tangent's zeros come out near
+// 1e-15 of it) and are left out: kept, they fill the factorisation
+// (docs/method.md, "Static solutions").
 inline constexpr double negligible_tangent_entry = 1e-12;
 // m_a = gershgorin_mass_factor × h² Σ_b |K_ab| (see the relaxation below).
 inline constexpr double gershgorin_mass_factor = 0.5;
