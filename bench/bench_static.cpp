@@ -88,6 +88,50 @@ void report_static(const std::string& name, double seconds, double cpu, double a
   m.static_answer = answer;
 }
 
+// The damped explicit run for `periods` periods of ω (the tests' hand-tuned
+// runs): times it, reports `answer` (named `answer_name`), its error against
+// `reference` and its change over the last period.
+template <class S, class Answer>
+void measure_damped(benchmark::State& state, const std::string& name, S& solver, double omega, int periods,
+                    Answer answer, const char* answer_name, double reference) {
+  const double period = 2 * M_PI / omega;
+  const auto start = Clock::now();
+  const double cpu_start = cpu_seconds();
+  solver.run_until((periods - 1) * period);
+  const double before = answer(solver);
+  solver.run_until(periods * period);
+  const double seconds = seconds_since(start);
+  const double cpu = cpu_seconds() - cpu_start;
+  const double value = answer(solver);
+  state.SetIterationTime(seconds);
+  report_damped(name, seconds, cpu, value);
+  state.counters["steps"] = double(solver.steps());
+  state.counters[answer_name] = value;
+  state.counters["error_pct"] = 100.0 * (value / reference - 1.0);
+  state.counters["last_period_change"] = std::abs(value - before) / value;
+}
+
+// solve_static with `parameters`: times it and reports as measure_damped does,
+// with the solve's force evaluations, iterations and final residual.
+template <class S, class Answer>
+void measure_static(benchmark::State& state, const std::string& name, S& solver,
+                    const solver::StaticParameters& parameters, Answer answer, const char* answer_name,
+                    double reference) {
+  const auto start = Clock::now();
+  const double cpu_start = cpu_seconds();
+  const solver::StaticResult result = solver.solve_static(parameters);
+  const double seconds = seconds_since(start);
+  const double cpu = cpu_seconds() - cpu_start;
+  const double value = answer(solver);
+  state.SetIterationTime(seconds);
+  report_static(name, seconds, cpu, value);
+  state.counters["force_evaluations"] = double(result.force_evaluations);
+  state.counters["iterations"] = double(result.iterations);
+  state.counters["residual"] = result.residual;
+  state.counters[answer_name] = value;
+  state.counters["error_pct"] = 100.0 * (value / reference - 1.0);
+}
+
 // ---------------------------------------------------------------- clamped plate
 
 using PlateSolver = Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<2>, material::Elastic>;
@@ -125,23 +169,8 @@ void clamped_plate_damped(benchmark::State& state) {
   for (auto _ : state) {
     const auto setup_start = Clock::now();
     PlateSolver solver = clamped_plate(true);
-    const double setup = seconds_since(setup_start);
-    const double period = 2 * M_PI / plate_omega;
-    const auto start = Clock::now();
-    const double cpu_start = cpu_seconds();
-    solver.run_until((plate_periods - 1) * period);
-    const double before = plate_coefficient(solver);
-    solver.run_until(plate_periods * period);
-    const double seconds = seconds_since(start);
-    const double cpu = cpu_seconds() - cpu_start;
-    const double coefficient = plate_coefficient(solver);
-    state.SetIterationTime(seconds);
-    report_damped("plate", seconds, cpu, coefficient);
-    state.counters["setup_s"] = setup;
-    state.counters["steps"] = double(solver.steps());
-    state.counters["wDqL4"] = coefficient;
-    state.counters["error_pct"] = 100.0 * (coefficient / mindlin_50 - 1.0);
-    state.counters["last_period_change"] = std::abs(coefficient - before) / coefficient;
+    state.counters["setup_s"] = seconds_since(setup_start);
+    measure_damped(state, "plate", solver, plate_omega, plate_periods, plate_coefficient, "wDqL4", mindlin_50);
   }
 }
 
@@ -150,23 +179,10 @@ void clamped_plate_static(benchmark::State& state) {
   for (auto _ : state) {
     const auto setup_start = Clock::now();
     PlateSolver solver = clamped_plate(false);
-    const double setup = seconds_since(setup_start);
+    state.counters["setup_s"] = seconds_since(setup_start);
     solver::StaticParameters parameters;
     parameters.mass = solver::StaticMass::tangent;
-    const auto start = Clock::now();
-    const double cpu_start = cpu_seconds();
-    const solver::StaticResult result = solver.solve_static(parameters);
-    const double seconds = seconds_since(start);
-    const double cpu = cpu_seconds() - cpu_start;
-    const double coefficient = plate_coefficient(solver);
-    state.SetIterationTime(seconds);
-    report_static("plate", seconds, cpu, coefficient);
-    state.counters["setup_s"] = setup;
-    state.counters["force_evaluations"] = double(result.force_evaluations);
-    state.counters["iterations"] = double(result.iterations);
-    state.counters["residual"] = result.residual;
-    state.counters["wDqL4"] = coefficient;
-    state.counters["error_pct"] = 100.0 * (coefficient / mindlin_50 - 1.0);
+    measure_static(state, "plate", solver, parameters, plate_coefficient, "wDqL4", mindlin_50);
   }
 }
 
@@ -212,23 +228,9 @@ void cantilever_damped(benchmark::State& state) {
   for (auto _ : state) {
     const auto setup_start = Clock::now();
     StripSolver solver = cantilever(true, double(alpha));
-    const double setup = seconds_since(setup_start);
-    const double period = 2 * M_PI / strip_omega;
-    const auto start = Clock::now();
-    const double cpu_start = cpu_seconds();
-    solver.run_until((strip_periods - 1) * period);
-    const double before = tip_deflection(solver);
-    solver.run_until(strip_periods * period);
-    const double seconds = seconds_since(start);
-    const double cpu = cpu_seconds() - cpu_start;
-    const double w = tip_deflection(solver);
-    state.SetIterationTime(seconds);
-    report_damped(cantilever_case(alpha), seconds, cpu, w);
-    state.counters["setup_s"] = setup;
-    state.counters["steps"] = double(solver.steps());
-    state.counters["tip_w_over_L"] = w;
-    state.counters["error_pct"] = 100.0 * (w / elastica_tip(alpha) - 1.0);
-    state.counters["last_period_change"] = std::abs(w - before) / w;
+    state.counters["setup_s"] = seconds_since(setup_start);
+    measure_damped(state, cantilever_case(alpha), solver, strip_omega, strip_periods, tip_deflection, "tip_w_over_L",
+                   elastica_tip(alpha));
   }
 }
 
@@ -243,23 +245,11 @@ void cantilever_static(benchmark::State& state) {
   for (auto _ : state) {
     const auto setup_start = Clock::now();
     StripSolver solver = cantilever(false, double(alpha));
-    const double setup = seconds_since(setup_start);
+    state.counters["setup_s"] = seconds_since(setup_start);
     solver::StaticParameters parameters;
     parameters.load_factors = {1.0};
-    const auto start = Clock::now();
-    const double cpu_start = cpu_seconds();
-    const solver::StaticResult result = solver.solve_static(parameters);
-    const double seconds = seconds_since(start);
-    const double cpu = cpu_seconds() - cpu_start;
-    const double w = tip_deflection(solver);
-    state.SetIterationTime(seconds);
-    report_static(cantilever_case(alpha), seconds, cpu, w);
-    state.counters["setup_s"] = setup;
-    state.counters["force_evaluations"] = double(result.force_evaluations);
-    state.counters["iterations"] = double(result.iterations);
-    state.counters["residual"] = result.residual;
-    state.counters["tip_w_over_L"] = w;
-    state.counters["error_pct"] = 100.0 * (w / elastica_tip(alpha) - 1.0);
+    measure_static(state, cantilever_case(alpha), solver, parameters, tip_deflection, "tip_w_over_L",
+                   elastica_tip(alpha));
   }
 }
 
