@@ -182,7 +182,8 @@ TEST_CASE("Benchmark: hemisphere with an 18 degree hole under alternating forces
           "[validation][benchmarks]") {
   // §3.4: the pulled point's outward and the pushed point's inward radial
   // displacement against the paper's table. Here 21 x 21 particles up to
-  // P/P_max = 0.05 (≈ 70 s; every further 0.05 costs about as much again).
+  // P/P_max = 0.05 (47 s on one thread; every further 0.05 costs about as much
+  // again).
   // Measured at 0.05: −1.66 % (pulled), −1.40 % (pushed); at 17 x 17 −4.92 /
   // −4.11 %, at 25 x 25 −0.43 / −0.49 % (−0.74 / −0.87 % at 0.1). Along the
   // path at 21 x 21 the error grows to −3.6 % at P/P_max = 0.45.
@@ -205,8 +206,8 @@ TEST_CASE("Benchmark: hemisphere with an 18 degree hole under alternating forces
 TEST_CASE("Benchmark: pull-out of an open-ended cylinder (Sze, Liu & Lo 2004, nonlinear)", "[validation][benchmarks]") {
   // §3.5: W_A (outward under the load), −U_B and −U_C (inward, 90° round at
   // mid-length and at the free end) against the paper's table at P/P_max =
-  // 0.025 … 0.3. Measured at 16 x 11 particles (θ x axial; ≈ 10 s): largest
-  // error −0.96 % (W_A at 0.25). Beyond 0.3 Newton under load control fails
+  // 0.025 … 0.3. Measured at 16 x 11 particles (θ x axial; 4.5 s): largest
+  // error −0.96 % (W_A at 0.25); at 22 x 15 +0.54 % up to 0.25. Beyond 0.3 Newton under load control fails
   // at this resolution (the paper's response snaps between 0.5 and 0.525).
   constexpr int circumferential = 16, axial = 11;
   const std::vector<TabulatedTriple> table = sze_pullout_table();
