@@ -182,3 +182,57 @@ TEST_CASE("Benchmark: slit annular plate under end shear (Sze, Liu & Lo 2004, no
               last.second, error_percent(last.second, reference.second), worst, run.report.iterations);
   CHECK(worst < 2.6);
 }
+
+TEST_CASE("Benchmark: hemisphere with an 18 degree hole under alternating forces (Sze, Liu & Lo 2004, nonlinear)",
+          "[validation][benchmarks]") {
+  // §3.4: the pulled point's outward and the pushed point's inward radial
+  // displacement against the paper's table. Here 21 x 21 particles up to
+  // P/P_max = 0.05 (47 s on one thread; every further 0.05 costs about as much
+  // again).
+  // Measured at 0.05: −1.66 % (pulled), −1.40 % (pushed); at 17 x 17 −4.92 /
+  // −4.11 %, at 25 x 25 −0.43 / −0.49 % (−0.74 / −0.87 % at 0.1). Along the
+  // path at 21 x 21 the error grows to −3.6 % at P/P_max = 0.45.
+  constexpr int n = 21;
+  const TabulatedRun run = run_sze_hemisphere<NonlinearSolver>(n, 0.0125, 0.05);
+  const std::vector<TabulatedPoint> table = sze_hemisphere_table();
+  REQUIRE(!run.points.empty());
+  double worst = 0.0;
+  for (std::size_t k = 0; k < run.points.size(); ++k) {
+    const double pulled = error_percent(run.points[k].first, table[k].first);
+    const double pushed = error_percent(run.points[k].second, table[k].second);
+    std::printf("Hemisphere (Sze), %d x %d, P/P_max = %.2f: pulled %.4g (%+.2f %%), pushed %.4g (%+.2f %%)\n", n, n,
+                run.points[k].load_factor, run.points[k].first, pulled, run.points[k].second, pushed);
+    worst = std::max({worst, std::abs(pulled), std::abs(pushed)});
+  }
+  std::printf("Hemisphere (Sze): largest error %.2f %%; %d Newton iterations\n", worst, run.report.iterations);
+  CHECK(worst < 2.0);
+}
+
+TEST_CASE("Benchmark: pull-out of an open-ended cylinder (Sze, Liu & Lo 2004, nonlinear)", "[validation][benchmarks]") {
+  // §3.5: W_A (outward under the load), −U_B and −U_C (inward, 90° round at
+  // mid-length and at the free end) against the paper's table at P/P_max =
+  // 0.025 … 0.3. Measured at 16 x 11 particles (θ x axial; 4.5 s): largest
+  // error −0.96 % (W_A at 0.25); at 22 x 15 +0.54 % up to 0.25. Beyond 0.3 Newton under load control fails
+  // at this resolution (the paper's response snaps between 0.5 and 0.525).
+  constexpr int circumferential = 16, axial = 11;
+  const std::vector<TabulatedTriple> table = sze_pullout_table();
+  std::vector<double> factors;
+  for (const TabulatedTriple& point : table)
+    if (point.load_factor <= 0.3 + 1e-12) factors.push_back(point.load_factor);
+  NewtonOptions newton;
+  newton.tolerance = 1e-5;  // the residual floors near 1e-6 of the load here
+  const CylinderRun run =
+      run_sze_cylinder<NonlinearSolver>(sze_pullout_cylinder(circumferential, axial), factors, 0.05, newton);
+  double worst = 0.0;
+  for (std::size_t k = 0; k < run.points.size(); ++k) {
+    const TabulatedTriple& point = run.points[k];
+    const double a = error_percent(point.a, table[k].a), b = error_percent(-point.b, table[k].b),
+                 c = error_percent(-point.c, table[k].c);
+    std::printf("Pull-out (Sze), %d x %d, P/P_max = %.3f: W_A %.4g (%+.2f %%), -U_B %.4g (%+.2f %%), -U_C %.4g "
+                "(%+.2f %%)\n",
+                circumferential, axial, point.load_factor, point.a, a, -point.b, b, -point.c, c);
+    worst = std::max({worst, std::abs(a), std::abs(b), std::abs(c)});
+  }
+  std::printf("Pull-out (Sze): largest error %.2f %%; %d Newton iterations\n", worst, run.report.iterations);
+  CHECK(worst < 1.3);
+}
