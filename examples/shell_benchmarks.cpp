@@ -292,7 +292,7 @@ int run(const Arguments& arguments) {
         pb.x.push_back(point.load_factor), pb.y.push_back(point.second);
       }
       io::write_svg_plot(arguments.output + "/sze_hemisphere.svg",
-                         {{"Hemisphere with an 18° hole under alternating forces (Sze, Liu & Lo 2004)", "P / Pmax",
+                         {{"Hemisphere, 18° hole, alternating forces (Sze et al. 2004)", "P / Pmax",
                            "radial displacement", {a, b, pa, pb}}});
 
       // §3.5, pull-out of an open-ended cylinder, to P/P_max = 0.25 (load
