@@ -268,14 +268,18 @@ struct TabulatedPoint {
   double load_factor;  // P / P_max
   double first, second;
 };
+// A table at P/P_max = 0.05, 0.10, …, 1 from its two columns.
+inline std::vector<TabulatedPoint> table_in_twentieths(const double (&first)[20], const double (&second)[20]) {
+  std::vector<TabulatedPoint> table;
+  for (int k = 0; k < 20; ++k) table.push_back({0.05 * (k + 1), first[k], second[k]});
+  return table;
+}
 inline std::vector<TabulatedPoint> sze_end_shear_table() {
   const double w[] = {0.663, 1.309, 1.922, 2.493, 3.015, 3.488, 3.912, 4.292, 4.631, 4.933,
                       5.202, 5.444, 5.660, 5.855, 6.031, 6.190, 6.335, 6.467, 6.588, 6.698};
   const double u[] = {0.026, 0.103, 0.224, 0.381, 0.563, 0.763, 0.971, 1.184, 1.396, 1.604,
                       1.807, 2.002, 2.190, 2.370, 2.541, 2.705, 2.861, 3.010, 3.151, 3.286};
-  std::vector<TabulatedPoint> table;
-  for (int k = 0; k < 20; ++k) table.push_back({0.05 * (k + 1), w[k], u[k]});
-  return table;
+  return table_in_twentieths(w, u);
 }
 
 // A cantilever strip (tests' Sze cases) solved at the given load factors: the
@@ -408,9 +412,7 @@ inline std::vector<TabulatedPoint> sze_hemisphere_table() {
                            3.508, 3.598, 3.678, 3.750, 3.816, 3.875, 3.929, 3.979, 4.025, 4.067};
   const double pushed[] = {0.955, 1.840, 2.604, 3.261, 3.833, 4.339, 4.790, 5.196, 5.565, 5.902,
                            6.212, 6.497, 6.761, 7.006, 7.234, 7.448, 7.647, 7.835, 8.011, 8.178};
-  std::vector<TabulatedPoint> table;
-  for (int k = 0; k < 20; ++k) table.push_back({0.05 * (k + 1), pulled[k], pushed[k]});
-  return table;
+  return table_in_twentieths(pulled, pushed);
 }
 
 // Σ w_j u_j · direction for weights w read from the current configuration.
