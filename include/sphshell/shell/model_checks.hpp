@@ -144,7 +144,10 @@ inline void require_thin(const std::string& name, double d, double extent) {
                               "must be below the shell's extent " + std::to_string(extent) +
                                   " m (the diagonal of its particles' bounding box): a shell is thin");
 }
+// The middle value (the upper one of an even count; 0 for none): also the
+// cell width of a search whose radii vary from point to point.
 inline double median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
   const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
   std::nth_element(values.begin(), middle, values.end());
   return *middle;

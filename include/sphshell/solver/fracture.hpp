@@ -87,7 +87,7 @@ inline StressPointNeighbourhoods stress_point_neighbourhoods(const ShellModel& m
       maps.particles_of_stress_point[q].assign(model.cells()[q].begin(), model.cells()[q].end());
   } else {
     const std::vector<double>& reach = local_spacing(model).stress_point;
-    const approx::CellList cells(model.particle_position, median_of(reach));
+    const approx::CellList cells(model.particle_position, sphshell::detail::model_checks::median(reach));
     for (std::size_t q = 0; q < model.stress_point_count(); ++q)
       cells.for_each_within(model.stress_point_position[q], reach[q],
                             [&](int i, double) { maps.particles_of_stress_point[q].push_back(i); });

@@ -51,23 +51,7 @@ inline constexpr double particle_spacing_reach = 1.5;
 struct LocalSpacing {
   std::vector<double> stress_point;  // Δ_q, per stress point (m)
   std::vector<double> particle;      // Δ_i, per particle (m)
-
-  double largest() const {
-    double value = 0.0;
-    for (const std::vector<double>* set : {&stress_point, &particle})
-      for (double spacing : *set) value = std::max(value, spacing);
-    return value;
-  }
 };
-
-// The middle value (the upper one of an even count): the cell width of a
-// search whose radii vary from point to point.
-inline double median_of(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
-}
 
 inline LocalSpacing local_spacing(const ShellModel& model) {
   LocalSpacing spacing;
@@ -102,7 +86,7 @@ inline LocalSpacing local_spacing(const ShellModel& model) {
     reach[j] = particle_spacing_reach * own[j];
   }
   spacing.particle = own;
-  const approx::CellList particles(model.particle_position, median_of(reach));
+  const approx::CellList particles(model.particle_position, sphshell::detail::model_checks::median(reach));
   for (std::size_t j = 0; j < own.size(); ++j)
     particles.for_each_within(model.particle_position[j], reach[j], [&](int i, double) {
       double& target = spacing.particle[static_cast<std::size_t>(i)];

@@ -45,7 +45,7 @@ inline double nearest_particle_distance(const ShellModel& model, const shell::Cu
   const std::vector<double>& local = local_spacing(model).particle;
   std::vector<double> reach(local.size());
   for (std::size_t i = 0; i < local.size(); ++i) reach[i] = 2.0 * local[i];
-  const approx::CellList cells(model.particle_position, median_of(reach));
+  const approx::CellList cells(model.particle_position, sphshell::detail::model_checks::median(reach));
   double nearest = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < model.particle_count(); ++i)
     cells.for_each_within(model.particle_position[i], reach[i], [&](int j, double distance_squared) {
