@@ -81,6 +81,43 @@ TEST_CASE("Static shell: the elastica by shooting matches the tabulated cantilev
   CHECK(small.w == Approx(1e-4 * 1000.0 / 300.0).epsilon(1e-6));
 }
 
+TEST_CASE("Static shell: displacement control follows the load-controlled path", "[static][benchmarks]") {
+  // The cantilever under end shear (21 x 3) solved twice: by load control to
+  // P/P_max = 0.5 and 1, and by prescribing the tip's deflection in steps of
+  // 0.5 (the load factor then an unknown). Both are equilibria of the same
+  // discrete model, so the path read at those load factors must give the load
+  // control's tip (to the Newton tolerance and the path's quadratic
+  // interpolation), and both stay near the elastica.
+  const std::vector<double> factors{0.5, 1.0};
+  const CantileverRun by_load = run_cantilever<NonlinearSolver>(EndLoad::shear, 21, 3, factors, 0.1);
+  CantileverStrip strip = cantilever_strip(10.0, 21, 3);
+  const std::vector<double> share = edge_shares(3);
+  for (int k = 0; k < 3; ++k) strip.conditions.add_force({strip.tip[k]}, Vector3(0.0, 0.0, 4.0 * share[k]));
+  const ControlDisplacement tip_w{{{strip.tip_mid, 1.0}}, Vector3::UnitZ()};
+  const ControlDisplacement tip_u{{{strip.tip_mid, 1.0}}, -Vector3::UnitX()};
+  const PathRun path = follow_path<NonlinearSolver>(strip.model, 1.2e6, 0.0, strip.conditions, tip_w, {tip_w, tip_u},
+                                                    0.5, 1.0, 40);
+  REQUIRE(path.path.back().load_factor >= 1.0);
+  for (std::size_t k = 1; k < path.path.size(); ++k)  // the tip's w is what was prescribed
+    CHECK(path.path[k].values[0] == Approx(0.5 * double(k)).epsilon(1e-9));
+  for (std::size_t k = 0; k < factors.size(); ++k) {
+    const std::vector<double> on_path = readings_at_load_factor(path.path, factors[k]);
+    REQUIRE(on_path.size() == 2);
+    std::printf("displacement control at P/Pmax = %.2f: w %.6f (load control %.6f), -u %.6f (%.6f)\n", factors[k],
+                on_path[0], by_load.points[k].w, on_path[1], by_load.points[k].u);
+    CHECK(on_path[0] == Approx(by_load.points[k].w).epsilon(2e-3));
+    CHECK(on_path[1] == Approx(by_load.points[k].u).epsilon(4e-3));
+    const TipDisplacement exact = elastica_tip(factors[k] * 4.0, 100.0, 10.0);
+    CHECK(on_path[0] == Approx(exact.w).epsilon(5e-3));
+  }
+  // A path read beyond its last load factor gives nothing.
+  CHECK(readings_at_load_factor(path.path, 10.0).empty());
+  // Bad input: a non-positive displacement step.
+  NonlinearSolver solver(strip.model, {1.2e6, 0.0});
+  StaticShell<NonlinearSolver> statics(solver, strip.conditions);
+  CHECK_THROWS_WITH(statics.solve_to_displacement(tip_w, 1.0, 0.0), Catch::Contains("displacement step must be positive"));
+}
+
 TEST_CASE("Benchmark: Scordelis-Lo roof (linear)", "[validation][benchmarks]") {
   // Reference 0.3024 (MacNeal & Harder 1985). Measured −0.52 % at 33 x 33
   // (+0.07 % at 17, −0.37 % at 25; −0.56 % at 41 in the example).

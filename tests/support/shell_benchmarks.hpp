@@ -25,7 +25,10 @@
 #include <sphshell/kernel/cubic_spline.hpp>
 #include <sphshell/shell/model.hpp>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -542,6 +545,86 @@ CylinderRun run_sze_cylinder(const SzeCylinder& cylinder, const std::vector<doub
   }
   run.report = statics.report();
   return run;
+}
+
+// A load-deflection path followed by displacement control
+// (StaticShell::solve_to_displacement): per converged step the control
+// displacement, the load factor and the displacements read.
+struct PathPoint {
+  double control, load_factor;
+  std::vector<double> values;
+};
+struct PathRun {
+  std::vector<PathPoint> path;  // from the unloaded state
+  NewtonReport report;
+  double seconds = 0.0;
+  std::string stopped;  // why the path ended before its last load factor (empty: it did not)
+};
+// A displacement to read along the path: Σ w_j u_j · direction.
+using PathReading = ControlDisplacement;
+
+// Follows the path of `conditions` on a new solver of `model` in steps of
+// `step` of the control displacement until the load factor reaches
+// `last_factor` (or `max_steps` steps were taken, or Newton failed: the path
+// so far is returned with the reason).
+template <class NonlinearSolver>
+PathRun follow_path(const ShellModel& model, double E, double nu, const StaticConditions& conditions,
+                    const ControlDisplacement& control, const std::vector<PathReading>& readings, double step,
+                    double last_factor, int max_steps, NewtonOptions newton = {}) {
+  const auto start = std::chrono::steady_clock::now();
+  NonlinearSolver solver(model, {E, nu});
+  StaticShell<NonlinearSolver> statics(solver, conditions, newton);
+  PathRun run;
+  run.path.push_back({0.0, 0.0, std::vector<double>(readings.size(), 0.0)});
+  for (int k = 1; k <= max_steps && run.path.back().load_factor < last_factor; ++k) {
+    try {
+      statics.solve_to_displacement(control, k * step, step);
+    } catch (const std::runtime_error& error) {  // Newton gave up: keep the path so far
+      run.stopped = error.what();
+      break;
+    }
+    PathPoint point{statics.displacement_of(control), statics.load_factor(), {}};
+    for (const PathReading& reading : readings) point.values.push_back(statics.displacement_of(reading));
+    run.path.push_back(std::move(point));
+  }
+  run.report = statics.report();
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return run;
+}
+
+// The path's readings where its load factor first reaches `lambda` (what load
+// control would give: past a snap-through, the far branch), by quadratic
+// interpolation in the control displacement through the two points around
+// the crossing and the next (or the one before, at the end). Empty when the
+// path never reaches `lambda`.
+inline std::vector<double> readings_at_load_factor(const std::vector<PathPoint>& path, double lambda) {
+  std::size_t k = 1;
+  while (k < path.size() && path[k].load_factor < lambda) ++k;
+  if (k >= path.size()) return {};
+  const std::size_t first = k + 1 < path.size() ? k - 1 : (k >= 2 ? k - 2 : k - 1);
+  const std::size_t count = std::min<std::size_t>(3, path.size() - first);
+  auto lagrange = [&](double s, auto&& value_of) {
+    double sum = 0.0;
+    for (std::size_t i = first; i < first + count; ++i) {
+      double basis = 1.0;
+      for (std::size_t j = first; j < first + count; ++j)
+        if (j != i) basis *= (s - path[j].control) / (path[i].control - path[j].control);
+      sum += basis * value_of(path[i]);
+    }
+    return sum;
+  };
+  const auto load_factor = [](const PathPoint& point) { return point.load_factor; };
+  // λ(s) − lambda changes sign on [s_{k−1}, s_k] (the interpolant passes through both points).
+  double low = path[k - 1].control, high = path[k].control;
+  for (int i = 0; i < 100; ++i) {
+    const double mid = 0.5 * (low + high);
+    (lagrange(mid, load_factor) < lambda ? low : high) = mid;
+  }
+  const double s = 0.5 * (low + high);
+  std::vector<double> values;
+  for (std::size_t r = 0; r < path[k].values.size(); ++r)
+    values.push_back(lagrange(s, [r](const PathPoint& point) { return point.values[r]; }));
+  return values;
 }
 
 }  // namespace sphshell::test_support

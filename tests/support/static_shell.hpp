@@ -11,6 +11,11 @@
 // - A nonlinear solver is solved by load stepping, a full Newton iteration per
 //   step (the tangent re-assembled at every iteration), and step halving when
 //   an iteration diverges.
+// - Or by displacement control (Batoz & Dhatt, IJNME 14 (1979) 1262–1267):
+//   one displacement Σ w_j u_j · e is prescribed step by step and the load
+//   factor is an unknown of each Newton iteration, so the path is followed
+//   through limit points of the load (a snap-through), where load control
+//   fails.
 //
 // The assembly perturbs many particles at once. A particle's motion changes
 // the forces only within two support radii (the stress points that see it and
@@ -39,10 +44,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdio>
 #include <functional>
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace sphshell::test_support {
@@ -98,6 +105,16 @@ struct NewtonOptions {
   double rotation_step = 1e-7;      // rad
   // Perturb one particle at a time (for checking the colouring; slow).
   bool one_particle_per_colour = false;
+  // Print every displacement-control iteration (load factor, relative
+  // residual, control gap) to standard error.
+  bool trace = false;
+};
+
+// A displacement of the model, Σ w_j u_j · direction over particles j with
+// weights w_j (a particle's own, or the approximation's value at a point).
+struct ControlDisplacement {
+  std::vector<std::pair<int, double>> weights;
+  Vector3 direction;
 };
 
 struct NewtonReport {
@@ -129,7 +146,7 @@ class StaticShell {
       const std::vector<Vector3> x0 = solver_.positions(), d0 = solver_.directors();
       predict(target);
       if (converge(target)) {
-        previous_ = {x0, d0, lambda_};
+        previous_ = {x0, d0, lambda_, 0.0};
         lambda_ = target;
         ++report_.load_steps;
         halvings = 0;
@@ -142,6 +159,44 @@ class StaticShell {
           throw std::runtime_error("StaticShell: Newton did not converge at load factor " + std::to_string(target));
       }
     }
+  }
+
+  // Equilibrium with the control displacement at `target`, reached from the
+  // current state in increments of at most `step` of it (halved when an
+  // iteration diverges); the load factor is solved for with the displacement.
+  void solve_to_displacement(const ControlDisplacement& control, double target, double step) {
+    if (!(step > 0.0)) throw std::invalid_argument("StaticShell: the displacement step must be positive");
+    double value = displacement_of(control);
+    double increment = step;
+    int halvings = 0;
+    while (std::abs(target - value) > 1e-12 * std::max(std::abs(target), step)) {
+      const double next = target > value ? std::min(target, value + increment) : std::max(target, value - increment);
+      const std::vector<Vector3> x0 = solver_.positions(), d0 = solver_.directors();
+      const double lambda0 = lambda_;
+      predict_displacement(next, value);
+      if (converge_displacement(control, next)) {
+        previous_ = {x0, d0, lambda0, value};
+        value = next;
+        ++report_.load_steps;
+        halvings = 0;
+        increment = std::min(step, 1.5 * increment);
+      } else {
+        solver_.set_configuration(x0, d0);
+        ++report_.force_evaluations;
+        lambda_ = lambda0;
+        increment *= 0.5;
+        if (++halvings > options_.max_halvings)
+          throw std::runtime_error("StaticShell: Newton did not converge at control displacement " +
+                                   std::to_string(next) + " (load factor " + std::to_string(lambda_) + ")");
+      }
+    }
+  }
+
+  // The control displacement in the current configuration.
+  double displacement_of(const ControlDisplacement& control) const {
+    double value = 0.0;
+    for (const auto& [particle, weight] : control.weights) value += weight * displacement(particle).dot(control.direction);
+    return value;
   }
 
   // One Newton step from the current configuration at load factor lambda (the
@@ -319,28 +374,31 @@ class StaticShell {
 
   enum class Factorisation { symmetric, general };
 
-  // One Newton update; returns the relative residual before it.
-  double newton_iteration(double lambda, Factorisation factorisation = Factorisation::general) {
-    const Dofs dofs = current_dofs();
-    const Eigen::VectorXd r = residual(dofs, lambda);
-    const double reference = load_norm(dofs, lambda);
+  // The tangent's solutions for the columns of `rhs`, from one factorisation.
+  // The stiffness is symmetrised and factorised by LDLᵀ (the linear
+  // stiffness is symmetric; the finite differences leave it so to rounding),
+  // or factorised as it is by LU (a nonlinear tangent).
+  Eigen::MatrixXd solve_tangent(const Dofs& dofs, const Eigen::MatrixXd& rhs, Factorisation factorisation) {
     Eigen::SparseMatrix<double> k = tangent(dofs);
     k.makeCompressed();
-    Eigen::VectorXd update;
     if (factorisation == Factorisation::symmetric) {
       const Eigen::SparseMatrix<double> transposed = k.transpose();
       const Eigen::SparseMatrix<double> symmetric = 0.5 * (k + transposed);
       Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(symmetric);
       if (ldlt.info() != Eigen::Success)
         throw std::runtime_error("StaticShell: the stiffness is singular (a free rigid-body mode?)");
-      update = ldlt.solve(r);
-    } else {
-      Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
-      lu.compute(k);
-      if (lu.info() != Eigen::Success)
-        throw std::runtime_error("StaticShell: the tangent stiffness is singular (a free rigid-body mode?)");
-      update = lu.solve(r);
+      return ldlt.solve(rhs);
     }
+    Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
+    lu.compute(k);
+    if (lu.info() != Eigen::Success)
+      throw std::runtime_error("StaticShell: the tangent stiffness is singular (a free rigid-body mode?)");
+    return lu.solve(rhs);
+  }
+
+  // Moves the particles by an update in the dofs (translations added,
+  // directors turned by the rotation vector of their dofs).
+  void apply_update(const Dofs& dofs, const Eigen::VectorXd& update) {
     std::vector<Vector3> x = solver_.positions(), d = solver_.directors();
     const int n = static_cast<int>(x.size());
     for (int i = 0; i < n; ++i) {
@@ -357,17 +415,97 @@ class StaticShell {
     solver_.set_configuration(std::move(x), std::move(d));
     ++report_.force_evaluations;
     ++report_.iterations;
+  }
+
+  // One Newton update; returns the relative residual before it.
+  double newton_iteration(double lambda, Factorisation factorisation = Factorisation::general) {
+    const Dofs dofs = current_dofs();
+    const Eigen::VectorXd r = residual(dofs, lambda);
+    const double reference = load_norm(dofs, lambda);
+    apply_update(dofs, solve_tangent(dofs, r, factorisation).col(0));
     return reference > 0.0 ? r.norm() / reference : r.norm();
   }
 
+  // The external load at load factor 1 in the dofs.
+  Eigen::VectorXd external_load(const Dofs& dofs) const {
+    Eigen::VectorXd f(dofs.direction.size());
+    for (std::size_t i = 0; i + 1 < dofs.first.size(); ++i)
+      for (int k = dofs.first[i]; k < dofs.first[i + 1]; ++k)
+        f[k] = dofs.direction[k].dot(dofs.is_rotation[k] ? conditions_.moment[i] : conditions_.force[i]);
+    return f;
+  }
+
+  // The control displacement's gradient in the dofs (it is linear in the translations).
+  Eigen::VectorXd control_gradient(const Dofs& dofs, const ControlDisplacement& control) const {
+    Eigen::VectorXd g = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(dofs.direction.size()));
+    for (const auto& [particle, weight] : control.weights)
+      for (int k = dofs.first[particle]; k < dofs.first[particle + 1]; ++k)
+        if (!dofs.is_rotation[k]) g[k] += weight * control.direction.dot(dofs.direction[k]);
+    return g;
+  }
+
+  // Newton's method on equilibrium and the prescribed control displacement,
+  // the load factor lambda_ an unknown: with K δu_r = r and K δu_f = f_ext,
+  // the update δu_r + δλ δu_f meets the displacement to first order (it is
+  // linear in the translations, so exactly).
+  bool converge_displacement(const ControlDisplacement& control, double target) {
+    // A relative residual this large along a path means the step left the
+    // path's basin (a wrong branch, a wild load factor): halving is cheaper.
+    constexpr double divergence = 1e2;
+    for (int iteration = 0; iteration < options_.max_iterations; ++iteration) {
+      const Dofs dofs = current_dofs();
+      const Eigen::VectorXd f = external_load(dofs);
+      const Eigen::VectorXd r = residual(dofs, lambda_);
+      const double reference = std::abs(lambda_) * f.norm();
+      const double gap = target - displacement_of(control);
+      if (options_.trace)
+        std::fprintf(stderr, "  iteration %d: load factor %.8g, residual %.3e (relative %.3e), gap %.3e\n", iteration,
+                     lambda_, r.norm(), reference > 0.0 ? r.norm() / reference : 0.0, gap);
+      if (!std::isfinite(r.norm())) return false;
+      // At λ = 0 (the first iteration from the unloaded state) there is no
+      // load to measure the residual against: iterate.
+      if (reference > 0.0) {
+        const double relative = r.norm() / reference;
+        if (relative > divergence) return false;
+        if (relative <= options_.tolerance && std::abs(gap) <= options_.tolerance * std::abs(target)) return true;
+      }
+      Eigen::MatrixXd rhs(r.size(), 2);
+      rhs.col(0) = r;
+      rhs.col(1) = f;
+      const Eigen::MatrixXd solution = solve_tangent(dofs, rhs, Factorisation::general);
+      const Eigen::VectorXd g = control_gradient(dofs, control);
+      const double along_load = g.dot(solution.col(1));
+      if (!(std::abs(along_load) > 0.0)) return false;
+      const double d_lambda = (gap - g.dot(solution.col(0))) / along_load;
+      lambda_ += d_lambda;
+      apply_update(dofs, solution.col(0) + d_lambda * solution.col(1));
+    }
+    return false;
+  }
+
+  // The start of a displacement step: the last two converged states (and
+  // load factors) extrapolated linearly in the control displacement.
+  void predict_displacement(double target, double value) {
+    if (previous_.x.empty()) return;
+    const double span = value - previous_.control;
+    if (!(std::abs(span) > 0.0)) return;
+    const double ratio = (target - value) / span;
+    lambda_ += ratio * (lambda_ - previous_.lambda);
+    extrapolate(ratio);
+  }
+
   // The start of a load step: the last two converged states extrapolated
-  // linearly in the load factor (translations, and the director turned on by
-  // the last step's rotation, scaled), else the current state.
+  // linearly in the load factor, else the current state.
   void predict(double target) {
     if (previous_.x.empty()) return;
     const double span = lambda_ - previous_.lambda;
     if (!(span > 0.0)) return;
-    const double ratio = (target - lambda_) / span;
+    extrapolate((target - lambda_) / span);
+  }
+
+  // The current state moved on by `ratio` times the last step (translations,
+  // and the director turned on by the last step's rotation, scaled).
+  void extrapolate(double ratio) {
     std::vector<Vector3> x = solver_.positions(), d = solver_.directors();
     for (std::size_t i = 0; i < x.size(); ++i) {
       x[i] += ratio * (x[i] - previous_.x[i]);
@@ -401,6 +539,7 @@ class StaticShell {
   struct Converged {
     std::vector<Vector3> x, d;
     double lambda = 0.0;
+    double control = 0.0;  // the control displacement (displacement control)
   } previous_;  // the converged state before the current one
   std::vector<std::vector<int>> colours_;
   std::vector<std::vector<int>> near_;  // per particle: the particles it is coupled to (itself included)
