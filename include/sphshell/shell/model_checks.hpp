@@ -9,6 +9,7 @@
 
 #include <sphshell/approx/neighbour_search.hpp>
 #include <sphshell/core/error.hpp>
+#include <sphshell/core/statistics.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/shell/cell.hpp>
 
@@ -144,14 +145,7 @@ inline void require_thin(const std::string& name, double d, double extent) {
                               "must be below the shell's extent " + std::to_string(extent) +
                                   " m (the diagonal of its particles' bounding box): a shell is thin");
 }
-// The middle value (the upper one of an even count; 0 for none): also the
-// cell width of a search whose radii vary from point to point.
-inline double median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
-}
+using sphshell::detail::median;  // core/statistics.hpp
 // The sheet spans a surface: not one line; a flat sheet's normals point out of its plane.
 inline void check_spans_a_surface(const std::vector<Vector3>& particle_position,
                                   const std::vector<Vector3>& particle_normal,

@@ -8,6 +8,7 @@
 #include <sphshell/approx/shape_functions.hpp>
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/parallel.hpp>
+#include <sphshell/core/statistics.hpp>
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/kernel/kernel.hpp>
@@ -201,10 +202,7 @@ class RowSmoothingLengths {
       if (!((*per_row_)[row] > 0.0) || !std::isfinite((*per_row_)[row]))
         invalid_parameter("h of evaluation point " + std::to_string(row), (*per_row_)[row], "must be finite and > 0");
     if (rows == 0) return;
-    std::vector<double> sorted = *per_row_;
-    const auto middle = sorted.begin() + static_cast<std::ptrdiff_t>(rows / 2);
-    std::nth_element(sorted.begin(), middle, sorted.end());
-    median_ = *middle;
+    median_ = sphshell::detail::median(*per_row_);
     smallest_ = *std::min_element(per_row_->begin(), per_row_->end());
     largest_ = *std::max_element(per_row_->begin(), per_row_->end());
   }
