@@ -248,19 +248,34 @@ class IntegrationPoints {
     return g;
   }
 
-  // The same from the packed positions and directors (solver/particles.hpp).
+  // The same from the packed positions and directors (solver/particles.hpp):
+  // the step's hot gather. The sums are kept in locals, not in the returned
+  // structure, and the arrays are read through local pointers: a store into
+  // the result might alias the arrays for all the compiler knows, so it would
+  // write the sums back and reload every array's address at every slot. The
+  // sums are the same, in the same order.
   shell::SurfaceGradients gather(PointGroup group, std::size_t row, const std::vector<PackedKinematics>& packed) const {
     const approx::ShapeFunctions& sf = shape(group);
-    shell::SurfaceGradients g;
+    const int* const neighbour = sf.neighbour.data();
+    const double *const phi = sf.phi.data(), *const dphi_d1 = sf.dphi_d1.data(), *const dphi_d2 = sf.dphi_d2.data();
+    const PackedKinematics* const particles = packed.data();
+    Vector3 a1 = Vector3::Zero(), a2 = Vector3::Zero(), n = Vector3::Zero(), n1 = Vector3::Zero(),
+            n2 = Vector3::Zero();
     const std::size_t end = sf.row_begin[row] + sf.row_size[row];
     for (std::size_t s = sf.row_begin[row]; s < end; ++s) {
-      const PackedKinematics& particle = packed[std::size_t(sf.neighbour[s])];
-      g.a1 += sf.dphi_d1[s] * particle.position;
-      g.a2 += sf.dphi_d2[s] * particle.position;
-      g.n += sf.phi[s] * particle.director;
-      g.n1 += sf.dphi_d1[s] * particle.director;
-      g.n2 += sf.dphi_d2[s] * particle.director;
+      const PackedKinematics& particle = particles[std::size_t(neighbour[s])];
+      a1 += dphi_d1[s] * particle.position;
+      a2 += dphi_d2[s] * particle.position;
+      n += phi[s] * particle.director;
+      n1 += dphi_d1[s] * particle.director;
+      n2 += dphi_d2[s] * particle.director;
     }
+    shell::SurfaceGradients g;
+    g.a1 = a1;
+    g.a2 = a2;
+    g.n = n;
+    g.n1 = n1;
+    g.n2 = n2;
     return g;
   }
 

@@ -50,7 +50,7 @@ class InternalForceAssembler {
     for (PointGroup group : point_groups)
       parallel::for_each(
           std::size_t{0}, points.count(group),
-          [&](std::size_t row) { integrate_point(group, row, particles, points, states); },
+          [&](std::size_t row) { integrate_point(group, row, points, states); },
           [&](std::size_t row, const std::exception_ptr& error) {
             failed_point_ = points.point(group, row);
             detail::fail_unstable(at, std::string(name_of(group)) + " " +
@@ -69,14 +69,9 @@ class InternalForceAssembler {
   double scatter_point(PointGroup group, std::size_t row, const shell::SurfaceGradients& current,
                        const ParticleState& particles, const IntegrationPoints<Approx>& points,
                        const SectionStates<Rule, Law>& states) {
-    const std::size_t p = points.point(group, row);
-    const double w = points.membrane_bending_weight(p);
-    const shell::WeightedStresses weighted{w * states.membrane_force(p), w * states.bending_moment(p),
-                                           states.shear_force(p)};
-    conjugate_[p] = shell::conjugate_forces(nonlinear_ ? current : points.reference(p), weighted);
-    cleared_[p] = 0;
-    tied_active_[p] = 0;
-    return points.shear_tied(group, row) ? tied_shear(row, p, particles, points) : 0.0;
+    return scatter(group, row, current, points, states,
+                   [&](int j) -> const Vector3& { return particles.position[std::size_t(j)]; },
+                   [&](int j) -> const Vector3& { return particles.director[std::size_t(j)]; });
   }
 
   // Zeroes the forces a point leaves on the slots of its row (a removed point).
@@ -165,8 +160,8 @@ class InternalForceAssembler {
   }
 
   template <class Approx, class Rule, class Law>
-  void integrate_point(PointGroup group, std::size_t row, const ParticleState& particles,
-                       const IntegrationPoints<Approx>& points, SectionStates<Rule, Law>& states) {
+  void integrate_point(PointGroup group, std::size_t row, const IntegrationPoints<Approx>& points,
+                       SectionStates<Rule, Law>& states) {
     const std::size_t p = points.point(group, row);
     if (!states.active(p)) return;
     const shell::SurfaceGradients current = points.gather(group, row, packed_);
@@ -188,19 +183,41 @@ class InternalForceAssembler {
     states.membrane_force(p) = resultants.membrane;
     states.bending_moment(p) = resultants.moment;
     states.shear_force(p) = shear_force;
-    const double tied_energy = scatter_point(group, row, current, particles, points, states);
+    // The tied shear reads the corners from this step's packed kinematics
+    // (the same numbers as the particle state's).
+    const double tied_energy =
+        scatter(group, row, current, points, states,
+                [&](int j) -> const Vector3& { return packed_[std::size_t(j)].position; },
+                [&](int j) -> const Vector3& { return packed_[std::size_t(j)].director; });
     // The tied shear is elastic and quadratic: its work over the step is
     // exactly the change of its energy.
     work_increment_[p] += tied_energy - states.tied_shear_energy(p);
     states.tied_shear_energy(p) = tied_energy;
   }
 
+  // scatter_point with the particles' positions and directors read through
+  // position(j) and director(j).
+  template <class Approx, class Rule, class Law, class Position, class Director>
+  double scatter(PointGroup group, std::size_t row, const shell::SurfaceGradients& current,
+                 const IntegrationPoints<Approx>& points, const SectionStates<Rule, Law>& states,
+                 const Position& position, const Director& director) {
+    const std::size_t p = points.point(group, row);
+    const double w = points.membrane_bending_weight(p);
+    const shell::WeightedStresses weighted{w * states.membrane_force(p), w * states.bending_moment(p),
+                                           states.shear_force(p)};
+    conjugate_[p] = shell::conjugate_forces(nonlinear_ ? current : points.reference(p), weighted);
+    cleared_[p] = 0;
+    tied_active_[p] = 0;
+    return points.shear_tied(group, row) ? tied_shear(row, p, points, position, director) : 0.0;
+  }
+
   // The forces of a stress point's edge-tied shear (shell/cell_shear.hpp) on
-  // its cell's corners, kept for the per-particle sums; returns its energy. A
-  // corner hidden from the point by a crack leaves the cell's shear out (energy 0).
-  template <class Approx>
-  double tied_shear(std::size_t row, std::size_t p, const ParticleState& particles,
-                    const IntegrationPoints<Approx>& points) {
+  // its cell's corners, written straight into the point's kept forces;
+  // returns its energy. A corner hidden from the point by a crack leaves the
+  // cell's shear out (energy 0).
+  template <class Approx, class Position, class Director>
+  double tied_shear(std::size_t row, std::size_t p, const IntegrationPoints<Approx>& points, const Position& position,
+                    const Director& director) {
     const shell::CellShearTying& tying = points.shear_tying(row);
     const approx::ShapeFunctions& shape = points.shape(PointGroup::stress_points);
     const std::size_t begin = shape.row_begin[row], end = begin + shape.row_size[row];
@@ -209,14 +226,13 @@ class InternalForceAssembler {
       while (s < end && shape.neighbour[s] != tying.particle[std::size_t(k)]) ++s;
       if (s == end) return 0.0;
     }
-    const shell::CellShearForces f = shell::cell_shear_forces(tying, particles.position, particles.director, nonlinear_);
     TiedShearForces& tied = tied_forces_[row];
-    for (int k = 0; k < tying.corners; ++k) {
-      tied.force[std::size_t(k)] = f.force[std::size_t(k)];
-      tied.director_force[std::size_t(k)] = f.director_force[std::size_t(k)];
-    }
+    const double energy = shell::corner_shear_forces(
+        tying, [&](int k) -> const Vector3& { return position(tying.particle[std::size_t(k)]); },
+        [&](int k) -> const Vector3& { return director(tying.particle[std::size_t(k)]); }, nonlinear_,
+        tied.force.data(), tied.director_force.data());
     tied_active_[p] = 1;
-    return f.energy;
+    return energy;
   }
 
   bool nonlinear_;
