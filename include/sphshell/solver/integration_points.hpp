@@ -369,14 +369,18 @@ class IntegrationPoints {
   // The same slots in the same order, each with what a particle needs to add
   // its force from the point's conjugate forces (InternalForceAssembler): the
   // point, the slot's shape-function values, and which corner of the point's
-  // edge-tied cell the particle is (−1: none). Contiguous per particle, so the
-  // per-particle sum streams through them.
+  // edge-tied cell the particle is, as the index row × max_cell_corners +
+  // corner of the tied corner forces the assembler keeps per stress point
+  // (untied_corner() when it is none: an index past them, whose forces the
+  // assembler keeps zero, so its sum adds them without a branch). Contiguous
+  // per particle, so the per-particle sum streams through them.
   struct ForceEntry {
     std::uint32_t point;
-    std::int32_t corner;
+    std::uint32_t tied_corner;
     double phi, dphi_d1, dphi_d2;
   };
   const std::vector<ForceEntry>& force_entries() const { return force_entries_; }
+  std::size_t untied_corner() const { return count(PointGroup::stress_points) * shell::max_cell_corners; }
 
   // Maps every particle to the shape-function slots that reference it, so the
   // force gather is a deterministic per-particle sum (no atomics, identical
@@ -401,13 +405,15 @@ class IntegrationPoints {
         const bool tied = shear_tied(group, row);
         for (std::size_t s = sf.row_begin[row]; s < sf.row_begin[row] + sf.row_size[row]; ++s) {
           const int particle = sf.neighbour[s];
-          std::int32_t corner = -1;
+          std::size_t tied_corner = untied_corner();
           for (int k = 0; tied && k < shear_tying_[row].corners; ++k)
-            if (shear_tying_[row].particle[std::size_t(k)] == particle) corner = k;
+            if (shear_tying_[row].particle[std::size_t(k)] == particle)
+              tied_corner = row * shell::max_cell_corners + std::size_t(k);
           const std::size_t k = count_of[particle]++;
           particle_slots_[k] = slot(group, s);
-          force_entries_[k] = ForceEntry{static_cast<std::uint32_t>(point(group, row)), corner, sf.phi[s],
-                                         sf.dphi_d1[s], sf.dphi_d2[s]};
+          force_entries_[k] = ForceEntry{static_cast<std::uint32_t>(point(group, row)),
+                                         static_cast<std::uint32_t>(tied_corner), sf.phi[s], sf.dphi_d1[s],
+                                         sf.dphi_d2[s]};
         }
       }
     }

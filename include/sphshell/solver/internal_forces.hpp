@@ -77,37 +77,37 @@ class InternalForceAssembler {
   // Zeroes the forces a point leaves on the slots of its row (a removed point).
   template <class Approx>
   void clear_slots(PointGroup group, std::size_t row, const IntegrationPoints<Approx>& points) {
-    const std::size_t p = points.point(group, row);
-    cleared_[p] = 1;
-    tied_active_[p] = 0;
+    const Vector3 zero = Vector3::Zero();
+    conjugate_[points.point(group, row)] = shell::ConjugateForces{zero, zero, zero, zero, zero};
+    if (group == PointGroup::stress_points) clear_tied_corners(row);
   }
 
   // Deterministic per-particle sums: for each slot that refers to the particle,
   // in the order of IntegrationPoints::force_entries, the slot's force
   // ∂Φ/∂X1 F_a1 + ∂Φ/∂X2 F_a2 (director: Φ F_n + ∂Φ/∂X1 F_n1 + ∂Φ/∂X2 F_n2) of its
   // point, plus the tied shear's force on that corner, is added. A removed
-  // point adds zero vectors.
+  // point's forces, an untied slot's corner forces and those of a cell whose
+  // shear is left out are kept zero, so every slot adds the same terms without
+  // a branch. Adding a zero changes no bit of the sum: it starts at +0 and a
+  // sum of doubles is −0 only when both terms are, so it is never −0, and
+  // x + (±0) is x for any other x.
   template <class Approx>
   void sum_particle_forces(const IntegrationPoints<Approx>& points, ParticleForces& forces) const {
     const std::vector<std::size_t>& begin = points.particle_slot_begin();
-    const auto& entries = points.force_entries();
+    const auto* const entries = points.force_entries().data();
+    const shell::ConjugateForces* const conjugate = conjugate_.data();
+    const Vector3 *const tied_force = tied_force_.data(), *const tied_director_force = tied_director_force_.data();
+    const std::size_t untied = points.untied_corner();
     parallel::for_each(std::size_t{0}, forces.internal.size(), [&](std::size_t i) noexcept {
       Vector3 force = Vector3::Zero(), director_force = Vector3::Zero();
       for (std::size_t k = begin[i]; k < begin[i + 1]; ++k) {
         const auto& entry = entries[k];
-        const std::size_t p = entry.point;
-        if (cleared_[p]) {
-          force += Vector3::Zero();
-          director_force += Vector3::Zero();
-          continue;
-        }
-        const shell::ConjugateForces& f = conjugate_[p];
+        const shell::ConjugateForces& f = conjugate[entry.point];
         Vector3 slot_force = entry.dphi_d1 * f.a1 + entry.dphi_d2 * f.a2;
         Vector3 slot_director_force = entry.phi * f.n + entry.dphi_d1 * f.n1 + entry.dphi_d2 * f.n2;
-        if (entry.corner >= 0 && tied_active_[p]) {
-          const TiedShearForces& tied = tied_forces_[p];
-          slot_force += tied.force[std::size_t(entry.corner)];
-          slot_director_force += tied.director_force[std::size_t(entry.corner)];
+        if (entry.tied_corner != untied) {
+          slot_force += tied_force[entry.tied_corner];
+          slot_director_force += tied_director_force[entry.tied_corner];
         }
         force += slot_force;
         director_force += slot_director_force;
@@ -138,25 +138,25 @@ class InternalForceAssembler {
   }
 
  private:
-  // A stress point's edge-tied shear forces on its cell's corners.
-  struct TiedShearForces {
-    std::array<Vector3, shell::max_cell_corners> force, director_force;
-  };
-
   // Per-point arrays are sized once; the work is zero for points that do not integrate.
   template <class Approx>
   void prepare(const IntegrationPoints<Approx>& points) {
     if (conjugate_.size() != points.size()) {
       const Vector3 zero = Vector3::Zero();
       conjugate_.assign(points.size(), shell::ConjugateForces{zero, zero, zero, zero, zero});
-      cleared_.assign(points.size(), 1);
-      tied_active_.assign(points.size(), 0);
-      TiedShearForces none;
-      none.force.fill(zero);
-      none.director_force.fill(zero);
-      tied_forces_.assign(points.count(PointGroup::stress_points), none);
+      // One more than the stress points' corners: untied_corner(), kept zero.
+      tied_force_.assign(points.untied_corner() + 1, zero);
+      tied_director_force_.assign(points.untied_corner() + 1, zero);
     }
     work_increment_.assign(points.size(), 0.0);
+  }
+
+  // The tied corner forces of a stress point whose cell's shear is left out.
+  void clear_tied_corners(std::size_t row) {
+    for (std::size_t k = 0; k < std::size_t(shell::max_cell_corners); ++k) {
+      tied_force_[row * shell::max_cell_corners + k] = Vector3::Zero();
+      tied_director_force_[row * shell::max_cell_corners + k] = Vector3::Zero();
+    }
   }
 
   template <class Approx, class Rule, class Law>
@@ -206,17 +206,15 @@ class InternalForceAssembler {
     const shell::WeightedStresses weighted{w * states.membrane_force(p), w * states.bending_moment(p),
                                            states.shear_force(p)};
     conjugate_[p] = shell::conjugate_forces(nonlinear_ ? current : points.reference(p), weighted);
-    cleared_[p] = 0;
-    tied_active_[p] = 0;
-    return points.shear_tied(group, row) ? tied_shear(row, p, points, position, director) : 0.0;
+    return points.shear_tied(group, row) ? tied_shear(row, points, position, director) : 0.0;
   }
 
   // The forces of a stress point's edge-tied shear (shell/cell_shear.hpp) on
-  // its cell's corners, written straight into the point's kept forces;
-  // returns its energy. A corner hidden from the point by a crack leaves the
-  // cell's shear out (energy 0).
+  // its cell's corners, written straight into its kept corner forces; returns
+  // its energy. A corner hidden from the point by a crack leaves the cell's
+  // shear out (energy 0, zero forces).
   template <class Approx, class Position, class Director>
-  double tied_shear(std::size_t row, std::size_t p, const IntegrationPoints<Approx>& points, const Position& position,
+  double tied_shear(std::size_t row, const IntegrationPoints<Approx>& points, const Position& position,
                     const Director& director) {
     const shell::CellShearTying& tying = points.shear_tying(row);
     const approx::ShapeFunctions& shape = points.shape(PointGroup::stress_points);
@@ -224,25 +222,26 @@ class InternalForceAssembler {
     for (int k = 0; k < tying.corners; ++k) {
       std::size_t s = begin;
       while (s < end && shape.neighbour[s] != tying.particle[std::size_t(k)]) ++s;
-      if (s == end) return 0.0;
+      if (s == end) {
+        clear_tied_corners(row);
+        return 0.0;
+      }
     }
-    TiedShearForces& tied = tied_forces_[row];
-    const double energy = shell::corner_shear_forces(
+    const std::size_t first = row * shell::max_cell_corners;
+    return shell::corner_shear_forces(
         tying, [&](int k) -> const Vector3& { return position(tying.particle[std::size_t(k)]); },
         [&](int k) -> const Vector3& { return director(tying.particle[std::size_t(k)]); }, nonlinear_,
-        tied.force.data(), tied.director_force.data());
-    tied_active_[p] = 1;
-    return energy;
+        &tied_force_[first], &tied_director_force_[first]);
   }
 
   bool nonlinear_;
   std::size_t failed_point_ = 0;
-  // Per point: its conjugate forces, whether it was removed (its slots then
-  // carry zero forces), whether its tied shear acts, and (stress points) the
-  // tied shear's corner forces.
+  // Per point: its conjugate forces (zero for a removed point). Per stress
+  // point corner (row × max_cell_corners + corner, then untied_corner()): the
+  // tied shear's forces on the corner particle and its director (zero where
+  // no tied shear acts).
   std::vector<shell::ConjugateForces> conjugate_;
-  std::vector<unsigned char> cleared_, tied_active_;
-  std::vector<TiedShearForces> tied_forces_;
+  std::vector<Vector3> tied_force_, tied_director_force_;
   std::vector<double> work_increment_;
   std::vector<PackedKinematics> packed_;  // this step's positions and directors
 };
