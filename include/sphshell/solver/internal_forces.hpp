@@ -216,17 +216,11 @@ class InternalForceAssembler {
   template <class Approx, class Position, class Director>
   double tied_shear(std::size_t row, const IntegrationPoints<Approx>& points, const Position& position,
                     const Director& director) {
-    const shell::CellShearTying& tying = points.shear_tying(row);
-    const approx::ShapeFunctions& shape = points.shape(PointGroup::stress_points);
-    const std::size_t begin = shape.row_begin[row], end = begin + shape.row_size[row];
-    for (int k = 0; k < tying.corners; ++k) {
-      std::size_t s = begin;
-      while (s < end && shape.neighbour[s] != tying.particle[std::size_t(k)]) ++s;
-      if (s == end) {
-        clear_tied_corners(row);
-        return 0.0;
-      }
+    if (!points.tied_corners_visible(row)) {
+      clear_tied_corners(row);
+      return 0.0;
     }
+    const shell::CellShearTying& tying = points.shear_tying(row);
     const std::size_t first = row * shell::max_cell_corners;
     return shell::corner_shear_forces(
         tying, [&](int k) -> const Vector3& { return position(tying.particle[std::size_t(k)]); },
