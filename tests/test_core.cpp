@@ -1,8 +1,10 @@
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/frame.hpp>
+#include <sphshell/core/types.hpp>
 
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -16,6 +18,22 @@ TEST_CASE("Error messages name the parameter and its value", "[core]") {
                     Catch::Contains("nu") && Catch::Contains("0.5"));
   CHECK_NOTHROW(detail::require_half_open_interval("Dc", 1.0, 0.0, 1.0));
   CHECK_THROWS_AS(detail::require_half_open_interval("Dc", 0.0, 0.0, 1.0), Error);
+}
+
+TEST_CASE("all_finite is false for any NaN or infinite component, true for the largest finite ones", "[core]") {
+  const double largest = std::numeric_limits<double>::max(), tiny = std::numeric_limits<double>::denorm_min();
+  const Vector3 finite(largest, -largest, tiny), signed_zero(-0.0, 0.0, -tiny);
+  CHECK(all_finite(finite));
+  CHECK(all_finite(finite, signed_zero, finite, signed_zero));
+  for (const double bad : {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
+                           -std::numeric_limits<double>::infinity()})
+    for (int vector = 0; vector < 4; ++vector)
+      for (int component = 0; component < 3; ++component) {
+        std::array<Vector3, 4> v{finite, signed_zero, finite, signed_zero};
+        v[std::size_t(vector)][component] = bad;
+        CHECK_FALSE(all_finite(v[0], v[1], v[2], v[3]));
+        CHECK_FALSE(all_finite(v[std::size_t(vector)]));
+      }
 }
 
 TEST_CASE("Tangent frames are right-handed and orthonormal", "[core]") {

@@ -638,8 +638,8 @@ class Solver {
 
   void check_configuration() const {
     parallel::for_each(std::size_t{0}, particles_.size(), [&](std::size_t i) {
-      if (!particles_.position[i].allFinite() || !particles_.director[i].allFinite() ||
-          !particles_.velocity[i].allFinite() || !particles_.angular_velocity[i].allFinite())
+      if (!all_finite(particles_.position[i], particles_.director[i], particles_.velocity[i],
+                      particles_.angular_velocity[i]))
         detail::fail_unstable(now(), "non-finite state at particle " + std::to_string(i) + " (external force " +
                                          solver::number_text(forces_.external[i].norm()) + " N, internal force " +
                                          solver::number_text(forces_.internal[i].norm()) + " N)");

@@ -939,8 +939,8 @@ class DistributedSolver {
 
   void check_configuration(std::optional<Failure>& failure) const {
     for (std::size_t i = 0; i < layout_.owned_count(); ++i)
-      if (!particles_.position[i].allFinite() || !particles_.director[i].allFinite() ||
-          !particles_.velocity[i].allFinite() || !particles_.angular_velocity[i].allFinite()) {
+      if (!all_finite(particles_.position[i], particles_.director[i], particles_.velocity[i],
+                      particles_.angular_velocity[i])) {
         keep_first(failure,
                    {key(Phase::configuration, layout_.owned[i]),
                     unstable_text(now(), "non-finite state at particle " + std::to_string(layout_.owned[i]) +

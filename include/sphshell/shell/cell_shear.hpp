@@ -110,17 +110,23 @@ struct CellShearForces {
   std::array<Vector3, max_cell_corners> director_force;
 };
 
-// Edge strains from positions x and directors d. The nonlinear form is the
-// exact dot product; the linear one (paper §3.1) its first-order part about
-// the reference configuration (X_b − X_a, N_a + N_b).
-inline Eigen::Matrix<double, max_cell_corners, 1> cell_edge_shear_strains(const CellShearTying& t,
-                                                                         const std::vector<Vector3>& x,
-                                                                         const std::vector<Vector3>& d,
-                                                                         bool nonlinear) {
+// The corner after corner k around a cell of `corners` corners: a compare,
+// not (k + 1) % corners, whose integer division cost more than the rest of a
+// cell's edge in the step's hot loop.
+inline int next_corner(int k, int corners) { return k + 1 < corners ? k + 1 : 0; }
+
+// Edge strains from the corners' positions x(k) and directors d(k) (k the
+// corner: callers read them from wherever they keep them). The nonlinear form
+// is the exact dot product; the linear one (paper §3.1) its first-order part
+// about the reference configuration (X_b − X_a, N_a + N_b).
+template <class CornerPosition, class CornerDirector>
+inline Eigen::Matrix<double, max_cell_corners, 1> corner_edge_shear_strains(const CellShearTying& t,
+                                                                           const CornerPosition& x,
+                                                                           const CornerDirector& d, bool nonlinear) {
   Eigen::Matrix<double, max_cell_corners, 1> strain = Eigen::Matrix<double, max_cell_corners, 1>::Zero();
   for (int e = 0; e < t.corners; ++e) {
-    const int a = t.particle[e], b = t.particle[(e + 1) % t.corners];
-    const Vector3 chord = x[b] - x[a], director_sum = d[a] + d[b];
+    const int b = next_corner(e, t.corners);
+    const Vector3 chord = x(b) - x(e), director_sum = d(e) + d(b);
     const double value = nonlinear ? chord.dot(director_sum)
                                    : (chord - t.chord[e]).dot(t.normal_sum[e]) +
                                          t.chord[e].dot(director_sum - t.normal_sum[e]) +
@@ -130,26 +136,80 @@ inline Eigen::Matrix<double, max_cell_corners, 1> cell_edge_shear_strains(const 
   return strain;
 }
 
+// Edge strains from particle positions x and directors d.
+inline Eigen::Matrix<double, max_cell_corners, 1> cell_edge_shear_strains(const CellShearTying& t,
+                                                                         const std::vector<Vector3>& x,
+                                                                         const std::vector<Vector3>& d,
+                                                                         bool nonlinear) {
+  return corner_edge_shear_strains(
+      t, [&](int k) -> const Vector3& { return x[std::size_t(t.particle[std::size_t(k)])]; },
+      [&](int k) -> const Vector3& { return d[std::size_t(t.particle[std::size_t(k)])]; }, nonlinear);
+}
+
+// corner_shear_forces for a cell of a known corner count, so the edge loops
+// unroll. The edges' chords and director sums are kept from the strains for
+// the forces, and the forces are summed in locals and stored once (a store
+// through the output pointers might alias the tying for all the compiler
+// knows). The same operations in the same order as edge by edge.
+template <int Corners, class CornerPosition, class CornerDirector>
+inline double corner_shear_forces_of(const CellShearTying& t, const CornerPosition& x, const CornerDirector& d,
+                                     bool nonlinear, Vector3* force, Vector3* director_force) {
+  std::array<Vector3, Corners> chord, director_sum;
+  Eigen::Matrix<double, max_cell_corners, 1> strain = Eigen::Matrix<double, max_cell_corners, 1>::Zero();
+  for (int e = 0; e < Corners; ++e) {
+    const int b = next_corner(e, Corners);
+    chord[e] = x(b) - x(e);
+    director_sum[e] = d(e) + d(b);
+    const double value = nonlinear ? chord[e].dot(director_sum[e])
+                                   : (chord[e] - t.chord[e]).dot(t.normal_sum[e]) +
+                                         t.chord[e].dot(director_sum[e] - t.normal_sum[e]) +
+                                         t.chord[e].dot(t.normal_sum[e]);
+    strain[e] = value * 0.5 * t.inverse_length[e] - t.reference_strain[e];
+  }
+  const Eigen::Matrix<double, max_cell_corners, 1> edge_force = t.stiffness * strain;  // ∂Π/∂e
+  std::array<Vector3, Corners> corner_force, corner_director_force;
+  corner_force.fill(Vector3::Zero());
+  corner_director_force.fill(Vector3::Zero());
+  for (int e = 0; e < Corners; ++e) {
+    const int b = next_corner(e, Corners);
+    // ∂e/∂x_b = −∂e/∂x_a = (d_a + d_b)/(2ℓ), ∂e/∂d_a = ∂e/∂d_b = (x_b − x_a)/(2ℓ),
+    // at the current vectors (nonlinear) or the reference ones (linear).
+    const double factor = edge_force[e] * 0.5 * t.inverse_length[e];
+    const Vector3 along_normal = factor * (nonlinear ? director_sum[e] : t.normal_sum[e]);
+    const Vector3 along_chord = factor * (nonlinear ? chord[e] : t.chord[e]);
+    corner_force[b] += along_normal;
+    corner_force[e] -= along_normal;
+    corner_director_force[e] += along_chord;
+    corner_director_force[b] += along_chord;
+  }
+  for (int k = 0; k < Corners; ++k) {
+    force[k] = corner_force[k];
+    director_force[k] = corner_director_force[k];
+  }
+  return 0.5 * strain.dot(edge_force);
+}
+
+// The energy and the corner forces from the corners' positions x(k) and
+// directors d(k), written into force and director_force (their first
+// t.corners entries; nothing else is touched), of a tied cell (3 or 4
+// corners). For the assembler, which keeps the forces per point and reads the
+// corners from its packed kinematics.
+template <class CornerPosition, class CornerDirector>
+inline double corner_shear_forces(const CellShearTying& t, const CornerPosition& x, const CornerDirector& d,
+                                  bool nonlinear, Vector3* force, Vector3* director_force) {
+  return t.corners == max_cell_corners
+             ? corner_shear_forces_of<max_cell_corners>(t, x, d, nonlinear, force, director_force)
+             : corner_shear_forces_of<3>(t, x, d, nonlinear, force, director_force);
+}
+
 inline CellShearForces cell_shear_forces(const CellShearTying& t, const std::vector<Vector3>& x,
                                          const std::vector<Vector3>& d, bool nonlinear) {
   CellShearForces out;
   if (t.corners == 0) return out;
-  const Eigen::Matrix<double, max_cell_corners, 1> strain = cell_edge_shear_strains(t, x, d, nonlinear);
-  const Eigen::Matrix<double, max_cell_corners, 1> edge_force = t.stiffness * strain;  // ∂Π/∂e
-  out.energy = 0.5 * strain.dot(edge_force);
-  for (int e = 0; e < t.corners; ++e) {
-    const int b_corner = (e + 1) % t.corners;
-    const int a = t.particle[e], b = t.particle[b_corner];
-    // ∂e/∂x_b = −∂e/∂x_a = (d_a + d_b)/(2ℓ), ∂e/∂d_a = ∂e/∂d_b = (x_b − x_a)/(2ℓ),
-    // at the current vectors (nonlinear) or the reference ones (linear).
-    const double factor = edge_force[e] * 0.5 * t.inverse_length[e];
-    const Vector3 along_normal = factor * (nonlinear ? Vector3(d[a] + d[b]) : t.normal_sum[e]);
-    const Vector3 along_chord = factor * (nonlinear ? Vector3(x[b] - x[a]) : t.chord[e]);
-    out.force[b_corner] += along_normal;
-    out.force[e] -= along_normal;
-    out.director_force[e] += along_chord;
-    out.director_force[b_corner] += along_chord;
-  }
+  out.energy = corner_shear_forces(
+      t, [&](int k) -> const Vector3& { return x[std::size_t(t.particle[std::size_t(k)])]; },
+      [&](int k) -> const Vector3& { return d[std::size_t(t.particle[std::size_t(k)])]; }, nonlinear,
+      out.force.data(), out.director_force.data());
   return out;
 }
 

@@ -183,7 +183,7 @@ class ExternalLoads {
     });
     for (const auto& load : loads_) load->apply(context);
     parallel::for_each(std::size_t{0}, context.force.size(), [&](std::size_t i) {
-      if (!context.force[i].allFinite() || !context.moment[i].allFinite())
+      if (!all_finite(context.force[i], context.moment[i]))
         detail::fail_unstable(at, "non-finite external load at particle " + std::to_string(i) +
                                       " (a pressure, force or moment function returned NaN or infinity)");
     });

@@ -142,6 +142,7 @@ class IntegrationPoints {
       }
     if (!shear_tying_.empty())
       for (std::size_t row : rows[0]) {
+        part.tied_corners_visible_.push_back(tied_corners_visible_[row]);
         part.shear_tying_.push_back(shear_tying_[row]);
         shell::CellShearTying& tying = part.shear_tying_.back();
         for (int k = 0; k < tying.corners; ++k)
@@ -174,6 +175,7 @@ class IntegrationPoints {
     }
     to.row_size[row] = source.row_size[from_row];
     to.shepard[row] = source.shepard[from_row];
+    check_tied_corners(group, row);
     reference_[point(group, row)] = from.reference_[from.point(group, from_row)];
     reference_products_[point(group, row)] = from.reference_products_[from.point(group, from_row)];
     mark_rebuilt(group, row);
@@ -227,6 +229,11 @@ class IntegrationPoints {
     return group == PointGroup::stress_points && !shear_tying_.empty() && shear_tying_[row].corners > 0;
   }
   const shell::CellShearTying& shear_tying(std::size_t row) const { return shear_tying_[row]; }
+  // Whether every corner of a tied stress point's cell is among its row's
+  // used slots (a crack can hide one: the cell's shear is then left out).
+  // Kept per row, refreshed wherever a row changes, so the step does not
+  // search the row for its corners.
+  bool tied_corners_visible(std::size_t row) const { return tied_corners_visible_[row] != 0; }
   const shell::SurfaceGradients& reference(std::size_t p) const { return reference_[p]; }
   // Its dot products in the Green strains (shell::green_strains).
   const shell::ReferenceProducts& reference_products(std::size_t p) const { return reference_products_[p]; }
@@ -248,19 +255,34 @@ class IntegrationPoints {
     return g;
   }
 
-  // The same from the packed positions and directors (solver/particles.hpp).
+  // The same from the packed positions and directors (solver/particles.hpp):
+  // the step's hot gather. The sums are kept in locals, not in the returned
+  // structure, and the arrays are read through local pointers: a store into
+  // the result might alias the arrays for all the compiler knows, so it would
+  // write the sums back and reload every array's address at every slot. The
+  // sums are the same, in the same order.
   shell::SurfaceGradients gather(PointGroup group, std::size_t row, const std::vector<PackedKinematics>& packed) const {
     const approx::ShapeFunctions& sf = shape(group);
-    shell::SurfaceGradients g;
+    const int* const neighbour = sf.neighbour.data();
+    const double *const phi = sf.phi.data(), *const dphi_d1 = sf.dphi_d1.data(), *const dphi_d2 = sf.dphi_d2.data();
+    const PackedKinematics* const particles = packed.data();
+    Vector3 a1 = Vector3::Zero(), a2 = Vector3::Zero(), n = Vector3::Zero(), n1 = Vector3::Zero(),
+            n2 = Vector3::Zero();
     const std::size_t end = sf.row_begin[row] + sf.row_size[row];
     for (std::size_t s = sf.row_begin[row]; s < end; ++s) {
-      const PackedKinematics& particle = packed[std::size_t(sf.neighbour[s])];
-      g.a1 += sf.dphi_d1[s] * particle.position;
-      g.a2 += sf.dphi_d2[s] * particle.position;
-      g.n += sf.phi[s] * particle.director;
-      g.n1 += sf.dphi_d1[s] * particle.director;
-      g.n2 += sf.dphi_d2[s] * particle.director;
+      const PackedKinematics& particle = particles[std::size_t(neighbour[s])];
+      a1 += dphi_d1[s] * particle.position;
+      a2 += dphi_d2[s] * particle.position;
+      n += phi[s] * particle.director;
+      n1 += dphi_d1[s] * particle.director;
+      n2 += dphi_d2[s] * particle.director;
     }
+    shell::SurfaceGradients g;
+    g.a1 = a1;
+    g.a2 = a2;
+    g.n = n;
+    g.n1 = n1;
+    g.n2 = n2;
     return g;
   }
 
@@ -269,12 +291,15 @@ class IntegrationPoints {
   // hiding what they hide. Throws Error when nothing stays visible.
   template <class Visible>
   void rebuild_row(const ShellModel& model, PointGroup group, std::size_t row, Visible&& visible) {
-    // Flagged first: a rebuild that throws (nothing visible) leaves its row changed too.
+    // Flagged first: a rebuild that throws (nothing visible) leaves its row
+    // changed too, and no corner of its tied cell counted as visible.
     mark_rebuilt(group, row);
+    if (shear_tied(group, row)) tied_corners_visible_[row] = 0;
     const auto cut_visible = cut_visibility(model, group);
     const auto both = [&](std::size_t r, std::size_t j) { return cut_visible(r, j) && visible(r, j); };
     Approx::rebuild_row(shape_[index_of(group)], row, model.particle_position, model.particle_area,
                         positions(model, group)[row], frame(group, row), smoothing_length(group, row), both);
+    check_tied_corners(group, row);
     set_reference(point(group, row), gather(group, row, model.particle_position, model.particle_normal));
   }
 
@@ -334,6 +359,7 @@ class IntegrationPoints {
             in.fail(std::string(name_of(group)) + " row " + std::to_string(row) + " names particle " +
                     std::to_string(sf.neighbour[s]));
         }
+        check_tied_corners(group, row);
         shell::SurfaceGradients g;
         in(g.a1, g.a2, g.n, g.n1, g.n2);
         set_reference(point(group, row), g);
@@ -354,14 +380,18 @@ class IntegrationPoints {
   // The same slots in the same order, each with what a particle needs to add
   // its force from the point's conjugate forces (InternalForceAssembler): the
   // point, the slot's shape-function values, and which corner of the point's
-  // edge-tied cell the particle is (−1: none). Contiguous per particle, so the
-  // per-particle sum streams through them.
+  // edge-tied cell the particle is, as the index row × max_cell_corners +
+  // corner of the tied corner forces the assembler keeps per stress point
+  // (untied_corner() when it is none: an index past them, whose forces the
+  // assembler keeps zero, so its sum adds them without a branch). Contiguous
+  // per particle, so the per-particle sum streams through them.
   struct ForceEntry {
     std::uint32_t point;
-    std::int32_t corner;
+    std::uint32_t tied_corner;
     double phi, dphi_d1, dphi_d2;
   };
   const std::vector<ForceEntry>& force_entries() const { return force_entries_; }
+  std::size_t untied_corner() const { return count(PointGroup::stress_points) * shell::max_cell_corners; }
 
   // Maps every particle to the shape-function slots that reference it, so the
   // force gather is a deterministic per-particle sum (no atomics, identical
@@ -386,13 +416,15 @@ class IntegrationPoints {
         const bool tied = shear_tied(group, row);
         for (std::size_t s = sf.row_begin[row]; s < sf.row_begin[row] + sf.row_size[row]; ++s) {
           const int particle = sf.neighbour[s];
-          std::int32_t corner = -1;
+          std::size_t tied_corner = untied_corner();
           for (int k = 0; tied && k < shear_tying_[row].corners; ++k)
-            if (shear_tying_[row].particle[std::size_t(k)] == particle) corner = k;
+            if (shear_tying_[row].particle[std::size_t(k)] == particle)
+              tied_corner = row * shell::max_cell_corners + std::size_t(k);
           const std::size_t k = count_of[particle]++;
           particle_slots_[k] = slot(group, s);
-          force_entries_[k] = ForceEntry{static_cast<std::uint32_t>(point(group, row)), corner, sf.phi[s],
-                                         sf.dphi_d1[s], sf.dphi_d2[s]};
+          force_entries_[k] = ForceEntry{static_cast<std::uint32_t>(point(group, row)),
+                                         static_cast<std::uint32_t>(tied_corner), sf.phi[s], sf.dphi_d1[s],
+                                         sf.dphi_d2[s]};
         }
       }
     }
@@ -400,6 +432,20 @@ class IntegrationPoints {
 
  private:
   IntegrationPoints() = default;  // subset() fills it
+
+  // Refreshes tied_corners_visible of a changed row (rows are rebuilt in
+  // parallel: each sets its own flag, in an array sized by tie_shear).
+  void check_tied_corners(PointGroup group, std::size_t row) {
+    if (!shear_tied(group, row)) return;
+    const approx::ShapeFunctions& sf = shape(group);
+    const shell::CellShearTying& tying = shear_tying_[row];
+    const auto used_begin = sf.neighbour.begin() + std::ptrdiff_t(sf.row_begin[row]);
+    const auto used_end = used_begin + sf.row_size[row];
+    bool visible = true;
+    for (int k = 0; k < tying.corners; ++k)
+      visible = visible && std::find(used_begin, used_end, tying.particle[std::size_t(k)]) != used_end;
+    tied_corners_visible_[row] = visible ? 1 : 0;
+  }
 
   void set_reference(std::size_t p, const shell::SurfaceGradients& g) {
     reference_[p] = g;
@@ -453,9 +499,12 @@ class IntegrationPoints {
   // nowhere to go: the support is too small for the cell.
   void tie_shear(const ShellModel& model, const PhysicsOptions& physics, double shear_modulus) {
     shear_tying_.clear();
+    tied_corners_visible_.clear();
     if (physics.transverse_shear != TransverseShear::cell_edges || model.cells().empty()) return;
     const approx::ShapeFunctions& sf = shape(PointGroup::stress_points);
     shear_tying_.resize(model.stress_point_count());
+    // Every corner is in its row (checked below) until a crack hides one.
+    tied_corners_visible_.assign(shear_tying_.size(), 1);
     for (std::size_t row = 0; row < shear_tying_.size(); ++row) {
       const Cell& cell = model.cells()[row];
       for (int corner : cell) {
@@ -478,6 +527,7 @@ class IntegrationPoints {
   std::array<std::vector<double>, 2> smoothing_length_;  // h_i per row of each group
   shell::CutVisibility cuts_;  // the model's cuts
   std::vector<shell::CellShearTying> shear_tying_;  // per stress point, or empty
+  std::vector<unsigned char> tied_corners_visible_;  // per stress point with shear_tying_
   std::array<approx::ShapeFunctions, 2> shape_;
   std::array<std::vector<TangentFrame>, 2> frames_;  // evaluation frames, kept for rebuilds
   std::array<std::size_t, 2> offset_{};

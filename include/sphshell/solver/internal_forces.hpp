@@ -50,7 +50,7 @@ class InternalForceAssembler {
     for (PointGroup group : point_groups)
       parallel::for_each(
           std::size_t{0}, points.count(group),
-          [&](std::size_t row) { integrate_point(group, row, particles, points, states); },
+          [&](std::size_t row) { integrate_point(group, row, points, states); },
           [&](std::size_t row, const std::exception_ptr& error) {
             failed_point_ = points.point(group, row);
             detail::fail_unstable(at, std::string(name_of(group)) + " " +
@@ -69,50 +69,45 @@ class InternalForceAssembler {
   double scatter_point(PointGroup group, std::size_t row, const shell::SurfaceGradients& current,
                        const ParticleState& particles, const IntegrationPoints<Approx>& points,
                        const SectionStates<Rule, Law>& states) {
-    const std::size_t p = points.point(group, row);
-    const double w = points.membrane_bending_weight(p);
-    const shell::WeightedStresses weighted{w * states.membrane_force(p), w * states.bending_moment(p),
-                                           states.shear_force(p)};
-    conjugate_[p] = shell::conjugate_forces(nonlinear_ ? current : points.reference(p), weighted);
-    cleared_[p] = 0;
-    tied_active_[p] = 0;
-    return points.shear_tied(group, row) ? tied_shear(row, p, particles, points) : 0.0;
+    return scatter(group, row, current, points, states,
+                   [&](int j) -> const Vector3& { return particles.position[std::size_t(j)]; },
+                   [&](int j) -> const Vector3& { return particles.director[std::size_t(j)]; });
   }
 
   // Zeroes the forces a point leaves on the slots of its row (a removed point).
   template <class Approx>
   void clear_slots(PointGroup group, std::size_t row, const IntegrationPoints<Approx>& points) {
-    const std::size_t p = points.point(group, row);
-    cleared_[p] = 1;
-    tied_active_[p] = 0;
+    const Vector3 zero = Vector3::Zero();
+    conjugate_[points.point(group, row)] = shell::ConjugateForces{zero, zero, zero, zero, zero};
+    if (group == PointGroup::stress_points) clear_tied_corners(row);
   }
 
   // Deterministic per-particle sums: for each slot that refers to the particle,
   // in the order of IntegrationPoints::force_entries, the slot's force
   // ∂Φ/∂X1 F_a1 + ∂Φ/∂X2 F_a2 (director: Φ F_n + ∂Φ/∂X1 F_n1 + ∂Φ/∂X2 F_n2) of its
   // point, plus the tied shear's force on that corner, is added. A removed
-  // point adds zero vectors.
+  // point's forces, an untied slot's corner forces and those of a cell whose
+  // shear is left out are kept zero, so every slot adds the same terms without
+  // a branch. Adding a zero changes no bit of the sum: it starts at +0 and a
+  // sum of doubles is −0 only when both terms are, so it is never −0, and
+  // x + (±0) is x for any other x.
   template <class Approx>
   void sum_particle_forces(const IntegrationPoints<Approx>& points, ParticleForces& forces) const {
     const std::vector<std::size_t>& begin = points.particle_slot_begin();
-    const auto& entries = points.force_entries();
+    const auto* const entries = points.force_entries().data();
+    const shell::ConjugateForces* const conjugate = conjugate_.data();
+    const Vector3 *const tied_force = tied_force_.data(), *const tied_director_force = tied_director_force_.data();
+    const std::size_t untied = points.untied_corner();
     parallel::for_each(std::size_t{0}, forces.internal.size(), [&](std::size_t i) noexcept {
       Vector3 force = Vector3::Zero(), director_force = Vector3::Zero();
       for (std::size_t k = begin[i]; k < begin[i + 1]; ++k) {
         const auto& entry = entries[k];
-        const std::size_t p = entry.point;
-        if (cleared_[p]) {
-          force += Vector3::Zero();
-          director_force += Vector3::Zero();
-          continue;
-        }
-        const shell::ConjugateForces& f = conjugate_[p];
+        const shell::ConjugateForces& f = conjugate[entry.point];
         Vector3 slot_force = entry.dphi_d1 * f.a1 + entry.dphi_d2 * f.a2;
         Vector3 slot_director_force = entry.phi * f.n + entry.dphi_d1 * f.n1 + entry.dphi_d2 * f.n2;
-        if (entry.corner >= 0 && tied_active_[p]) {
-          const TiedShearForces& tied = tied_forces_[p];
-          slot_force += tied.force[std::size_t(entry.corner)];
-          slot_director_force += tied.director_force[std::size_t(entry.corner)];
+        if (entry.tied_corner != untied) {
+          slot_force += tied_force[entry.tied_corner];
+          slot_director_force += tied_director_force[entry.tied_corner];
         }
         force += slot_force;
         director_force += slot_director_force;
@@ -143,30 +138,30 @@ class InternalForceAssembler {
   }
 
  private:
-  // A stress point's edge-tied shear forces on its cell's corners.
-  struct TiedShearForces {
-    std::array<Vector3, shell::max_cell_corners> force, director_force;
-  };
-
   // Per-point arrays are sized once; the work is zero for points that do not integrate.
   template <class Approx>
   void prepare(const IntegrationPoints<Approx>& points) {
     if (conjugate_.size() != points.size()) {
       const Vector3 zero = Vector3::Zero();
       conjugate_.assign(points.size(), shell::ConjugateForces{zero, zero, zero, zero, zero});
-      cleared_.assign(points.size(), 1);
-      tied_active_.assign(points.size(), 0);
-      TiedShearForces none;
-      none.force.fill(zero);
-      none.director_force.fill(zero);
-      tied_forces_.assign(points.count(PointGroup::stress_points), none);
+      // One more than the stress points' corners: untied_corner(), kept zero.
+      tied_force_.assign(points.untied_corner() + 1, zero);
+      tied_director_force_.assign(points.untied_corner() + 1, zero);
     }
     work_increment_.assign(points.size(), 0.0);
   }
 
+  // The tied corner forces of a stress point whose cell's shear is left out.
+  void clear_tied_corners(std::size_t row) {
+    for (std::size_t k = 0; k < std::size_t(shell::max_cell_corners); ++k) {
+      tied_force_[row * shell::max_cell_corners + k] = Vector3::Zero();
+      tied_director_force_[row * shell::max_cell_corners + k] = Vector3::Zero();
+    }
+  }
+
   template <class Approx, class Rule, class Law>
-  void integrate_point(PointGroup group, std::size_t row, const ParticleState& particles,
-                       const IntegrationPoints<Approx>& points, SectionStates<Rule, Law>& states) {
+  void integrate_point(PointGroup group, std::size_t row, const IntegrationPoints<Approx>& points,
+                       SectionStates<Rule, Law>& states) {
     const std::size_t p = points.point(group, row);
     if (!states.active(p)) return;
     const shell::SurfaceGradients current = points.gather(group, row, packed_);
@@ -188,45 +183,59 @@ class InternalForceAssembler {
     states.membrane_force(p) = resultants.membrane;
     states.bending_moment(p) = resultants.moment;
     states.shear_force(p) = shear_force;
-    const double tied_energy = scatter_point(group, row, current, particles, points, states);
+    // The tied shear reads the corners from this step's packed kinematics
+    // (the same numbers as the particle state's).
+    const double tied_energy =
+        scatter(group, row, current, points, states,
+                [&](int j) -> const Vector3& { return packed_[std::size_t(j)].position; },
+                [&](int j) -> const Vector3& { return packed_[std::size_t(j)].director; });
     // The tied shear is elastic and quadratic: its work over the step is
     // exactly the change of its energy.
     work_increment_[p] += tied_energy - states.tied_shear_energy(p);
     states.tied_shear_energy(p) = tied_energy;
   }
 
+  // scatter_point with the particles' positions and directors read through
+  // position(j) and director(j).
+  template <class Approx, class Rule, class Law, class Position, class Director>
+  double scatter(PointGroup group, std::size_t row, const shell::SurfaceGradients& current,
+                 const IntegrationPoints<Approx>& points, const SectionStates<Rule, Law>& states,
+                 const Position& position, const Director& director) {
+    const std::size_t p = points.point(group, row);
+    const double w = points.membrane_bending_weight(p);
+    const shell::WeightedStresses weighted{w * states.membrane_force(p), w * states.bending_moment(p),
+                                           states.shear_force(p)};
+    conjugate_[p] = shell::conjugate_forces(nonlinear_ ? current : points.reference(p), weighted);
+    return points.shear_tied(group, row) ? tied_shear(row, points, position, director) : 0.0;
+  }
+
   // The forces of a stress point's edge-tied shear (shell/cell_shear.hpp) on
-  // its cell's corners, kept for the per-particle sums; returns its energy. A
-  // corner hidden from the point by a crack leaves the cell's shear out (energy 0).
-  template <class Approx>
-  double tied_shear(std::size_t row, std::size_t p, const ParticleState& particles,
-                    const IntegrationPoints<Approx>& points) {
+  // its cell's corners, written straight into its kept corner forces; returns
+  // its energy. A corner hidden from the point by a crack leaves the cell's
+  // shear out (energy 0, zero forces).
+  template <class Approx, class Position, class Director>
+  double tied_shear(std::size_t row, const IntegrationPoints<Approx>& points, const Position& position,
+                    const Director& director) {
+    if (!points.tied_corners_visible(row)) {
+      clear_tied_corners(row);
+      return 0.0;
+    }
     const shell::CellShearTying& tying = points.shear_tying(row);
-    const approx::ShapeFunctions& shape = points.shape(PointGroup::stress_points);
-    const std::size_t begin = shape.row_begin[row], end = begin + shape.row_size[row];
-    for (int k = 0; k < tying.corners; ++k) {
-      std::size_t s = begin;
-      while (s < end && shape.neighbour[s] != tying.particle[std::size_t(k)]) ++s;
-      if (s == end) return 0.0;
-    }
-    const shell::CellShearForces f = shell::cell_shear_forces(tying, particles.position, particles.director, nonlinear_);
-    TiedShearForces& tied = tied_forces_[row];
-    for (int k = 0; k < tying.corners; ++k) {
-      tied.force[std::size_t(k)] = f.force[std::size_t(k)];
-      tied.director_force[std::size_t(k)] = f.director_force[std::size_t(k)];
-    }
-    tied_active_[p] = 1;
-    return f.energy;
+    const std::size_t first = row * shell::max_cell_corners;
+    return shell::corner_shear_forces(
+        tying, [&](int k) -> const Vector3& { return position(tying.particle[std::size_t(k)]); },
+        [&](int k) -> const Vector3& { return director(tying.particle[std::size_t(k)]); }, nonlinear_,
+        &tied_force_[first], &tied_director_force_[first]);
   }
 
   bool nonlinear_;
   std::size_t failed_point_ = 0;
-  // Per point: its conjugate forces, whether it was removed (its slots then
-  // carry zero forces), whether its tied shear acts, and (stress points) the
-  // tied shear's corner forces.
+  // Per point: its conjugate forces (zero for a removed point). Per stress
+  // point corner (row × max_cell_corners + corner, then untied_corner()): the
+  // tied shear's forces on the corner particle and its director (zero where
+  // no tied shear acts).
   std::vector<shell::ConjugateForces> conjugate_;
-  std::vector<unsigned char> cleared_, tied_active_;
-  std::vector<TiedShearForces> tied_forces_;
+  std::vector<Vector3> tied_force_, tied_director_force_;
   std::vector<double> work_increment_;
   std::vector<PackedKinematics> packed_;  // this step's positions and directors
 };
