@@ -51,8 +51,9 @@ std::optional<Arguments> parse(int argc, char** argv) {
   command_line.flag("--coarse", arguments.coarse,
                     "three coarse resolutions per case, without the slit annular plate (a quick run, for checks)");
   command_line.choice("--cases", arguments.cases, {"all", "linear", "nonlinear", "paths"},
-                      "which benchmarks to run: all is linear and nonlinear; paths follows the Sze hemisphere's "
-                      "and pull-out's whole load paths by displacement control (one resolution each, about 20 min)");
+                      "which benchmarks to run: all is linear and nonlinear; paths follows the whole load paths of "
+                      "Sze et al.'s hemisphere, pull-out and pinched cylinder by displacement control (one "
+                      "resolution each)");
   command_line.output_folder(arguments.output);
   command_line.writes("benchmarks.csv", "every run: case, resolution, value, reference, error, seconds");
   command_line.writes("end_shear.csv", "cantilever under end shear: P/Pmax, tip w and -u, the elastica's");
@@ -71,6 +72,8 @@ std::optional<Arguments> parse(int argc, char** argv) {
   command_line.writes("sze_hemisphere_path.svg", "its load-deflection chart with the paper's points");
   command_line.writes("pullout_path.csv", "--cases paths: the pull-out's path, control, P/Pmax, W_A, -U_B, -U_C");
   command_line.writes("pullout_path.svg", "its load-deflection chart with the paper's points");
+  command_line.writes("pinched_cylinder_path.csv", "--cases paths: the pinched cylinder's path, control, P/Pmax, -W_A, U_B");
+  command_line.writes("pinched_cylinder_path.svg", "its load-deflection chart with the paper's points");
   if (!command_line.parse(argc, argv)) return std::nullopt;
   return arguments;
 }
@@ -381,107 +384,123 @@ int run(const Arguments& arguments) {
     // The whole load paths, by displacement control (the load factor is
     // solved for with a prescribed displacement, so limit points of the load
     // do not stop it); the paper's points are read where the path first
-    // reaches their load factor (load control's response).
+    // reaches their load factor (load control's response). Each case's files
+    // are written when its path ends.
     NewtonOptions newton;
     newton.tolerance = 1e-5;
     newton.max_iterations = 12;
+    const auto start = std::chrono::steady_clock::now();
+    const auto progress = [&](const PathPoint& point, const NewtonReport& report) {
+      std::cerr << "  control " << point.control << ": P/Pmax " << point.load_factor << " (" << report.iterations
+                << " Newton iterations, " << seconds_since(start) << " s)\n";
+    };
+    const auto follow = [&](const char* name, const std::string& grid, const ShellModel& model, double E, double nu,
+                            const StaticConditions& conditions, const ControlDisplacement& control,
+                            const std::vector<PathReading>& readings, double step, int max_steps) {
+      std::cerr << name << ", " << grid << ": following the path\n";
+      const PathRun run = follow_path<NonlinearSolver>(model, E, nu, conditions, control, readings, step, 1.0,
+                                                       max_steps, newton, progress);
+      std::cerr << "  " << run.path.size() - 1 << " steps to P/Pmax = " << run.path.back().load_factor << ", "
+                << run.report.iterations << " Newton iterations, " << run.seconds << " s"
+                << (run.stopped.empty() ? "" : "; stopped: " + run.stopped) << "\n";
+      return run;
+    };
+    // A path's CSV and chart with the paper's points, and its table rows at
+    // the given load factors (those the path reached).
+    struct PaperSeries {
+      std::string name;
+      std::vector<double> load_factor, value;
+    };
+    const auto report = [&](const std::string& file, const std::string& title, const std::string& benchmark,
+                            const std::string& grid, const PathRun& run, const std::vector<std::string>& names,
+                            const std::vector<PaperSeries>& paper, const std::vector<double>& rows) {
+      std::vector<std::string> columns{"control", "P/Pmax"};
+      for (const std::string& name : names) columns.push_back(name);
+      io::CsvProbe csv(arguments.output + "/" + file + ".csv", columns);
+      std::vector<io::PlotSeries> series;
+      for (std::size_t r = 0; r < names.size(); ++r)
+        series.push_back({"SPH " + names[r] + (r == 0 ? " (" + grid + ")" : ""), {}, {}, io::PlotStyle::line});
+      for (const PathPoint& point : run.path) {
+        std::vector<double> row{point.control, point.load_factor};
+        for (std::size_t r = 0; r < names.size(); ++r) {
+          row.push_back(point.values[r]);
+          series[r].x.push_back(point.load_factor), series[r].y.push_back(point.values[r]);
+        }
+        csv.write_row(row);
+      }
+      for (const PaperSeries& points : paper)
+        series.push_back({"Sze et al. 2004, " + points.name, points.load_factor, points.value, io::PlotStyle::points});
+      io::write_svg_plot(arguments.output + "/" + file + ".svg", {{title, "P / Pmax", "displacement", series}});
+      for (double factor : rows) {
+        const std::vector<double> at = readings_at_load_factor(run.path, factor);
+        if (at.empty()) continue;
+        for (std::size_t r = 0; r < names.size(); ++r)
+          for (std::size_t k = 0; k < paper[r].load_factor.size(); ++k)
+            if (std::abs(paper[r].load_factor[k] - factor) < 1e-9) {
+              char label[96];
+              std::snprintf(label, sizeof label, " at P/Pmax = %g (whole path)", factor);
+              table.push_back({{{benchmark, grid, at[r], paper[r].value[k], run.seconds}}, names[r] + label});
+            }
+      }
+    };
+
+    // §3.4, the hemisphere: the pushed point's inward motion in steps of 0.5.
     const int hemisphere_n = 29;
     const SzeHemisphere hemisphere = sze_hemisphere(hemisphere_n);
     const ControlDisplacement pushed{hemisphere.pushed, -Vector3::UnitY()};
     const ControlDisplacement pulled{hemisphere.pulled, Vector3::UnitX()};
-    std::cerr << "hemisphere (Sze), " << hemisphere_n << "²: following the path (pushed point in steps of 0.5)\n";
-    const PathRun hemisphere_path = follow_path<NonlinearSolver>(hemisphere.model, 6.825e7, 0.3, hemisphere.conditions,
-                                                                 pushed, {pulled, pushed}, 0.5, 1.0, 40, newton);
-    const int pullout_nx = 22, pullout_ny = 15;
-    const SzeCylinder cylinder = sze_pullout_cylinder(pullout_nx, pullout_ny);
-    // B's inward motion grows through the paper's snap (W_A barely moves, U_C turns back).
-    const ControlDisplacement b_inward{cylinder.b, -Vector3::UnitY()};
-    const ControlDisplacement a_outward{cylinder.a, Vector3::UnitX()};
-    const ControlDisplacement c_inward{cylinder.c, -Vector3::UnitY()};
-    std::cerr << "pull-out (Sze), " << pullout_nx << "×" << pullout_ny << ": following the path (B in steps of 0.15)\n";
-    const PathRun pullout_path = follow_path<NonlinearSolver>(cylinder.model, cylinder.E, cylinder.nu,
-                                                              cylinder.conditions, b_inward,
-                                                              {a_outward, b_inward, c_inward}, 0.15, 1.0, 60, newton);
-    for (const PathRun* run : {&hemisphere_path, &pullout_path})
-      std::cerr << "  " << run->path.size() - 1 << " steps to P/Pmax = " << run->path.back().load_factor << ", "
-                << run->report.iterations << " Newton iterations, " << run->seconds << " s"
-                << (run->stopped.empty() ? "" : "; stopped: " + run->stopped) << "\n";
-
-    // Table rows at P/Pmax = 0.5 and 1 (or the path's last table point).
-    const std::vector<TabulatedPoint> hemisphere_table = sze_hemisphere_table();
     const std::string hemisphere_grid = std::to_string(hemisphere_n) + "²";
-    for (double factor : {0.5, 1.0})
-      for (const TabulatedPoint& paper : hemisphere_table) {
-        if (std::abs(paper.load_factor - factor) > 1e-9) continue;
-        const std::vector<double> at = readings_at_load_factor(hemisphere_path.path, factor);
-        if (at.empty()) continue;
-        char label[96];
-        std::snprintf(label, sizeof label, "at P/Pmax = %g (whole path, displacement control)", factor);
-        table.push_back({{{"Hemisphere, alternating forces", hemisphere_grid, at[0], paper.first,
-                           hemisphere_path.seconds}},
-                         std::string("pulled point's outward u ") + label});
-        table.push_back({{{"Hemisphere, alternating forces", hemisphere_grid, at[1], paper.second,
-                           hemisphere_path.seconds}},
-                         std::string("pushed point's inward u ") + label});
+    const PathRun hemisphere_path = follow("Hemisphere (Sze)", hemisphere_grid, hemisphere.model, 6.825e7, 0.3,
+                                           hemisphere.conditions, pushed, {pulled, pushed}, 0.5, 40);
+    {
+      PaperSeries a{"pulled", {}, {}}, b{"pushed", {}, {}};
+      for (const TabulatedPoint& point : sze_hemisphere_table()) {
+        a.load_factor.push_back(point.load_factor), a.value.push_back(point.first);
+        b.load_factor.push_back(point.load_factor), b.value.push_back(point.second);
       }
-    const std::vector<TabulatedTriple> pullout_table = sze_pullout_table();
-    const std::string pullout_grid = std::to_string(pullout_nx) + "×" + std::to_string(pullout_ny);
-    const TabulatedTriple* last_reached = nullptr;
-    for (const TabulatedTriple& paper : pullout_table)
-      if (!readings_at_load_factor(pullout_path.path, paper.load_factor).empty()) last_reached = &paper;
-    if (last_reached) {
-      const std::vector<double> at = readings_at_load_factor(pullout_path.path, last_reached->load_factor);
-      char label[64];
-      std::snprintf(label, sizeof label, " at P/Pmax = %g (whole path)", last_reached->load_factor);
-      table.push_back({{{"Pull-out, open cylinder", pullout_grid, at[0], last_reached->a, pullout_path.seconds}},
-                       std::string("W_A") + label});
-      table.push_back({{{"Pull-out, open cylinder", pullout_grid, at[1], last_reached->b, pullout_path.seconds}},
-                       std::string("−U_B") + label});
-      table.push_back({{{"Pull-out, open cylinder", pullout_grid, at[2], last_reached->c, pullout_path.seconds}},
-                       std::string("−U_C") + label});
+      report("sze_hemisphere_path", "Hemisphere, 18° hole, alternating forces: the whole path (Sze et al. 2004)",
+             "Hemisphere, alternating forces", hemisphere_grid, hemisphere_path, {"pulled, outward", "pushed, inward"},
+             {a, b}, {0.5, 1.0});
     }
 
-    // The paths as CSV and charts, the paper's points beside them.
-    io::CsvProbe hemisphere_csv(arguments.output + "/sze_hemisphere_path.csv",
-                                {"pushed (control)", "P/Pmax", "pulled", "pushed"});
-    io::PlotSeries ha{"SPH pulled, outward (" + hemisphere_grid + ")", {}, {}, io::PlotStyle::line};
-    io::PlotSeries hb{"SPH pushed, inward", {}, {}, io::PlotStyle::line};
-    for (const PathPoint& point : hemisphere_path.path) {
-      hemisphere_csv.write_row({point.control, point.load_factor, point.values[0], point.values[1]});
-      ha.x.push_back(point.load_factor), ha.y.push_back(point.values[0]);
-      hb.x.push_back(point.load_factor), hb.y.push_back(point.values[1]);
+    // §3.5, the pull-out: B's inward motion (it grows through the paper's
+    // snap, where W_A barely moves and U_C turns back) in steps of 0.15.
+    const int pullout_nx = 22, pullout_ny = 15;
+    const SzeCylinder pullout = sze_pullout_cylinder(pullout_nx, pullout_ny);
+    const std::string pullout_grid = std::to_string(pullout_nx) + "×" + std::to_string(pullout_ny);
+    const PathRun pullout_path =
+        follow("Pull-out (Sze)", pullout_grid, pullout.model, pullout.E, pullout.nu, pullout.conditions,
+               {pullout.b, -Vector3::UnitY()},
+               {{pullout.a, Vector3::UnitX()}, {pullout.b, -Vector3::UnitY()}, {pullout.c, -Vector3::UnitY()}}, 0.15, 60);
+    {
+      PaperSeries a{"W_A", {}, {}}, b{"−U_B", {}, {}}, c{"−U_C", {}, {}};
+      for (const TabulatedTriple& point : sze_pullout_table()) {
+        a.load_factor.push_back(point.load_factor), a.value.push_back(point.a);
+        b.load_factor.push_back(point.load_factor), b.value.push_back(point.b);
+        c.load_factor.push_back(point.load_factor), c.value.push_back(point.c);
+      }
+      report("pullout_path", "Pull-out of an open-ended cylinder: the path (Sze, Liu & Lo 2004)",
+             "Pull-out, open cylinder", pullout_grid, pullout_path, {"W_A", "−U_B", "−U_C"}, {a, b, c},
+             {0.25, 0.3, 0.5, 1.0});
     }
-    io::PlotSeries hpa{"Sze et al. 2004, pulled", {}, {}, io::PlotStyle::points};
-    io::PlotSeries hpb{"Sze et al. 2004, pushed", {}, {}, io::PlotStyle::points};
-    for (const TabulatedPoint& paper : hemisphere_table) {
-      hpa.x.push_back(paper.load_factor), hpa.y.push_back(paper.first);
-      hpb.x.push_back(paper.load_factor), hpb.y.push_back(paper.second);
+
+    // §3.6, the pinched cylinder: −W_A in steps of 2 (the load snaps between
+    // P/P_max = 0.15 and 0.175 in the paper, where U_B turns outward).
+    const int pinched_n = 25;
+    const SzeCylinder pinched = sze_pinched_cylinder(pinched_n, pinched_n);
+    const std::string pinched_grid = std::to_string(pinched_n) + "²";
+    const PathRun pinched_path =
+        follow("Pinched cylinder (Sze)", pinched_grid, pinched.model, pinched.E, pinched.nu, pinched.conditions,
+               {pinched.a, -Vector3::UnitX()}, {{pinched.a, -Vector3::UnitX()}, {pinched.b, Vector3::UnitY()}}, 2.0, 50);
+    {
+      PaperSeries a{"−W_A", {}, {}}, b{"U_B", {}, {}};
+      for (const TabulatedPoint& point : sze_pinched_cylinder_table()) {
+        a.load_factor.push_back(point.load_factor), a.value.push_back(point.first);
+        b.load_factor.push_back(point.load_factor), b.value.push_back(point.second);
+      }
+      report("pinched_cylinder_path", "Pinched cylinder on rigid diaphragms: the path (Sze, Liu & Lo 2004)",
+             "Pinched cylinder (Sze §3.6)", pinched_grid, pinched_path, {"−W_A", "U_B"}, {a, b}, {0.05, 0.1, 0.15, 1.0});
     }
-    io::write_svg_plot(arguments.output + "/sze_hemisphere_path.svg",
-                       {{"Hemisphere, 18° hole, alternating forces: the whole path (Sze et al. 2004)", "P / Pmax",
-                         "radial displacement", {ha, hb, hpa, hpb}}});
-    io::CsvProbe pullout_csv(arguments.output + "/pullout_path.csv",
-                             {"-U_B (control)", "P/Pmax", "W_A", "-U_B", "-U_C"});
-    io::PlotSeries pa{"SPH W_A (" + pullout_grid + ")", {}, {}, io::PlotStyle::line};
-    io::PlotSeries pb{"SPH −U_B", {}, {}, io::PlotStyle::line};
-    io::PlotSeries pc{"SPH −U_C", {}, {}, io::PlotStyle::line};
-    for (const PathPoint& point : pullout_path.path) {
-      pullout_csv.write_row({point.control, point.load_factor, point.values[0], point.values[1], point.values[2]});
-      pa.x.push_back(point.load_factor), pa.y.push_back(point.values[0]);
-      pb.x.push_back(point.load_factor), pb.y.push_back(point.values[1]);
-      pc.x.push_back(point.load_factor), pc.y.push_back(point.values[2]);
-    }
-    io::PlotSeries ra{"Sze et al. 2004, W_A", {}, {}, io::PlotStyle::points};
-    io::PlotSeries rb{"Sze et al. 2004, −U_B", {}, {}, io::PlotStyle::points};
-    io::PlotSeries rc{"Sze et al. 2004, −U_C", {}, {}, io::PlotStyle::points};
-    for (const TabulatedTriple& paper : pullout_table) {
-      ra.x.push_back(paper.load_factor), ra.y.push_back(paper.a);
-      rb.x.push_back(paper.load_factor), rb.y.push_back(paper.b);
-      rc.x.push_back(paper.load_factor), rc.y.push_back(paper.c);
-    }
-    io::write_svg_plot(arguments.output + "/pullout_path.svg",
-                       {{"Pull-out of an open-ended cylinder: the path (Sze, Liu & Lo 2004)", "P / Pmax",
-                         "radial displacement", {pa, pb, pc, ra, rb, rc}}});
   }
 
   std::printf("\n| benchmark | quantity | resolution | value | reference | error | coarser | time |\n");

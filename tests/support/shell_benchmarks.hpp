@@ -28,6 +28,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -566,11 +567,12 @@ using PathReading = ControlDisplacement;
 // Follows the path of `conditions` on a new solver of `model` in steps of
 // `step` of the control displacement until the load factor reaches
 // `last_factor` (or `max_steps` steps were taken, or Newton failed: the path
-// so far is returned with the reason).
+// so far is returned with the reason); `progress` sees every step.
 template <class NonlinearSolver>
 PathRun follow_path(const ShellModel& model, double E, double nu, const StaticConditions& conditions,
                     const ControlDisplacement& control, const std::vector<PathReading>& readings, double step,
-                    double last_factor, int max_steps, NewtonOptions newton = {}) {
+                    double last_factor, int max_steps, NewtonOptions newton = {},
+                    const std::function<void(const PathPoint&, const NewtonReport&)>& progress = {}) {
   const auto start = std::chrono::steady_clock::now();
   NonlinearSolver solver(model, {E, nu});
   StaticShell<NonlinearSolver> statics(solver, conditions, newton);
@@ -586,6 +588,7 @@ PathRun follow_path(const ShellModel& model, double E, double nu, const StaticCo
     PathPoint point{statics.displacement_of(control), statics.load_factor(), {}};
     for (const PathReading& reading : readings) point.values.push_back(statics.displacement_of(reading));
     run.path.push_back(std::move(point));
+    if (progress) progress(run.path.back(), statics.report());
   }
   run.report = statics.report();
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -105,6 +105,10 @@ struct NewtonOptions {
   double rotation_step = 1e-7;      // rad
   // Perturb one particle at a time (for checking the colouring; slow).
   bool one_particle_per_colour = false;
+  // Displacement control: at most this many converged sub-steps (halved
+  // increments) per solve_to_displacement call, so a path creeping in tiny
+  // steps (a bifurcation the control cannot pass) stops with an error.
+  int max_substeps = 64;
   // Print every displacement-control iteration (load factor, relative
   // residual, control gap) to standard error.
   bool trace = false;
@@ -168,8 +172,12 @@ class StaticShell {
     if (!(step > 0.0)) throw std::invalid_argument("StaticShell: the displacement step must be positive");
     double value = displacement_of(control);
     double increment = step;
-    int halvings = 0;
+    int halvings = 0, substeps = 0;
     while (std::abs(target - value) > 1e-12 * std::max(std::abs(target), step)) {
+      if (++substeps > options_.max_substeps)
+        throw std::runtime_error("StaticShell: displacement control took more than " +
+                                 std::to_string(options_.max_substeps) + " sub-steps toward " + std::to_string(target) +
+                                 " (at " + std::to_string(value) + ", load factor " + std::to_string(lambda_) + ")");
       const double next = target > value ? std::min(target, value + increment) : std::max(target, value - increment);
       const std::vector<Vector3> x0 = solver_.positions(), d0 = solver_.directors();
       const double lambda0 = lambda_;
@@ -449,9 +457,11 @@ class StaticShell {
   // the update δu_r + δλ δu_f meets the displacement to first order (it is
   // linear in the translations, so exactly).
   bool converge_displacement(const ControlDisplacement& control, double target) {
-    // A relative residual this large along a path means the step left the
-    // path's basin (a wrong branch, a wild load factor): halving is cheaper.
+    // A relative residual this much above the step's smallest so far means
+    // the iteration left the path's basin (a wrong branch, a wild load
+    // factor): halving the step is cheaper than iterating on.
     constexpr double divergence = 1e2;
+    double smallest = std::numeric_limits<double>::infinity();
     for (int iteration = 0; iteration < options_.max_iterations; ++iteration) {
       const Dofs dofs = current_dofs();
       const Eigen::VectorXd f = external_load(dofs);
@@ -466,7 +476,8 @@ class StaticShell {
       // load to measure the residual against: iterate.
       if (reference > 0.0) {
         const double relative = r.norm() / reference;
-        if (relative > divergence) return false;
+        if (relative > divergence * smallest) return false;
+        smallest = std::min(smallest, relative);
         if (relative <= options_.tolerance && std::abs(gap) <= options_.tolerance * std::abs(target)) return true;
       }
       Eigen::MatrixXd rhs(r.size(), 2);
