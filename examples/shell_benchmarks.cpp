@@ -458,7 +458,7 @@ int run(const Arguments& arguments) {
         a.load_factor.push_back(point.load_factor), a.value.push_back(point.first);
         b.load_factor.push_back(point.load_factor), b.value.push_back(point.second);
       }
-      report("sze_hemisphere_path", "Hemisphere, 18° hole, alternating forces: the whole path (Sze et al. 2004)",
+      report("sze_hemisphere_path", "Hemisphere under alternating forces: the path (Sze 2004)",
              "Hemisphere, alternating forces", hemisphere_grid, hemisphere_path, {"pulled, outward", "pushed, inward"},
              {a, b}, {0.5, 1.0});
     }
@@ -479,7 +479,7 @@ int run(const Arguments& arguments) {
         b.load_factor.push_back(point.load_factor), b.value.push_back(point.b);
         c.load_factor.push_back(point.load_factor), c.value.push_back(point.c);
       }
-      report("pullout_path", "Pull-out of an open-ended cylinder: the path (Sze, Liu & Lo 2004)",
+      report("pullout_path", "Pull-out of an open cylinder: the path (Sze 2004)",
              "Pull-out, open cylinder", pullout_grid, pullout_path, {"W_A", "−U_B", "−U_C"}, {a, b, c},
              {0.25, 0.3, 0.5, 1.0});
     }
@@ -498,7 +498,7 @@ int run(const Arguments& arguments) {
         a.load_factor.push_back(point.load_factor), a.value.push_back(point.first);
         b.load_factor.push_back(point.load_factor), b.value.push_back(point.second);
       }
-      report("pinched_cylinder_path", "Pinched cylinder on rigid diaphragms: the path (Sze, Liu & Lo 2004)",
+      report("pinched_cylinder_path", "Pinched cylinder, diaphragms: the path (Sze 2004)",
              "Pinched cylinder (Sze §3.6)", pinched_grid, pinched_path, {"−W_A", "U_B"}, {a, b}, {0.05, 0.1, 0.15, 1.0});
     }
   }
