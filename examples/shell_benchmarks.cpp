@@ -411,16 +411,24 @@ int run(const Arguments& arguments) {
       std::string name;
       std::vector<double> load_factor, value;
     };
+    // A path's CSV and chart (its finest run) with the paper's points, and
+    // its table rows at the given load factors that the finest run reached,
+    // the coarser runs' errors beside them.
+    struct GridRun {
+      std::string grid;
+      PathRun run;
+    };
     const auto report = [&](const std::string& file, const std::string& title, const std::string& benchmark,
-                            const std::string& grid, const PathRun& run, const std::vector<std::string>& names,
+                            const std::vector<GridRun>& runs, const std::vector<std::string>& names,
                             const std::vector<PaperSeries>& paper, const std::vector<double>& rows) {
+      const GridRun& finest = runs.back();
       std::vector<std::string> columns{"control", "P/Pmax"};
       for (const std::string& name : names) columns.push_back(name);
       io::CsvProbe csv(arguments.output + "/" + file + ".csv", columns);
       std::vector<io::PlotSeries> series;
       for (std::size_t r = 0; r < names.size(); ++r)
-        series.push_back({"SPH " + names[r] + (r == 0 ? " (" + grid + ")" : ""), {}, {}, io::PlotStyle::line});
-      for (const PathPoint& point : run.path) {
+        series.push_back({"SPH " + names[r] + (r == 0 ? " (" + finest.grid + ")" : ""), {}, {}, io::PlotStyle::line});
+      for (const PathPoint& point : finest.run.path) {
         std::vector<double> row{point.control, point.load_factor};
         for (std::size_t r = 0; r < names.size(); ++r) {
           row.push_back(point.values[r]);
@@ -432,26 +440,33 @@ int run(const Arguments& arguments) {
         series.push_back({"Sze et al. 2004, " + points.name, points.load_factor, points.value, io::PlotStyle::points});
       io::write_svg_plot(arguments.output + "/" + file + ".svg", {{title, "P / Pmax", "displacement", series}});
       for (double factor : rows) {
-        const std::vector<double> at = readings_at_load_factor(run.path, factor);
-        if (at.empty()) continue;
+        if (readings_at_load_factor(finest.run.path, factor).empty()) continue;
         for (std::size_t r = 0; r < names.size(); ++r)
           for (std::size_t k = 0; k < paper[r].load_factor.size(); ++k)
             if (std::abs(paper[r].load_factor[k] - factor) < 1e-9) {
+              std::vector<Row> row;
+              for (const GridRun& coarser : runs) {
+                const std::vector<double> at = readings_at_load_factor(coarser.run.path, factor);
+                if (!at.empty()) row.push_back({benchmark, coarser.grid, at[r], paper[r].value[k], coarser.run.seconds});
+              }
               char label[96];
               std::snprintf(label, sizeof label, " at P/Pmax = %g (whole path)", factor);
-              table.push_back({{{benchmark, grid, at[r], paper[r].value[k], run.seconds}}, names[r] + label});
+              table.push_back({row, names[r] + label});
             }
       }
     };
 
-    // §3.4, the hemisphere: the pushed point's inward motion in steps of 0.5.
-    const int hemisphere_n = 29;
-    const SzeHemisphere hemisphere = sze_hemisphere(hemisphere_n);
-    const ControlDisplacement pushed{hemisphere.pushed, -Vector3::UnitY()};
-    const ControlDisplacement pulled{hemisphere.pulled, Vector3::UnitX()};
-    const std::string hemisphere_grid = std::to_string(hemisphere_n) + "²";
-    const PathRun hemisphere_path = follow("Hemisphere (Sze)", hemisphere_grid, hemisphere.model, 6.825e7, 0.3,
-                                           hemisphere.conditions, pushed, {pulled, pushed}, 0.5, 40);
+    // §3.4, the hemisphere: the pushed point's inward motion in steps of 0.5,
+    // at three resolutions.
+    std::vector<GridRun> hemisphere_runs;
+    for (int n : {25, 29, 33}) {
+      const SzeHemisphere hemisphere = sze_hemisphere(n);
+      const ControlDisplacement pushed{hemisphere.pushed, -Vector3::UnitY()};
+      const ControlDisplacement pulled{hemisphere.pulled, Vector3::UnitX()};
+      const std::string grid = std::to_string(n) + "²";
+      hemisphere_runs.push_back({grid, follow("Hemisphere (Sze)", grid, hemisphere.model, 6.825e7, 0.3,
+                                              hemisphere.conditions, pushed, {pulled, pushed}, 0.5, 40)});
+    }
     {
       PaperSeries a{"pulled", {}, {}}, b{"pushed", {}, {}};
       for (const TabulatedPoint& point : sze_hemisphere_table()) {
@@ -459,8 +474,8 @@ int run(const Arguments& arguments) {
         b.load_factor.push_back(point.load_factor), b.value.push_back(point.second);
       }
       report("sze_hemisphere_path", "Hemisphere under alternating forces: the path (Sze 2004)",
-             "Hemisphere, alternating forces", hemisphere_grid, hemisphere_path, {"pulled, outward", "pushed, inward"},
-             {a, b}, {0.5, 1.0});
+             "Hemisphere, alternating forces", hemisphere_runs, {"pulled, outward", "pushed, inward"}, {a, b},
+             {0.1, 0.5, 1.0});
     }
 
     // §3.5, the pull-out: B's inward motion (it grows through the paper's
@@ -480,7 +495,7 @@ int run(const Arguments& arguments) {
         c.load_factor.push_back(point.load_factor), c.value.push_back(point.c);
       }
       report("pullout_path", "Pull-out of an open cylinder: the path (Sze 2004)",
-             "Pull-out, open cylinder", pullout_grid, pullout_path, {"W_A", "−U_B", "−U_C"}, {a, b, c},
+             "Pull-out, open cylinder", {{pullout_grid, pullout_path}}, {"W_A", "−U_B", "−U_C"}, {a, b, c},
              {0.25, 0.3, 0.5, 1.0});
     }
 
@@ -499,7 +514,7 @@ int run(const Arguments& arguments) {
         b.load_factor.push_back(point.load_factor), b.value.push_back(point.second);
       }
       report("pinched_cylinder_path", "Pinched cylinder, diaphragms: the path (Sze 2004)",
-             "Pinched cylinder (Sze §3.6)", pinched_grid, pinched_path, {"−W_A", "U_B"}, {a, b}, {0.05, 0.1, 0.15, 1.0});
+             "Pinched cylinder (Sze §3.6)", {{pinched_grid, pinched_path}}, {"−W_A", "U_B"}, {a, b}, {0.05, 0.1, 0.15, 1.0});
     }
   }
 
