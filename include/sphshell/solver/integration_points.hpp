@@ -55,10 +55,17 @@ class IntegrationPoints {
     const auto smoothing = [&](double local) {
       return physics.support_radius_factor * local / Approx::kernel_type::support_radius_factor;
     };
+    // Sized up front: grown by push_back they would keep up to twice their
+    // size for the solver's life.
+    smoothing_length_[0].reserve(spacing.stress_point.size());
     for (double local : spacing.stress_point) smoothing_length_[0].push_back(smoothing(local));
-    if (particles_integrate)
+    if (particles_integrate) {
+      smoothing_length_[1].reserve(spacing.particle.size());
       for (double local : spacing.particle) smoothing_length_[1].push_back(smoothing(local));
+    }
+    frames_[0].reserve(model.stress_point_normal.size());
     for (const Vector3& normal : model.stress_point_normal) frames_[0].push_back(tangent_frame(normal));
+    frames_[1].reserve(model.particle_normal.size());
     for (const Vector3& normal : model.particle_normal) frames_[1].push_back(tangent_frame(normal));
     // The cut test looks for cut pieces within the largest row support (each
     // row's own support lies within it).
@@ -369,15 +376,14 @@ class IntegrationPoints {
     build_slot_transpose(particle_count);
   }
 
-  // Slots: every (row, neighbour) entry of both groups, numbered across them.
+  // Slots: every (row, neighbour) entry of both groups.
   std::size_t slot_count() const { return shape_[0].neighbour.size() + shape_[1].neighbour.size(); }
-  std::size_t slot(PointGroup group, std::size_t s) const { return slot_offset_[index_of(group)] + s; }
-  // The slots referring to particle i: particle_slots()[k] for k in
-  // [particle_slot_begin()[i], particle_slot_begin()[i + 1]).
+  // The used slots referring to particle i are force_entries()[k] for k in
+  // [particle_slot_begin()[i], particle_slot_begin()[i + 1]): the stress
+  // points' rows first, then the particles', rows and slots ascending.
   const std::vector<std::size_t>& particle_slot_begin() const { return particle_slot_begin_; }
-  const std::vector<std::size_t>& particle_slots() const { return particle_slots_; }
 
-  // The same slots in the same order, each with what a particle needs to add
+  // Each such slot with what a particle needs to add
   // its force from the point's conjugate forces (InternalForceAssembler): the
   // point, the slot's shape-function values, and which corner of the point's
   // edge-tied cell the particle is, as the index row × max_cell_corners +
@@ -398,7 +404,6 @@ class IntegrationPoints {
   // results for any thread count). Rows keep their capacity when cracks shrink
   // them, so the slot numbering stays; only the map is rebuilt.
   void build_slot_transpose(std::size_t particle_count) {
-    slot_offset_ = {0, shape_[0].neighbour.size()};
     std::vector<std::size_t> count_of(particle_count + 1, 0);
     for (PointGroup group : point_groups) {
       const approx::ShapeFunctions& sf = shape(group);
@@ -408,8 +413,9 @@ class IntegrationPoints {
     }
     for (std::size_t i = 1; i < count_of.size(); ++i) count_of[i] += count_of[i - 1];
     particle_slot_begin_ = count_of;
-    particle_slots_.resize(count_of.back());
-    force_entries_.resize(count_of.back());
+    // Exactly sized: a rebuilt transpose (a checkpoint load) must not keep a
+    // larger one's capacity.
+    std::vector<ForceEntry>(count_of.back()).swap(force_entries_);
     for (PointGroup group : point_groups) {
       const approx::ShapeFunctions& sf = shape(group);
       for (std::size_t row = 0; row < count(group); ++row) {
@@ -421,7 +427,6 @@ class IntegrationPoints {
             if (shear_tying_[row].particle[std::size_t(k)] == particle)
               tied_corner = row * shell::max_cell_corners + std::size_t(k);
           const std::size_t k = count_of[particle]++;
-          particle_slots_[k] = slot(group, s);
           force_entries_[k] = ForceEntry{static_cast<std::uint32_t>(point(group, row)),
                                          static_cast<std::uint32_t>(tied_corner), sf.phi[s], sf.dphi_d1[s],
                                          sf.dphi_d2[s]};
@@ -531,12 +536,11 @@ class IntegrationPoints {
   std::array<approx::ShapeFunctions, 2> shape_;
   std::array<std::vector<TangentFrame>, 2> frames_;  // evaluation frames, kept for rebuilds
   std::array<std::size_t, 2> offset_{};
-  std::array<std::size_t, 2> slot_offset_{};
   std::vector<double> membrane_bending_weight_, shear_weight_;
   std::vector<shell::SurfaceGradients> reference_;
   std::vector<shell::ReferenceProducts> reference_products_;
-  std::vector<std::size_t> particle_slot_begin_, particle_slots_;
-  std::vector<ForceEntry> force_entries_;  // per particle, in particle_slots_ order
+  std::vector<std::size_t> particle_slot_begin_;
+  std::vector<ForceEntry> force_entries_;  // per particle, from particle_slot_begin_
   std::array<std::vector<unsigned char>, 2> rebuilt_;  // per row: changed by a crack since construction
   std::array<std::vector<std::size_t>, 2> global_row_;  // a subset's global rows (empty: the whole model)
 };
