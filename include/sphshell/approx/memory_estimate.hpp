@@ -21,10 +21,9 @@ namespace sphshell::approx {
 
 // Bytes one shape-function slot (one row × neighbour pair) costs: the
 // neighbour index and Φ, ∇Φ (ShapeFunctions), the gathered index while
-// building, and the solver's force entry (its point and tied corner, and Φ,
-// ∇Φ again, in the particles' order: solver/integration_points.hpp).
-inline constexpr double bytes_per_slot = sizeof(int) + 3 * sizeof(double) + sizeof(int) +
-                                         2 * sizeof(std::uint32_t) + 3 * sizeof(double);
+// building, and the solver's force entry (its point, tied corner and slot,
+// in the particles' order: solver/integration_points.hpp).
+inline constexpr double bytes_per_slot = sizeof(int) + 3 * sizeof(double) + sizeof(int) + 3 * sizeof(std::uint32_t);
 
 // Mean number of particles within a support of the given radius: the particle
 // density (count over the area they cover) times π r².

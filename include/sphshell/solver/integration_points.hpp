@@ -91,7 +91,8 @@ class IntegrationPoints {
     offset_ = {0, stress_points};
     tie_shear(model, physics, shear_modulus);
     compute_weights(model, physics, particle_integration, shear_modulus, stress_points, particle_points);
-    reference_.resize(size());
+    keep_reference_ = !physics.nonlinear;
+    if (keep_reference_) reference_.resize(size());
     reference_products_.resize(size());
     for (PointGroup group : point_groups)
       for (std::size_t row = 0; row < count(group); ++row)
@@ -117,6 +118,7 @@ class IntegrationPoints {
       return j;
     };
     IntegrationPoints part;
+    part.keep_reference_ = keep_reference_;
     for (PointGroup group : point_groups) {
       const std::size_t g = index_of(group);
       const approx::ShapeFunctions& from = shape_[g];
@@ -144,7 +146,7 @@ class IntegrationPoints {
         const std::size_t p = point(group, row);
         part.membrane_bending_weight_.push_back(membrane_bending_weight_[p]);
         part.shear_weight_.push_back(shear_weight_[p]);
-        part.reference_.push_back(reference_[p]);
+        if (keep_reference_) part.reference_.push_back(reference_[p]);
         part.reference_products_.push_back(reference_products_[p]);
       }
     if (!shear_tying_.empty())
@@ -183,7 +185,7 @@ class IntegrationPoints {
     to.row_size[row] = source.row_size[from_row];
     to.shepard[row] = source.shepard[from_row];
     check_tied_corners(group, row);
-    reference_[point(group, row)] = from.reference_[from.point(group, from_row)];
+    if (keep_reference_) reference_[point(group, row)] = from.reference_[from.point(group, from_row)];
     reference_products_[point(group, row)] = from.reference_products_[from.point(group, from_row)];
     mark_rebuilt(group, row);
   }
@@ -241,6 +243,8 @@ class IntegrationPoints {
   // Kept per row, refreshed wherever a row changes, so the step does not
   // search the row for its corners.
   bool tied_corners_visible(std::size_t row) const { return tied_corners_visible_[row] != 0; }
+  // Kept for the linear analysis only (the nonlinear one needs only its
+  // products below): 120 bytes a point.
   const shell::SurfaceGradients& reference(std::size_t p) const { return reference_[p]; }
   // Its dot products in the Green strains (shell::green_strains).
   const shell::ReferenceProducts& reference_products(std::size_t p) const { return reference_products_[p]; }
@@ -314,8 +318,10 @@ class IntegrationPoints {
   // their slots, the hidden ones too, which later rebuilds start from) with
   // their reference gradients. Every other row is as the constructor built it
   // from the model, which is deterministic. The slot transpose is rebuilt.
+  // A nonlinear analysis keeps no reference gradients: a rebuilt row's are
+  // gathered again from the model, as rebuild_row and load set them.
   template <class Writer>
-  void save(Writer& out) const {
+  void save(Writer& out, const ShellModel& model) const {
     for (PointGroup group : point_groups) {
       const std::vector<unsigned char>& rebuilt = rebuilt_[index_of(group)];
       const approx::ShapeFunctions& sf = shape(group);
@@ -327,7 +333,9 @@ class IntegrationPoints {
         const std::size_t begin = sf.row_begin[row], end = sf.row_begin[row + 1];
         out(static_cast<std::uint64_t>(end - begin), sf.row_size[row], sf.shepard[row]);
         for (std::size_t s = begin; s < end; ++s) out(sf.neighbour[s], sf.phi[s], sf.dphi_d1[s], sf.dphi_d2[s]);
-        const shell::SurfaceGradients& g = reference_[point(group, row)];
+        const shell::SurfaceGradients g = keep_reference_ ? reference_[point(group, row)]
+                                                          : gather(group, row, model.particle_position,
+                                                                   model.particle_normal);
         out(g.a1, g.a2, g.n, g.n1, g.n2);
       }
     }
@@ -383,18 +391,20 @@ class IntegrationPoints {
   // points' rows first, then the particles', rows and slots ascending.
   const std::vector<std::size_t>& particle_slot_begin() const { return particle_slot_begin_; }
 
-  // Each such slot with what a particle needs to add
-  // its force from the point's conjugate forces (InternalForceAssembler): the
-  // point, the slot's shape-function values, and which corner of the point's
+  // Each such slot with what a particle needs to add its force from the
+  // point's conjugate forces (InternalForceAssembler): the point, the slot in
+  // its group's shape functions (whose Φ, ∇Φ it reads there: a copy of them
+  // here would cost 24 bytes a slot), and which corner of the point's
   // edge-tied cell the particle is, as the index row × max_cell_corners +
   // corner of the tied corner forces the assembler keeps per stress point
   // (untied_corner() when it is none: an index past them, whose forces the
   // assembler keeps zero, so its sum adds them without a branch). Contiguous
-  // per particle, so the per-particle sum streams through them.
+  // per particle, so the per-particle sum streams through them; the slots of
+  // one particle lie in rows near each other.
   struct ForceEntry {
     std::uint32_t point;
     std::uint32_t tied_corner;
-    double phi, dphi_d1, dphi_d2;
+    std::uint32_t slot;
   };
   const std::vector<ForceEntry>& force_entries() const { return force_entries_; }
   std::size_t untied_corner() const { return count(PointGroup::stress_points) * shell::max_cell_corners; }
@@ -404,6 +414,15 @@ class IntegrationPoints {
   // results for any thread count). Rows keep their capacity when cracks shrink
   // them, so the slot numbering stays; only the map is rebuilt.
   void build_slot_transpose(std::size_t particle_count) {
+    // The entries' 32-bit indices: points (× max_cell_corners for the tied
+    // corners) and each group's slots.
+    constexpr std::size_t index_limit = std::size_t(UINT32_MAX);
+    if (size() >= index_limit / shell::max_cell_corners)
+      detail::invalid_parameter("integration point count", size(), "must stay below 2³⁰ (32-bit force entries)");
+    for (PointGroup group : point_groups)
+      if (shape(group).slots() >= index_limit)
+        detail::invalid_parameter(std::string(name_of(group)) + " shape-function slot count", shape(group).slots(),
+                                  "must stay below 2³² (32-bit force entries)");
     std::vector<std::size_t> count_of(particle_count + 1, 0);
     for (PointGroup group : point_groups) {
       const approx::ShapeFunctions& sf = shape(group);
@@ -428,8 +447,7 @@ class IntegrationPoints {
               tied_corner = row * shell::max_cell_corners + std::size_t(k);
           const std::size_t k = count_of[particle]++;
           force_entries_[k] = ForceEntry{static_cast<std::uint32_t>(point(group, row)),
-                                         static_cast<std::uint32_t>(tied_corner), sf.phi[s], sf.dphi_d1[s],
-                                         sf.dphi_d2[s]};
+                                         static_cast<std::uint32_t>(tied_corner), static_cast<std::uint32_t>(s)};
         }
       }
     }
@@ -453,7 +471,7 @@ class IntegrationPoints {
   }
 
   void set_reference(std::size_t p, const shell::SurfaceGradients& g) {
-    reference_[p] = g;
+    if (keep_reference_) reference_[p] = g;
     reference_products_[p] = shell::reference_products(g);
   }
 
@@ -537,7 +555,8 @@ class IntegrationPoints {
   std::array<std::vector<TangentFrame>, 2> frames_;  // evaluation frames, kept for rebuilds
   std::array<std::size_t, 2> offset_{};
   std::vector<double> membrane_bending_weight_, shear_weight_;
-  std::vector<shell::SurfaceGradients> reference_;
+  bool keep_reference_ = true;  // the linear analysis's reference gradients are kept
+  std::vector<shell::SurfaceGradients> reference_;  // per point when keep_reference_, else empty
   std::vector<shell::ReferenceProducts> reference_products_;
   std::vector<std::size_t> particle_slot_begin_;
   std::vector<ForceEntry> force_entries_;  // per particle, from particle_slot_begin_
