@@ -89,9 +89,9 @@ class IntegrationPoints {
     const std::size_t stress_points = model.stress_point_count();
     const std::size_t particle_points = particles_integrate ? model.particle_count() : 0;
     offset_ = {0, stress_points};
+    keep_reference_ = !physics.nonlinear;
     tie_shear(model, physics, shear_modulus);
     compute_weights(model, physics, particle_integration, shear_modulus, stress_points, particle_points);
-    keep_reference_ = !physics.nonlinear;
     if (keep_reference_) reference_.resize(size());
     reference_products_.resize(size());
     for (PointGroup group : point_groups)
@@ -153,7 +153,8 @@ class IntegrationPoints {
       for (std::size_t row : rows[0]) {
         part.tied_corners_visible_.push_back(tied_corners_visible_[row]);
         part.shear_tying_.push_back(shear_tying_[row]);
-        shell::CellShearTying& tying = part.shear_tying_.back();
+        if (keep_reference_) part.shear_edges_.push_back(shear_edges_[row]);
+        shell::CellShearTie& tying = part.shear_tying_.back();
         for (int k = 0; k < tying.corners; ++k)
           tying.particle[k] = local(tying.particle[k], PointGroup::stress_points, row);
       }
@@ -237,7 +238,12 @@ class IntegrationPoints {
   bool shear_tied(PointGroup group, std::size_t row) const {
     return group == PointGroup::stress_points && !shear_tying_.empty() && shear_tying_[row].corners > 0;
   }
-  const shell::CellShearTying& shear_tying(std::size_t row) const { return shear_tying_[row]; }
+  const shell::CellShearTie& shear_tying(std::size_t row) const { return shear_tying_[row]; }
+  // Its reference edges, which the linear analysis reads (null in a nonlinear
+  // one, which keeps none: 192 bytes a stress point).
+  const shell::CellShearEdges* shear_edges(std::size_t row) const {
+    return shear_edges_.empty() ? nullptr : &shear_edges_[row];
+  }
   // Whether every corner of a tied stress point's cell is among its row's
   // used slots (a crack can hide one: the cell's shear is then left out).
   // Kept per row, refreshed wherever a row changes, so the step does not
@@ -461,7 +467,7 @@ class IntegrationPoints {
   void check_tied_corners(PointGroup group, std::size_t row) {
     if (!shear_tied(group, row)) return;
     const approx::ShapeFunctions& sf = shape(group);
-    const shell::CellShearTying& tying = shear_tying_[row];
+    const shell::CellShearTie& tying = shear_tying_[row];
     const auto used_begin = sf.neighbour.begin() + std::ptrdiff_t(sf.row_begin[row]);
     const auto used_end = used_begin + sf.row_size[row];
     bool visible = true;
@@ -522,10 +528,12 @@ class IntegrationPoints {
   // nowhere to go: the support is too small for the cell.
   void tie_shear(const ShellModel& model, const PhysicsOptions& physics, double shear_modulus) {
     shear_tying_.clear();
+    shear_edges_.clear();
     tied_corners_visible_.clear();
     if (physics.transverse_shear != TransverseShear::cell_edges || model.cells().empty()) return;
     const approx::ShapeFunctions& sf = shape(PointGroup::stress_points);
     shear_tying_.resize(model.stress_point_count());
+    if (keep_reference_) shear_edges_.resize(shear_tying_.size());
     // Every corner is in its row (checked below) until a crack hides one.
     tied_corners_visible_.assign(shear_tying_.size(), 1);
     for (std::size_t row = 0; row < shear_tying_.size(); ++row) {
@@ -541,21 +549,25 @@ class IntegrationPoints {
                                         std::to_string(support_radius(PointGroup::stress_points, row)) + " m");
       }
       const double stiffness = physics.shear_correction * shear_modulus * model.stress_point_thickness(row);
-      shear_tying_[row] = shell::tie_cell_shear(cell.begin(), static_cast<int>(cell.size()), model.particle_position,
-                                                model.particle_normal, frame(PointGroup::stress_points, row),
-                                                stiffness, model.stress_point_area[row]);
+      const shell::CellShearTying tying =
+          shell::tie_cell_shear(cell.begin(), static_cast<int>(cell.size()), model.particle_position,
+                                model.particle_normal, frame(PointGroup::stress_points, row), stiffness,
+                                model.stress_point_area[row]);
+      shear_tying_[row] = tying;
+      if (keep_reference_) shear_edges_[row] = tying;
     }
   }
 
   std::array<std::vector<double>, 2> smoothing_length_;  // h_i per row of each group
   shell::CutVisibility cuts_;  // the model's cuts
-  std::vector<shell::CellShearTying> shear_tying_;  // per stress point, or empty
+  std::vector<shell::CellShearTie> shear_tying_;  // per stress point, or empty
+  std::vector<shell::CellShearEdges> shear_edges_;  // per stress point with shear_tying_ when keep_reference_
   std::vector<unsigned char> tied_corners_visible_;  // per stress point with shear_tying_
   std::array<approx::ShapeFunctions, 2> shape_;
   std::array<std::vector<TangentFrame>, 2> frames_;  // evaluation frames, kept for rebuilds
   std::array<std::size_t, 2> offset_{};
   std::vector<double> membrane_bending_weight_, shear_weight_;
-  bool keep_reference_ = true;  // the linear analysis's reference gradients are kept
+  bool keep_reference_ = true;  // a linear analysis: its reference gradients and tied edges are kept
   std::vector<shell::SurfaceGradients> reference_;  // per point when keep_reference_, else empty
   std::vector<shell::ReferenceProducts> reference_products_;
   std::vector<std::size_t> particle_slot_begin_;

@@ -228,10 +228,10 @@ class InternalForceAssembler {
       clear_tied_corners(row);
       return 0.0;
     }
-    const shell::CellShearTying& tying = points.shear_tying(row);
+    const shell::CellShearTie& tying = points.shear_tying(row);
     const std::size_t first = row * shell::max_cell_corners;
     return shell::corner_shear_forces(
-        tying, [&](int k) -> const Vector3& { return position(tying.particle[std::size_t(k)]); },
+        tying, points.shear_edges(row), [&](int k) -> const Vector3& { return position(tying.particle[std::size_t(k)]); },
         [&](int k) -> const Vector3& { return director(tying.particle[std::size_t(k)]); }, nonlinear_,
         &tied_force_[first], &tied_director_force_[first]);
   }
