@@ -325,9 +325,12 @@ class IntegrationPoints {
   // their reference gradients. Every other row is as the constructor built it
   // from the model, which is deterministic. The slot transpose is rebuilt.
   // A nonlinear analysis keeps no reference gradients: a rebuilt row's are
-  // gathered again from the model, as rebuild_row and load set them.
+  // gathered again from the particles' reference positions and normals
+  // (numbered as the rows' neighbours are: the model's, or a subset's local
+  // particles), the same sums rebuild_row formed.
   template <class Writer>
-  void save(Writer& out, const ShellModel& model) const {
+  void save(Writer& out, const std::vector<Vector3>& reference_positions,
+            const std::vector<Vector3>& reference_normals) const {
     for (PointGroup group : point_groups) {
       const std::vector<unsigned char>& rebuilt = rebuilt_[index_of(group)];
       const approx::ShapeFunctions& sf = shape(group);
@@ -340,8 +343,8 @@ class IntegrationPoints {
         out(static_cast<std::uint64_t>(end - begin), sf.row_size[row], sf.shepard[row]);
         for (std::size_t s = begin; s < end; ++s) out(sf.neighbour[s], sf.phi[s], sf.dphi_d1[s], sf.dphi_d2[s]);
         const shell::SurfaceGradients g = keep_reference_ ? reference_[point(group, row)]
-                                                          : gather(group, row, model.particle_position,
-                                                                   model.particle_normal);
+                                                          : gather(group, row, reference_positions,
+                                                                   reference_normals);
         out(g.a1, g.a2, g.n, g.n1, g.n2);
       }
     }
