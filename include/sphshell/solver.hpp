@@ -288,7 +288,7 @@ class Solver {
     forces_.save(out);
     out.end_section();
     out.begin_section("PNTS");
-    points_.save(out);
+    points_.save(out, model_.particle_position, model_.particle_normal);
     out.end_section();
     out.begin_section("SECT");
     states_.save(out);

@@ -21,18 +21,6 @@ using namespace sphshell;
 
 namespace {
 
-// (group, global row) of every slot of the serial numbering.
-std::vector<std::pair<std::size_t, std::size_t>> row_of_slots(const mpi_test::Points& points) {
-  std::vector<std::pair<std::size_t, std::size_t>> rows(points.slot_count());
-  for (solver::PointGroup group : solver::point_groups) {
-    const approx::ShapeFunctions& shape = points.shape(group);
-    for (std::size_t row = 0; row < shape.rows(); ++row)
-      for (std::size_t s = shape.row_begin[row]; s < shape.row_begin[row + 1]; ++s)
-        rows[points.slot(group, s)] = {solver::index_of(group), row};
-  }
-  return rows;
-}
-
 void check_decomposition(const mpi::Communicator& comm, const mpi_test::Case& c) {
   INFO(c.name << " on " << comm.size() << " ranks, rank " << comm.rank());
   const mpi::DecompositionInput input = c.input();
@@ -110,12 +98,12 @@ void check_decomposition(const mpi::Communicator& comm, const mpi_test::Case& c)
   CHECK(bad_ghosts == 0);
   if (comm.size() == 1) CHECK(layout.ghost_count() == 0);
 
-  // The force sum of each owned particle: the serial transpose lists its slots
-  // by group and row; the rank's computed rows, walked in their order, must
-  // give the same (group, row) sequence — the same terms in the same order.
-  const auto slot_rows = row_of_slots(*c.points);
+  // The force sum of each owned particle: the serial transpose lists its
+  // force entries by group and row; the rank's computed rows, walked in their
+  // order, must give the same (group, row) sequence — the same terms in the
+  // same order.
   const std::vector<std::size_t>& begin = c.points->particle_slot_begin();
-  const std::vector<std::size_t>& slots = c.points->particle_slots();
+  const auto& entries = c.points->force_entries();
   std::vector<std::vector<std::pair<std::size_t, std::size_t>>> local_order(layout.owned_count());
   for (std::size_t g = 0; g < mpi::group_count; ++g) {
     const approx::ShapeFunctions& shape = *input.groups[g].shape;
@@ -129,7 +117,10 @@ void check_decomposition(const mpi::Communicator& comm, const mpi_test::Case& c)
   for (std::size_t k = 0; k < layout.owned_count(); ++k) {
     const auto i = static_cast<std::size_t>(layout.owned[k]);
     std::vector<std::pair<std::size_t, std::size_t>> serial;
-    for (std::size_t m = begin[i]; m < begin[i + 1]; ++m) serial.push_back(slot_rows[slots[m]]);
+    for (std::size_t m = begin[i]; m < begin[i + 1]; ++m) {
+      const std::size_t p = entries[m].point;
+      serial.push_back({solver::index_of(c.points->group_of(p)), c.points->row_of(p)});
+    }
     if (serial != local_order[k]) ++different_sums;
   }
   CHECK(different_sums == 0);

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -20,9 +21,9 @@ namespace sphshell::approx {
 
 // Bytes one shape-function slot (one row × neighbour pair) costs: the
 // neighbour index and Φ, ∇Φ (ShapeFunctions), the gathered index while
-// building, and the solver's per-slot force pair and slot transpose.
-inline constexpr double bytes_per_slot = sizeof(int) + 3 * sizeof(double) + sizeof(int) + 6 * sizeof(double) +
-                                         sizeof(std::size_t);
+// building, and the solver's force entry (its point, tied corner and slot,
+// in the particles' order: solver/integration_points.hpp).
+inline constexpr double bytes_per_slot = sizeof(int) + 3 * sizeof(double) + sizeof(int) + 3 * sizeof(std::uint32_t);
 
 // Mean number of particles within a support of the given radius: the particle
 // density (count over the area they cover) times π r².

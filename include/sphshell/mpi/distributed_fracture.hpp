@@ -309,7 +309,7 @@ class DistributedFracture<Crack, true> {
     if (nothing_visible || parts.points.shape(group).shepard[row]) return Rebuild::cut_loose;
     const shell::SurfaceGradients current =
         parts.points.gather(group, row, parts.particles.position, parts.particles.director);
-    parts.states.restart_strains(p, parts.assembler.strains_of(current, parts.points.reference(p)));
+    parts.states.restart_strains(p, parts.assembler.strains_of(current, parts.points, p));
     parts.assembler.clear_slots(group, row, parts.points);
     const double tied_energy =
         parts.assembler.scatter_point(group, row, current, parts.particles, parts.points, parts.states);

@@ -354,8 +354,18 @@ class DistributedSolver {
       forces_.save(out);
       out.end_section();
       out.begin_section("PNTS");
-      points_->save(out);
-      if constexpr (Crack::enabled) all_points_->save(out);
+      {
+        // The local particles' reference positions and normals (a nonlinear
+        // run's rows gather their reference gradients from them).
+        std::vector<Vector3> reference_positions(layout_.local_count()), reference_normals(layout_.local_count());
+        for (std::size_t k = 0; k < layout_.local_count(); ++k) {
+          const auto i = static_cast<std::size_t>(layout_.global_of(k));
+          reference_positions[k] = model_.particle_position[i];
+          reference_normals[k] = model_.particle_normal[i];
+        }
+        points_->save(out, reference_positions, reference_normals);
+      }
+      if constexpr (Crack::enabled) all_points_->save(out, model_.particle_position, model_.particle_normal);
       out.end_section();
       out.begin_section("SECT");
       states_->save(out);

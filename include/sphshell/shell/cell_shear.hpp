@@ -40,20 +40,25 @@ inline constexpr int max_cell_corners = 4;
 using CellShearMatrix = Eigen::Matrix<double, max_cell_corners, max_cell_corners>;
 
 // What is fixed about one cell's tied shear (reference configuration). Edge e
-// runs from corner e to corner (e + 1) mod corners.
-struct CellShearTying {
-  CellShearTying() {
-    chord.fill(Vector3::Zero());  // Eigen vectors are not zeroed by {}
-    normal_sum.fill(Vector3::Zero());
-  }
+// runs from corner e to corner (e + 1) mod corners. CellShearTie is what both
+// analyses read; CellShearEdges the reference edges, which only the linear
+// form reads (a solver keeps them only for a linear analysis).
+struct CellShearTie {
   int corners = 0;                                          // 3 or 4; 0: the cell is not tied
   std::array<int, max_cell_corners> particle{};             // corner particle indices
-  std::array<Vector3, max_cell_corners> chord;              // X_b − X_a
-  std::array<Vector3, max_cell_corners> normal_sum;         // N_a + N_b
   std::array<double, max_cell_corners> inverse_length{};    // 1 / ℓ_ab
   std::array<double, max_cell_corners> reference_strain{};  // chord·normal_sum / (2ℓ)
   CellShearMatrix stiffness = CellShearMatrix::Zero();      // C (N/m × m²: κs G d A per unit strain²)
 };
+struct CellShearEdges {
+  CellShearEdges() {
+    chord.fill(Vector3::Zero());  // Eigen vectors are not zeroed by {}
+    normal_sum.fill(Vector3::Zero());
+  }
+  std::array<Vector3, max_cell_corners> chord;       // X_b − X_a
+  std::array<Vector3, max_cell_corners> normal_sum;  // N_a + N_b
+};
+struct CellShearTying : CellShearTie, CellShearEdges {};
 
 // Below this |sin| of the angle between a corner's two edges the cell is
 // degenerate there (the corner cannot recover a Cartesian shear).
@@ -152,8 +157,8 @@ inline Eigen::Matrix<double, max_cell_corners, 1> cell_edge_shear_strains(const 
 // through the output pointers might alias the tying for all the compiler
 // knows). The same operations in the same order as edge by edge.
 template <int Corners, class CornerPosition, class CornerDirector>
-inline double corner_shear_forces_of(const CellShearTying& t, const CornerPosition& x, const CornerDirector& d,
-                                     bool nonlinear, Vector3* force, Vector3* director_force) {
+inline double corner_shear_forces_of(const CellShearTie& t, const CellShearEdges* edges, const CornerPosition& x,
+                                     const CornerDirector& d, bool nonlinear, Vector3* force, Vector3* director_force) {
   std::array<Vector3, Corners> chord, director_sum;
   Eigen::Matrix<double, max_cell_corners, 1> strain = Eigen::Matrix<double, max_cell_corners, 1>::Zero();
   for (int e = 0; e < Corners; ++e) {
@@ -161,9 +166,9 @@ inline double corner_shear_forces_of(const CellShearTying& t, const CornerPositi
     chord[e] = x(b) - x(e);
     director_sum[e] = d(e) + d(b);
     const double value = nonlinear ? chord[e].dot(director_sum[e])
-                                   : (chord[e] - t.chord[e]).dot(t.normal_sum[e]) +
-                                         t.chord[e].dot(director_sum[e] - t.normal_sum[e]) +
-                                         t.chord[e].dot(t.normal_sum[e]);
+                                   : (chord[e] - edges->chord[e]).dot(edges->normal_sum[e]) +
+                                         edges->chord[e].dot(director_sum[e] - edges->normal_sum[e]) +
+                                         edges->chord[e].dot(edges->normal_sum[e]);
     strain[e] = value * 0.5 * t.inverse_length[e] - t.reference_strain[e];
   }
   const Eigen::Matrix<double, max_cell_corners, 1> edge_force = t.stiffness * strain;  // ∂Π/∂e
@@ -175,8 +180,8 @@ inline double corner_shear_forces_of(const CellShearTying& t, const CornerPositi
     // ∂e/∂x_b = −∂e/∂x_a = (d_a + d_b)/(2ℓ), ∂e/∂d_a = ∂e/∂d_b = (x_b − x_a)/(2ℓ),
     // at the current vectors (nonlinear) or the reference ones (linear).
     const double factor = edge_force[e] * 0.5 * t.inverse_length[e];
-    const Vector3 along_normal = factor * (nonlinear ? director_sum[e] : t.normal_sum[e]);
-    const Vector3 along_chord = factor * (nonlinear ? chord[e] : t.chord[e]);
+    const Vector3 along_normal = factor * (nonlinear ? director_sum[e] : edges->normal_sum[e]);
+    const Vector3 along_chord = factor * (nonlinear ? chord[e] : edges->chord[e]);
     corner_force[b] += along_normal;
     corner_force[e] -= along_normal;
     corner_director_force[e] += along_chord;
@@ -194,12 +199,19 @@ inline double corner_shear_forces_of(const CellShearTying& t, const CornerPositi
 // t.corners entries; nothing else is touched), of a tied cell (3 or 4
 // corners). For the assembler, which keeps the forces per point and reads the
 // corners from its packed kinematics.
+// The reference edges are read only by the linear form (nonlinear false):
+// edges may be null for the nonlinear one.
+template <class CornerPosition, class CornerDirector>
+inline double corner_shear_forces(const CellShearTie& t, const CellShearEdges* edges, const CornerPosition& x,
+                                  const CornerDirector& d, bool nonlinear, Vector3* force, Vector3* director_force) {
+  return t.corners == max_cell_corners
+             ? corner_shear_forces_of<max_cell_corners>(t, edges, x, d, nonlinear, force, director_force)
+             : corner_shear_forces_of<3>(t, edges, x, d, nonlinear, force, director_force);
+}
 template <class CornerPosition, class CornerDirector>
 inline double corner_shear_forces(const CellShearTying& t, const CornerPosition& x, const CornerDirector& d,
                                   bool nonlinear, Vector3* force, Vector3* director_force) {
-  return t.corners == max_cell_corners
-             ? corner_shear_forces_of<max_cell_corners>(t, x, d, nonlinear, force, director_force)
-             : corner_shear_forces_of<3>(t, x, d, nonlinear, force, director_force);
+  return corner_shear_forces(t, &t, x, d, nonlinear, force, director_force);
 }
 
 inline CellShearForces cell_shear_forces(const CellShearTying& t, const std::vector<Vector3>& x,

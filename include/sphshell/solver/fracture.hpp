@@ -320,7 +320,7 @@ class FractureManager<Crack, true> {
     if (parts.points.shape(group).shepard[row]) return Rebuild::cut_loose;  // no gradient: no strain
     const shell::SurfaceGradients current =
         parts.points.gather(group, row, parts.particles.position, parts.particles.director);
-    parts.states.restart_strains(p, parts.assembler.strains_of(current, parts.points.reference(p)));
+    parts.states.restart_strains(p, parts.assembler.strains_of(current, parts.points, p));
     parts.assembler.clear_slots(group, row, parts.points);
     // The edge-tied shear does not depend on the shape functions; it lets its
     // energy go only when a corner of the cell is hidden (docs/method.md §6).

@@ -55,10 +55,17 @@ class IntegrationPoints {
     const auto smoothing = [&](double local) {
       return physics.support_radius_factor * local / Approx::kernel_type::support_radius_factor;
     };
+    // Sized up front: grown by push_back they would keep up to twice their
+    // size for the solver's life.
+    smoothing_length_[0].reserve(spacing.stress_point.size());
     for (double local : spacing.stress_point) smoothing_length_[0].push_back(smoothing(local));
-    if (particles_integrate)
+    if (particles_integrate) {
+      smoothing_length_[1].reserve(spacing.particle.size());
       for (double local : spacing.particle) smoothing_length_[1].push_back(smoothing(local));
+    }
+    frames_[0].reserve(model.stress_point_normal.size());
     for (const Vector3& normal : model.stress_point_normal) frames_[0].push_back(tangent_frame(normal));
+    frames_[1].reserve(model.particle_normal.size());
     for (const Vector3& normal : model.particle_normal) frames_[1].push_back(tangent_frame(normal));
     // The cut test looks for cut pieces within the largest row support (each
     // row's own support lies within it).
@@ -82,9 +89,10 @@ class IntegrationPoints {
     const std::size_t stress_points = model.stress_point_count();
     const std::size_t particle_points = particles_integrate ? model.particle_count() : 0;
     offset_ = {0, stress_points};
+    keep_reference_ = !physics.nonlinear;
     tie_shear(model, physics, shear_modulus);
     compute_weights(model, physics, particle_integration, shear_modulus, stress_points, particle_points);
-    reference_.resize(size());
+    if (keep_reference_) reference_.resize(size());
     reference_products_.resize(size());
     for (PointGroup group : point_groups)
       for (std::size_t row = 0; row < count(group); ++row)
@@ -110,6 +118,7 @@ class IntegrationPoints {
       return j;
     };
     IntegrationPoints part;
+    part.keep_reference_ = keep_reference_;
     for (PointGroup group : point_groups) {
       const std::size_t g = index_of(group);
       const approx::ShapeFunctions& from = shape_[g];
@@ -137,14 +146,15 @@ class IntegrationPoints {
         const std::size_t p = point(group, row);
         part.membrane_bending_weight_.push_back(membrane_bending_weight_[p]);
         part.shear_weight_.push_back(shear_weight_[p]);
-        part.reference_.push_back(reference_[p]);
+        if (keep_reference_) part.reference_.push_back(reference_[p]);
         part.reference_products_.push_back(reference_products_[p]);
       }
     if (!shear_tying_.empty())
       for (std::size_t row : rows[0]) {
         part.tied_corners_visible_.push_back(tied_corners_visible_[row]);
         part.shear_tying_.push_back(shear_tying_[row]);
-        shell::CellShearTying& tying = part.shear_tying_.back();
+        if (keep_reference_) part.shear_edges_.push_back(shear_edges_[row]);
+        shell::CellShearTie& tying = part.shear_tying_.back();
         for (int k = 0; k < tying.corners; ++k)
           tying.particle[k] = local(tying.particle[k], PointGroup::stress_points, row);
       }
@@ -176,7 +186,7 @@ class IntegrationPoints {
     to.row_size[row] = source.row_size[from_row];
     to.shepard[row] = source.shepard[from_row];
     check_tied_corners(group, row);
-    reference_[point(group, row)] = from.reference_[from.point(group, from_row)];
+    if (keep_reference_) reference_[point(group, row)] = from.reference_[from.point(group, from_row)];
     reference_products_[point(group, row)] = from.reference_products_[from.point(group, from_row)];
     mark_rebuilt(group, row);
   }
@@ -228,12 +238,19 @@ class IntegrationPoints {
   bool shear_tied(PointGroup group, std::size_t row) const {
     return group == PointGroup::stress_points && !shear_tying_.empty() && shear_tying_[row].corners > 0;
   }
-  const shell::CellShearTying& shear_tying(std::size_t row) const { return shear_tying_[row]; }
+  const shell::CellShearTie& shear_tying(std::size_t row) const { return shear_tying_[row]; }
+  // Its reference edges, which the linear analysis reads (null in a nonlinear
+  // one, which keeps none: 192 bytes a stress point).
+  const shell::CellShearEdges* shear_edges(std::size_t row) const {
+    return shear_edges_.empty() ? nullptr : &shear_edges_[row];
+  }
   // Whether every corner of a tied stress point's cell is among its row's
   // used slots (a crack can hide one: the cell's shear is then left out).
   // Kept per row, refreshed wherever a row changes, so the step does not
   // search the row for its corners.
   bool tied_corners_visible(std::size_t row) const { return tied_corners_visible_[row] != 0; }
+  // Kept for the linear analysis only (the nonlinear one needs only its
+  // products below): 120 bytes a point.
   const shell::SurfaceGradients& reference(std::size_t p) const { return reference_[p]; }
   // Its dot products in the Green strains (shell::green_strains).
   const shell::ReferenceProducts& reference_products(std::size_t p) const { return reference_products_[p]; }
@@ -307,8 +324,13 @@ class IntegrationPoints {
   // their slots, the hidden ones too, which later rebuilds start from) with
   // their reference gradients. Every other row is as the constructor built it
   // from the model, which is deterministic. The slot transpose is rebuilt.
+  // A nonlinear analysis keeps no reference gradients: a rebuilt row's are
+  // gathered again from the particles' reference positions and normals
+  // (numbered as the rows' neighbours are: the model's, or a subset's local
+  // particles), the same sums rebuild_row formed.
   template <class Writer>
-  void save(Writer& out) const {
+  void save(Writer& out, const std::vector<Vector3>& reference_positions,
+            const std::vector<Vector3>& reference_normals) const {
     for (PointGroup group : point_groups) {
       const std::vector<unsigned char>& rebuilt = rebuilt_[index_of(group)];
       const approx::ShapeFunctions& sf = shape(group);
@@ -320,7 +342,9 @@ class IntegrationPoints {
         const std::size_t begin = sf.row_begin[row], end = sf.row_begin[row + 1];
         out(static_cast<std::uint64_t>(end - begin), sf.row_size[row], sf.shepard[row]);
         for (std::size_t s = begin; s < end; ++s) out(sf.neighbour[s], sf.phi[s], sf.dphi_d1[s], sf.dphi_d2[s]);
-        const shell::SurfaceGradients& g = reference_[point(group, row)];
+        const shell::SurfaceGradients g = keep_reference_ ? reference_[point(group, row)]
+                                                          : gather(group, row, reference_positions,
+                                                                   reference_normals);
         out(g.a1, g.a2, g.n, g.n1, g.n2);
       }
     }
@@ -369,26 +393,27 @@ class IntegrationPoints {
     build_slot_transpose(particle_count);
   }
 
-  // Slots: every (row, neighbour) entry of both groups, numbered across them.
+  // Slots: every (row, neighbour) entry of both groups.
   std::size_t slot_count() const { return shape_[0].neighbour.size() + shape_[1].neighbour.size(); }
-  std::size_t slot(PointGroup group, std::size_t s) const { return slot_offset_[index_of(group)] + s; }
-  // The slots referring to particle i: particle_slots()[k] for k in
-  // [particle_slot_begin()[i], particle_slot_begin()[i + 1]).
+  // The used slots referring to particle i are force_entries()[k] for k in
+  // [particle_slot_begin()[i], particle_slot_begin()[i + 1]): the stress
+  // points' rows first, then the particles', rows and slots ascending.
   const std::vector<std::size_t>& particle_slot_begin() const { return particle_slot_begin_; }
-  const std::vector<std::size_t>& particle_slots() const { return particle_slots_; }
 
-  // The same slots in the same order, each with what a particle needs to add
-  // its force from the point's conjugate forces (InternalForceAssembler): the
-  // point, the slot's shape-function values, and which corner of the point's
+  // Each such slot with what a particle needs to add its force from the
+  // point's conjugate forces (InternalForceAssembler): the point, the slot in
+  // its group's shape functions (whose Φ, ∇Φ it reads there: a copy of them
+  // here would cost 24 bytes a slot), and which corner of the point's
   // edge-tied cell the particle is, as the index row × max_cell_corners +
   // corner of the tied corner forces the assembler keeps per stress point
   // (untied_corner() when it is none: an index past them, whose forces the
   // assembler keeps zero, so its sum adds them without a branch). Contiguous
-  // per particle, so the per-particle sum streams through them.
+  // per particle, so the per-particle sum streams through them; the slots of
+  // one particle lie in rows near each other.
   struct ForceEntry {
     std::uint32_t point;
     std::uint32_t tied_corner;
-    double phi, dphi_d1, dphi_d2;
+    std::uint32_t slot;
   };
   const std::vector<ForceEntry>& force_entries() const { return force_entries_; }
   std::size_t untied_corner() const { return count(PointGroup::stress_points) * shell::max_cell_corners; }
@@ -398,7 +423,15 @@ class IntegrationPoints {
   // results for any thread count). Rows keep their capacity when cracks shrink
   // them, so the slot numbering stays; only the map is rebuilt.
   void build_slot_transpose(std::size_t particle_count) {
-    slot_offset_ = {0, shape_[0].neighbour.size()};
+    // The entries' 32-bit indices: points (× max_cell_corners for the tied
+    // corners) and each group's slots.
+    constexpr std::size_t index_limit = std::size_t(UINT32_MAX);
+    if (size() >= index_limit / shell::max_cell_corners)
+      detail::invalid_parameter("integration point count", size(), "must stay below 2³⁰ (32-bit force entries)");
+    for (PointGroup group : point_groups)
+      if (shape(group).slots() >= index_limit)
+        detail::invalid_parameter(std::string(name_of(group)) + " shape-function slot count", shape(group).slots(),
+                                  "must stay below 2³² (32-bit force entries)");
     std::vector<std::size_t> count_of(particle_count + 1, 0);
     for (PointGroup group : point_groups) {
       const approx::ShapeFunctions& sf = shape(group);
@@ -408,8 +441,9 @@ class IntegrationPoints {
     }
     for (std::size_t i = 1; i < count_of.size(); ++i) count_of[i] += count_of[i - 1];
     particle_slot_begin_ = count_of;
-    particle_slots_.resize(count_of.back());
-    force_entries_.resize(count_of.back());
+    // Exactly sized: a rebuilt transpose (a checkpoint load) must not keep a
+    // larger one's capacity.
+    std::vector<ForceEntry>(count_of.back()).swap(force_entries_);
     for (PointGroup group : point_groups) {
       const approx::ShapeFunctions& sf = shape(group);
       for (std::size_t row = 0; row < count(group); ++row) {
@@ -421,10 +455,8 @@ class IntegrationPoints {
             if (shear_tying_[row].particle[std::size_t(k)] == particle)
               tied_corner = row * shell::max_cell_corners + std::size_t(k);
           const std::size_t k = count_of[particle]++;
-          particle_slots_[k] = slot(group, s);
           force_entries_[k] = ForceEntry{static_cast<std::uint32_t>(point(group, row)),
-                                         static_cast<std::uint32_t>(tied_corner), sf.phi[s], sf.dphi_d1[s],
-                                         sf.dphi_d2[s]};
+                                         static_cast<std::uint32_t>(tied_corner), static_cast<std::uint32_t>(s)};
         }
       }
     }
@@ -438,7 +470,7 @@ class IntegrationPoints {
   void check_tied_corners(PointGroup group, std::size_t row) {
     if (!shear_tied(group, row)) return;
     const approx::ShapeFunctions& sf = shape(group);
-    const shell::CellShearTying& tying = shear_tying_[row];
+    const shell::CellShearTie& tying = shear_tying_[row];
     const auto used_begin = sf.neighbour.begin() + std::ptrdiff_t(sf.row_begin[row]);
     const auto used_end = used_begin + sf.row_size[row];
     bool visible = true;
@@ -448,7 +480,7 @@ class IntegrationPoints {
   }
 
   void set_reference(std::size_t p, const shell::SurfaceGradients& g) {
-    reference_[p] = g;
+    if (keep_reference_) reference_[p] = g;
     reference_products_[p] = shell::reference_products(g);
   }
 
@@ -499,10 +531,12 @@ class IntegrationPoints {
   // nowhere to go: the support is too small for the cell.
   void tie_shear(const ShellModel& model, const PhysicsOptions& physics, double shear_modulus) {
     shear_tying_.clear();
+    shear_edges_.clear();
     tied_corners_visible_.clear();
     if (physics.transverse_shear != TransverseShear::cell_edges || model.cells().empty()) return;
     const approx::ShapeFunctions& sf = shape(PointGroup::stress_points);
     shear_tying_.resize(model.stress_point_count());
+    if (keep_reference_) shear_edges_.resize(shear_tying_.size());
     // Every corner is in its row (checked below) until a crack hides one.
     tied_corners_visible_.assign(shear_tying_.size(), 1);
     for (std::size_t row = 0; row < shear_tying_.size(); ++row) {
@@ -518,25 +552,29 @@ class IntegrationPoints {
                                         std::to_string(support_radius(PointGroup::stress_points, row)) + " m");
       }
       const double stiffness = physics.shear_correction * shear_modulus * model.stress_point_thickness(row);
-      shear_tying_[row] = shell::tie_cell_shear(cell.begin(), static_cast<int>(cell.size()), model.particle_position,
-                                                model.particle_normal, frame(PointGroup::stress_points, row),
-                                                stiffness, model.stress_point_area[row]);
+      const shell::CellShearTying tying =
+          shell::tie_cell_shear(cell.begin(), static_cast<int>(cell.size()), model.particle_position,
+                                model.particle_normal, frame(PointGroup::stress_points, row), stiffness,
+                                model.stress_point_area[row]);
+      shear_tying_[row] = tying;
+      if (keep_reference_) shear_edges_[row] = tying;
     }
   }
 
   std::array<std::vector<double>, 2> smoothing_length_;  // h_i per row of each group
   shell::CutVisibility cuts_;  // the model's cuts
-  std::vector<shell::CellShearTying> shear_tying_;  // per stress point, or empty
+  std::vector<shell::CellShearTie> shear_tying_;  // per stress point, or empty
+  std::vector<shell::CellShearEdges> shear_edges_;  // per stress point with shear_tying_ when keep_reference_
   std::vector<unsigned char> tied_corners_visible_;  // per stress point with shear_tying_
   std::array<approx::ShapeFunctions, 2> shape_;
   std::array<std::vector<TangentFrame>, 2> frames_;  // evaluation frames, kept for rebuilds
   std::array<std::size_t, 2> offset_{};
-  std::array<std::size_t, 2> slot_offset_{};
   std::vector<double> membrane_bending_weight_, shear_weight_;
-  std::vector<shell::SurfaceGradients> reference_;
+  bool keep_reference_ = true;  // a linear analysis: its reference gradients and tied edges are kept
+  std::vector<shell::SurfaceGradients> reference_;  // per point when keep_reference_, else empty
   std::vector<shell::ReferenceProducts> reference_products_;
-  std::vector<std::size_t> particle_slot_begin_, particle_slots_;
-  std::vector<ForceEntry> force_entries_;  // per particle, in particle_slots_ order
+  std::vector<std::size_t> particle_slot_begin_;
+  std::vector<ForceEntry> force_entries_;  // per particle, from particle_slot_begin_
   std::array<std::vector<unsigned char>, 2> rebuilt_;  // per row: changed by a crack since construction
   std::array<std::vector<std::size_t>, 2> global_row_;  // a subset's global rows (empty: the whole model)
 };

@@ -98,13 +98,24 @@ class InternalForceAssembler {
     const shell::ConjugateForces* const conjugate = conjugate_.data();
     const Vector3 *const tied_force = tied_force_.data(), *const tied_director_force = tied_director_force_.data();
     const std::size_t untied = points.untied_corner();
+    // Each group's Φ, ∂Φ/∂X1, ∂Φ/∂X2, picked by whether the entry's point is a
+    // particle point (those follow the stress points).
+    const approx::ShapeFunctions &stress_shape = points.shape(PointGroup::stress_points),
+                                 &particle_shape = points.shape(PointGroup::particles);
+    const double* const phi_of[2] = {stress_shape.phi.data(), particle_shape.phi.data()};
+    const double* const dphi_d1_of[2] = {stress_shape.dphi_d1.data(), particle_shape.dphi_d1.data()};
+    const double* const dphi_d2_of[2] = {stress_shape.dphi_d2.data(), particle_shape.dphi_d2.data()};
+    const std::size_t first_particle_point = points.point(PointGroup::particles, 0);
     parallel::for_each(std::size_t{0}, forces.internal.size(), [&](std::size_t i) noexcept {
       Vector3 force = Vector3::Zero(), director_force = Vector3::Zero();
       for (std::size_t k = begin[i]; k < begin[i + 1]; ++k) {
         const auto& entry = entries[k];
         const shell::ConjugateForces& f = conjugate[entry.point];
-        Vector3 slot_force = entry.dphi_d1 * f.a1 + entry.dphi_d2 * f.a2;
-        Vector3 slot_director_force = entry.phi * f.n + entry.dphi_d1 * f.n1 + entry.dphi_d2 * f.n2;
+        const std::size_t g = entry.point >= first_particle_point ? 1 : 0;
+        const double phi = phi_of[g][entry.slot], dphi_d1 = dphi_d1_of[g][entry.slot],
+                     dphi_d2 = dphi_d2_of[g][entry.slot];
+        Vector3 slot_force = dphi_d1 * f.a1 + dphi_d2 * f.a2;
+        Vector3 slot_director_force = phi * f.n + dphi_d1 * f.n1 + dphi_d2 * f.n2;
         if (entry.tied_corner != untied) {
           slot_force += tied_force[entry.tied_corner];
           slot_director_force += tied_director_force[entry.tied_corner];
@@ -125,11 +136,8 @@ class InternalForceAssembler {
   // for inactive points), for the energy ledger.
   const std::vector<double>& work_increments() const { return work_increment_; }
 
-  // Strains of a point's current gradients against its reference.
-  shell::Strains strains_of(const shell::SurfaceGradients& current, const shell::SurfaceGradients& reference) const {
-    return nonlinear_ ? shell::green_strains(current, reference) : shell::linear_strains(current, reference);
-  }
-  // The same for point p, with its precomputed reference products (the same numbers).
+  // Strains of point p's current gradients against its reference (the
+  // reference's dot products, computed once, in the nonlinear analysis).
   template <class Approx>
   shell::Strains strains_of(const shell::SurfaceGradients& current, const IntegrationPoints<Approx>& points,
                             std::size_t p) const {
@@ -220,10 +228,10 @@ class InternalForceAssembler {
       clear_tied_corners(row);
       return 0.0;
     }
-    const shell::CellShearTying& tying = points.shear_tying(row);
+    const shell::CellShearTie& tying = points.shear_tying(row);
     const std::size_t first = row * shell::max_cell_corners;
     return shell::corner_shear_forces(
-        tying, [&](int k) -> const Vector3& { return position(tying.particle[std::size_t(k)]); },
+        tying, points.shear_edges(row), [&](int k) -> const Vector3& { return position(tying.particle[std::size_t(k)]); },
         [&](int k) -> const Vector3& { return director(tying.particle[std::size_t(k)]); }, nonlinear_,
         &tied_force_[first], &tied_director_force_[first]);
   }

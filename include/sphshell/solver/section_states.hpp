@@ -18,6 +18,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace sphshell::solver {
@@ -160,15 +161,15 @@ class SectionStates {
   const std::vector<Section>& sections() const { return sections_; }
 
  private:
-  std::size_t section_for(const Law& law, double d) {
+  std::uint32_t section_for(const Law& law, double d) {
     for (std::size_t k = 0; k < sections_.size(); ++k)
-      if (sections_[k].thickness() == d) return k;
+      if (sections_[k].thickness() == d) return static_cast<std::uint32_t>(k);
     sections_.emplace_back(law, d);
-    return sections_.size() - 1;
+    return static_cast<std::uint32_t>(sections_.size() - 1);
   }
 
   std::vector<Section> sections_;
-  std::vector<std::size_t> section_index_;
+  std::vector<std::uint32_t> section_index_;  // 4 bytes a point: a model has far fewer thicknesses
   std::vector<State> state_;
   std::vector<StrainVoigt> membrane_strain_, curvature_;
   std::vector<Vector2> shear_, shear_force_;
