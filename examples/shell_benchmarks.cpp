@@ -52,8 +52,8 @@ std::optional<Arguments> parse(int argc, char** argv) {
                     "three coarse resolutions per case, without the slit annular plate (a quick run, for checks)");
   command_line.choice("--cases", arguments.cases, {"all", "linear", "nonlinear", "paths"},
                       "which benchmarks to run: all is linear and nonlinear; paths follows the whole load paths of "
-                      "Sze et al.'s hemisphere, pull-out and pinched cylinder by displacement control (one "
-                      "resolution each)");
+                      "Sze et al.'s hemisphere (at three resolutions), pull-out and pinched cylinder (one each) by "
+                      "displacement control, about 17 min");
   command_line.output_folder(arguments.output);
   command_line.writes("benchmarks.csv", "every run: case, resolution, value, reference, error, seconds");
   command_line.writes("end_shear.csv", "cantilever under end shear: P/Pmax, tip w and -u, the elastica's");
