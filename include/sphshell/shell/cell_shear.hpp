@@ -120,37 +120,6 @@ struct CellShearForces {
 // cell's edge in the step's hot loop.
 inline int next_corner(int k, int corners) { return k + 1 < corners ? k + 1 : 0; }
 
-// Edge strains from the corners' positions x(k) and directors d(k) (k the
-// corner: callers read them from wherever they keep them). The nonlinear form
-// is the exact dot product; the linear one (paper §3.1) its first-order part
-// about the reference configuration (X_b − X_a, N_a + N_b).
-template <class CornerPosition, class CornerDirector>
-inline Eigen::Matrix<double, max_cell_corners, 1> corner_edge_shear_strains(const CellShearTying& t,
-                                                                           const CornerPosition& x,
-                                                                           const CornerDirector& d, bool nonlinear) {
-  Eigen::Matrix<double, max_cell_corners, 1> strain = Eigen::Matrix<double, max_cell_corners, 1>::Zero();
-  for (int e = 0; e < t.corners; ++e) {
-    const int b = next_corner(e, t.corners);
-    const Vector3 chord = x(b) - x(e), director_sum = d(e) + d(b);
-    const double value = nonlinear ? chord.dot(director_sum)
-                                   : (chord - t.chord[e]).dot(t.normal_sum[e]) +
-                                         t.chord[e].dot(director_sum - t.normal_sum[e]) +
-                                         t.chord[e].dot(t.normal_sum[e]);
-    strain[e] = value * 0.5 * t.inverse_length[e] - t.reference_strain[e];
-  }
-  return strain;
-}
-
-// Edge strains from particle positions x and directors d.
-inline Eigen::Matrix<double, max_cell_corners, 1> cell_edge_shear_strains(const CellShearTying& t,
-                                                                         const std::vector<Vector3>& x,
-                                                                         const std::vector<Vector3>& d,
-                                                                         bool nonlinear) {
-  return corner_edge_shear_strains(
-      t, [&](int k) -> const Vector3& { return x[std::size_t(t.particle[std::size_t(k)])]; },
-      [&](int k) -> const Vector3& { return d[std::size_t(t.particle[std::size_t(k)])]; }, nonlinear);
-}
-
 // corner_shear_forces for a cell of a known corner count, so the edge loops
 // unroll. The edges' chords and director sums are kept from the strains for
 // the forces, and the forces are summed in locals and stored once (a store

@@ -406,8 +406,7 @@ class IntegrationPoints {
   // here would cost 24 bytes a slot), and which corner of the point's
   // edge-tied cell the particle is, as the index row × max_cell_corners +
   // corner of the tied corner forces the assembler keeps per stress point
-  // (untied_corner() when it is none: an index past them, whose forces the
-  // assembler keeps zero, so its sum adds them without a branch). Contiguous
+  // (untied_corner() when it is none: an index past them). Contiguous
   // per particle, so the per-particle sum streams through them; the slots of
   // one particle lie in rows near each other.
   struct ForceEntry {

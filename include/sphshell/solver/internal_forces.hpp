@@ -85,12 +85,12 @@ class InternalForceAssembler {
   // Deterministic per-particle sums: for each slot that refers to the particle,
   // in the order of IntegrationPoints::force_entries, the slot's force
   // ∂Φ/∂X1 F_a1 + ∂Φ/∂X2 F_a2 (director: Φ F_n + ∂Φ/∂X1 F_n1 + ∂Φ/∂X2 F_n2) of its
-  // point, plus the tied shear's force on that corner, is added. A removed
-  // point's forces, an untied slot's corner forces and those of a cell whose
-  // shear is left out are kept zero, so every slot adds the same terms without
-  // a branch. Adding a zero changes no bit of the sum: it starts at +0 and a
-  // sum of doubles is −0 only when both terms are, so it is never −0, and
-  // x + (±0) is x for any other x.
+  // point, plus the tied shear's force on that corner (a slot whose particle
+  // is a tied corner). A removed point's forces and the corner forces of a
+  // cell whose shear is left out are kept zero, so those slots add zeros
+  // instead of being skipped. Adding a zero changes no bit of the sum: it
+  // starts at +0 and a sum of doubles is −0 only when both terms are, so it is
+  // never −0, and x + (±0) is x for any other x.
   template <class Approx>
   void sum_particle_forces(const IntegrationPoints<Approx>& points, ParticleForces& forces) const {
     const std::vector<std::size_t>& begin = points.particle_slot_begin();
@@ -152,9 +152,9 @@ class InternalForceAssembler {
     if (conjugate_.size() != points.size()) {
       const Vector3 zero = Vector3::Zero();
       conjugate_.assign(points.size(), shell::ConjugateForces{zero, zero, zero, zero, zero});
-      // One more than the stress points' corners: untied_corner(), kept zero.
-      tied_force_.assign(points.untied_corner() + 1, zero);
-      tied_director_force_.assign(points.untied_corner() + 1, zero);
+      // Every stress point's corners (untied_corner() is their count).
+      tied_force_.assign(points.untied_corner(), zero);
+      tied_director_force_.assign(points.untied_corner(), zero);
     }
     work_increment_.assign(points.size(), 0.0);
   }
@@ -239,9 +239,8 @@ class InternalForceAssembler {
   bool nonlinear_;
   std::size_t failed_point_ = 0;
   // Per point: its conjugate forces (zero for a removed point). Per stress
-  // point corner (row × max_cell_corners + corner, then untied_corner()): the
-  // tied shear's forces on the corner particle and its director (zero where
-  // no tied shear acts).
+  // point corner (row × max_cell_corners + corner): the tied shear's forces
+  // on the corner particle and its director (zero where no tied shear acts).
   std::vector<shell::ConjugateForces> conjugate_;
   std::vector<Vector3> tied_force_, tied_director_force_;
   std::vector<double> work_increment_;
