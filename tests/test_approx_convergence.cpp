@@ -39,7 +39,7 @@ double gradient_error(int n, bool at_particles) {
     if (std::min({x.x(), x.y(), 1.0 - x.x(), 1.0 - x.y()}) < support - 1e-12) continue;
     Vector2 gradient = Vector2::Zero();
     for (std::size_t s = sf.row_begin[r]; s < sf.row_begin[r] + std::size_t(sf.row_size[r]); ++s)
-      gradient += field(sets.particles[std::size_t(sf.neighbour[s])]) * Vector2(sf.dphi_d1[s], sf.dphi_d2[s]);
+      gradient += field(sets.particles[std::size_t(sf.neighbour[s])]) * Vector2(sf.value[s].dphi_d1, sf.value[s].dphi_d2);
     worst = std::max(worst, (gradient - field_gradient(x)).norm());
   }
   return worst;

@@ -54,9 +54,9 @@ void check_rows_equal(const ShapeFunctions& a, const ShapeFunctions& b, std::siz
   CHECK(a.shepard[r] == b.shepard[r]);
   for (std::size_t s = a.row_begin[r]; s < a.row_begin[r + 1]; ++s) {
     CHECK(a.neighbour[s] == b.neighbour[s]);
-    CHECK(a.phi[s] == b.phi[s]);
-    CHECK(a.dphi_d1[s] == b.dphi_d1[s]);
-    CHECK(a.dphi_d2[s] == b.dphi_d2[s]);
+    CHECK(a.value[s].phi == b.value[s].phi);
+    CHECK(a.value[s].dphi_d1 == b.value[s].dphi_d1);
+    CHECK(a.value[s].dphi_d2 == b.value[s].dphi_d2);
   }
 }
 
@@ -85,14 +85,14 @@ TEMPLATE_TEST_CASE("Rows with fewer than three visible neighbours fall back to S
       kernel::CubicSpline::value((sets.particles[first] - sets.eval_positions[target]).norm(), h);
   const double w_second =
       kernel::CubicSpline::value((sets.particles[second] - sets.eval_positions[target]).norm(), h);
-  CHECK(cut.phi[begin] == Approx(w_first / (w_first + w_second)).epsilon(1e-14));
-  CHECK(cut.phi[begin] + cut.phi[begin + 1] == Approx(1.0).epsilon(1e-15));
+  CHECK(cut.value[begin].phi == Approx(w_first / (w_first + w_second)).epsilon(1e-14));
+  CHECK(cut.value[begin].phi + cut.value[begin + 1].phi == Approx(1.0).epsilon(1e-15));
   std::size_t hidden_slots = 0;
   for (std::size_t s = begin; s < cut.row_begin[target + 1]; ++s) {
-    CHECK(cut.dphi_d1[s] == 0.0);
-    CHECK(cut.dphi_d2[s] == 0.0);
+    CHECK(cut.value[s].dphi_d1 == 0.0);
+    CHECK(cut.value[s].dphi_d2 == 0.0);
     if (s >= begin + 2) {
-      CHECK(cut.phi[s] == 0.0);
+      CHECK(cut.value[s].phi == 0.0);
       ++hidden_slots;
     }
   }

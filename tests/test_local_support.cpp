@@ -91,12 +91,12 @@ void check_first_order(const ShellModel& model, bool linear_values) {
       for (std::size_t s = sf.row_begin[row]; s < sf.row_begin[row] + sf.row_size[row]; ++s) {
         const Vector3 d = model.particle_position[static_cast<std::size_t>(sf.neighbour[s])] - eval[row];
         const Vector2 xi(d.dot(e1), d.dot(e2));
-        sum += sf.phi[s];
-        d1 += sf.dphi_d1[s];
-        d2 += sf.dphi_d2[s];
-        first += sf.phi[s] * xi;
-        gradient.col(0) += sf.dphi_d1[s] * xi;
-        gradient.col(1) += sf.dphi_d2[s] * xi;
+        sum += sf.value[s].phi;
+        d1 += sf.value[s].dphi_d1;
+        d2 += sf.value[s].dphi_d2;
+        first += sf.value[s].phi * xi;
+        gradient.col(0) += sf.value[s].dphi_d1 * xi;
+        gradient.col(1) += sf.value[s].dphi_d2 * xi;
         scale = std::max(scale, xi.norm());
       }
       const double h = points.smoothing_length(group, row);

@@ -564,7 +564,7 @@ class Solver {
     const approx::ShapeFunctions& shape = points_.shape(solver::PointGroup::stress_points);
     parallel::for_each(std::size_t{0}, positions.size(), [&](std::size_t row) noexcept {
       for (std::size_t s = shape.row_begin[row]; s < shape.row_begin[row] + shape.row_size[row]; ++s)
-        positions[row] += shape.phi[s] * particles_.position[shape.neighbour[s]];
+        positions[row] += shape.value[s].phi * particles_.position[shape.neighbour[s]];
     });
     return positions;
   }

@@ -74,11 +74,11 @@ void check_round_trip(const mpi::Communicator& comm, const mpi_test::Case& c) {
       shell::SurfaceGradients mine;
       for (std::size_t s = local.row_begin[k]; s < local.row_begin[k] + local.row_size[k]; ++s) {
         const int j = local.neighbour[s];
-        mine.a1 += local.dphi_d1[s] * x[j];
-        mine.a2 += local.dphi_d2[s] * x[j];
-        mine.n += local.phi[s] * d[j];
-        mine.n1 += local.dphi_d1[s] * d[j];
-        mine.n2 += local.dphi_d2[s] * d[j];
+        mine.a1 += local.value[s].dphi_d1 * x[j];
+        mine.a2 += local.value[s].dphi_d2 * x[j];
+        mine.n += local.value[s].phi * d[j];
+        mine.n1 += local.value[s].dphi_d1 * d[j];
+        mine.n2 += local.value[s].dphi_d2 * d[j];
       }
       if (mine.a1 != serial.a1 || mine.a2 != serial.a2 || mine.n != serial.n || mine.n1 != serial.n1 ||
           mine.n2 != serial.n2)
@@ -174,8 +174,8 @@ TEST_CASE("halo: after a crack rebuild the local rows still gather the serial va
     const shell::SurfaceGradients serial = plate.points->gather(group, row, x_global, d_global);
     Vector3 a1 = Vector3::Zero(), n = Vector3::Zero();
     for (std::size_t s = local.row_begin[k]; s < local.row_begin[k] + local.row_size[k]; ++s) {
-      a1 += local.dphi_d1[s] * x[local.neighbour[s]];
-      n += local.phi[s] * d[local.neighbour[s]];
+      a1 += local.value[s].dphi_d1 * x[local.neighbour[s]];
+      n += local.value[s].phi * d[local.neighbour[s]];
     }
     if (a1 != serial.a1 || n != serial.n) ++different;
   }

@@ -81,7 +81,7 @@ void check_decomposition(const mpi::Communicator& comm, const mpi_test::Case& c)
       for (std::size_t s = 0; s < shape.capacity(row); ++s) {
         const std::size_t global_slot = shape.row_begin[row] + s, local_slot = local.row_begin[k] + s;
         if (layout.global_of(static_cast<std::size_t>(local.neighbour[local_slot])) != shape.neighbour[global_slot] ||
-            local.phi[local_slot] != shape.phi[global_slot] || local.dphi_d1[local_slot] != shape.dphi_d1[global_slot])
+            local.value[local_slot].phi != shape.value[global_slot].phi || local.value[local_slot].dphi_d1 != shape.value[global_slot].dphi_d1)
           ++mismatched;
       }
     }

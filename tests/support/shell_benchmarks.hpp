@@ -79,7 +79,7 @@ ParticleWeights shape_function_weights(const ShellModel& model, const Vector3& p
   const approx::ShapeFunctions sf =
       Approx::build(model.particle_position, model.particle_area, {point}, {tangent_frame(normal)}, h);
   ParticleWeights weights;
-  for (int k = 0; k < sf.row_size[0]; ++k) weights.push_back({sf.neighbour[k], sf.phi[k]});
+  for (int k = 0; k < sf.row_size[0]; ++k) weights.push_back({sf.neighbour[k], sf.value[k].phi});
   return weights;
 }
 

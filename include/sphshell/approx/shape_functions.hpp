@@ -14,13 +14,27 @@ namespace sphshell::approx {
 // crack cuts more pairs — from its full geometric neighbour set. Code that
 // shrinks a row itself should therefore permute slots rather than overwrite
 // neighbour indices.
+// Φ_j and ∇Φ_j of one slot, kept side by side: the gather reads a row's slots
+// in order, but the per-particle force sum visits the slots that refer to one
+// particle — scattered over many rows — and needs all three of each, so one
+// cache line then serves a slot instead of three.
+struct ShapeValue {
+  double phi = 0.0;      // Φ_j at the evaluation point
+  double dphi_d1 = 0.0;  // ∇Φ_j in the evaluation point's tangent frame (e1, e2)
+  double dphi_d2 = 0.0;
+
+  friend bool operator==(const ShapeValue& a, const ShapeValue& b) {
+    return a.phi == b.phi && a.dphi_d1 == b.dphi_d1 && a.dphi_d2 == b.dphi_d2;
+  }
+  friend bool operator!=(const ShapeValue& a, const ShapeValue& b) { return !(a == b); }
+};
+
 struct ShapeFunctions {
-  std::vector<std::size_t> row_begin;    // size rows+1
-  std::vector<int> row_size;             // used slots of row r (<= capacity)
-  std::vector<int> neighbour;            // particle index per slot
-  std::vector<double> phi;               // Φ_j at the evaluation point
-  std::vector<double> dphi_d1, dphi_d2;  // ∇Φ_j in the evaluation point's tangent frame (e1, e2)
-  std::vector<unsigned char> shepard;    // per row: 1 when the row fell back to the Shepard approximation
+  std::vector<std::size_t> row_begin;  // size rows+1
+  std::vector<int> row_size;           // used slots of row r (<= capacity)
+  std::vector<int> neighbour;          // particle index per slot
+  std::vector<ShapeValue> value;       // Φ_j, ∇Φ_j per slot
+  std::vector<unsigned char> shepard;  // per row: 1 when the row fell back to the Shepard approximation
 
   std::size_t rows() const { return row_size.size(); }
   std::size_t capacity(std::size_t row) const { return row_begin[row + 1] - row_begin[row]; }
@@ -29,8 +43,7 @@ struct ShapeFunctions {
   // Heap bytes held by the storage (what a row costs in memory).
   std::size_t bytes() const {
     return row_begin.capacity() * sizeof(std::size_t) + row_size.capacity() * sizeof(int) +
-           neighbour.capacity() * sizeof(int) +
-           (phi.capacity() + dphi_d1.capacity() + dphi_d2.capacity()) * sizeof(double) +
+           neighbour.capacity() * sizeof(int) + value.capacity() * sizeof(ShapeValue) +
            shepard.capacity() * sizeof(unsigned char);
   }
 };

@@ -729,7 +729,7 @@ class DistributedSolver {
     const approx::ShapeFunctions& shape = points_->shape(solver::PointGroup::stress_points);
     Vector3 position = Vector3::Zero();
     for (std::size_t s = shape.row_begin[k]; s < shape.row_begin[k] + shape.row_size[k]; ++s)
-      position += shape.phi[s] * particles_.position[static_cast<std::size_t>(shape.neighbour[s])];
+      position += shape.value[s].phi * particles_.position[static_cast<std::size_t>(shape.neighbour[s])];
     return position;
   }
   // Local stress-point rows owned here, in global order.

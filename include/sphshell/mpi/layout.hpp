@@ -111,9 +111,7 @@ inline approx::ShapeFunctions local_rows(const approx::ShapeFunctions& global, c
                                                 std::to_string(layout.rank),
                                             global.neighbour[s], "is neither owned nor a ghost");
       local.neighbour.push_back(j);
-      local.phi.push_back(global.phi[s]);
-      local.dphi_d1.push_back(global.dphi_d1[s]);
-      local.dphi_d2.push_back(global.dphi_d2[s]);
+      local.value.push_back(global.value[s]);
     }
     local.row_begin.push_back(local.neighbour.size());
     local.row_size.push_back(global.row_size[row]);

@@ -127,9 +127,7 @@ class IntegrationPoints {
       for (std::size_t row : rows[g]) {
         for (std::size_t s = from.row_begin[row]; s < from.row_begin[row + 1]; ++s) {
           to.neighbour.push_back(local(from.neighbour[s], group, row));
-          to.phi.push_back(from.phi[s]);
-          to.dphi_d1.push_back(from.dphi_d1[s]);
-          to.dphi_d2.push_back(from.dphi_d2[s]);
+          to.value.push_back(from.value[s]);
         }
         to.row_begin.push_back(to.neighbour.size());
         to.row_size.push_back(from.row_size[row]);
@@ -179,9 +177,7 @@ class IntegrationPoints {
       if (to.neighbour[s] < 0)
         detail::invalid_parameter(std::string("particle of ") + name_of(group) + " row " + std::to_string(from_row),
                                   source.neighbour[t], "is not local to the subset (its rows need it)");
-      to.phi[s] = source.phi[t];
-      to.dphi_d1[s] = source.dphi_d1[t];
-      to.dphi_d2[s] = source.dphi_d2[t];
+      to.value[s] = source.value[t];
     }
     to.row_size[row] = source.row_size[from_row];
     to.shepard[row] = source.shepard[from_row];
@@ -263,11 +259,12 @@ class IntegrationPoints {
     const std::size_t end = sf.row_begin[row] + sf.row_size[row];
     for (std::size_t s = sf.row_begin[row]; s < end; ++s) {
       const int j = sf.neighbour[s];
-      g.a1 += sf.dphi_d1[s] * x[j];
-      g.a2 += sf.dphi_d2[s] * x[j];
-      g.n += sf.phi[s] * d[j];
-      g.n1 += sf.dphi_d1[s] * d[j];
-      g.n2 += sf.dphi_d2[s] * d[j];
+      const approx::ShapeValue& v = sf.value[s];
+      g.a1 += v.dphi_d1 * x[j];
+      g.a2 += v.dphi_d2 * x[j];
+      g.n += v.phi * d[j];
+      g.n1 += v.dphi_d1 * d[j];
+      g.n2 += v.dphi_d2 * d[j];
     }
     return g;
   }
@@ -281,18 +278,19 @@ class IntegrationPoints {
   shell::SurfaceGradients gather(PointGroup group, std::size_t row, const std::vector<PackedKinematics>& packed) const {
     const approx::ShapeFunctions& sf = shape(group);
     const int* const neighbour = sf.neighbour.data();
-    const double *const phi = sf.phi.data(), *const dphi_d1 = sf.dphi_d1.data(), *const dphi_d2 = sf.dphi_d2.data();
+    const approx::ShapeValue* const value = sf.value.data();
     const PackedKinematics* const particles = packed.data();
     Vector3 a1 = Vector3::Zero(), a2 = Vector3::Zero(), n = Vector3::Zero(), n1 = Vector3::Zero(),
             n2 = Vector3::Zero();
     const std::size_t end = sf.row_begin[row] + sf.row_size[row];
     for (std::size_t s = sf.row_begin[row]; s < end; ++s) {
       const PackedKinematics& particle = particles[std::size_t(neighbour[s])];
-      a1 += dphi_d1[s] * particle.position;
-      a2 += dphi_d2[s] * particle.position;
-      n += phi[s] * particle.director;
-      n1 += dphi_d1[s] * particle.director;
-      n2 += dphi_d2[s] * particle.director;
+      const double phi = value[s].phi, dphi_d1 = value[s].dphi_d1, dphi_d2 = value[s].dphi_d2;
+      a1 += dphi_d1 * particle.position;
+      a2 += dphi_d2 * particle.position;
+      n += phi * particle.director;
+      n1 += dphi_d1 * particle.director;
+      n2 += dphi_d2 * particle.director;
     }
     shell::SurfaceGradients g;
     g.a1 = a1;
@@ -341,7 +339,7 @@ class IntegrationPoints {
       for (const std::uint64_t row : rows) {
         const std::size_t begin = sf.row_begin[row], end = sf.row_begin[row + 1];
         out(static_cast<std::uint64_t>(end - begin), sf.row_size[row], sf.shepard[row]);
-        for (std::size_t s = begin; s < end; ++s) out(sf.neighbour[s], sf.phi[s], sf.dphi_d1[s], sf.dphi_d2[s]);
+        for (std::size_t s = begin; s < end; ++s) out(sf.neighbour[s], sf.value[s].phi, sf.value[s].dphi_d1, sf.value[s].dphi_d2);
         const shell::SurfaceGradients g = keep_reference_ ? reference_[point(group, row)]
                                                           : gather(group, row, reference_positions,
                                                                    reference_normals);
@@ -378,7 +376,7 @@ class IntegrationPoints {
         if (sf.row_size[row] < 0 || static_cast<std::size_t>(sf.row_size[row]) > capacity)
           in.fail(std::string(name_of(group)) + " row " + std::to_string(row) + " uses more slots than it has");
         for (std::size_t s = sf.row_begin[row]; s < sf.row_begin[row + 1]; ++s) {
-          in(sf.neighbour[s], sf.phi[s], sf.dphi_d1[s], sf.dphi_d2[s]);
+          in(sf.neighbour[s], sf.value[s].phi, sf.value[s].dphi_d1, sf.value[s].dphi_d2);
           if (sf.neighbour[s] < 0 || static_cast<std::size_t>(sf.neighbour[s]) >= particle_count)
             in.fail(std::string(name_of(group)) + " row " + std::to_string(row) + " names particle " +
                     std::to_string(sf.neighbour[s]));

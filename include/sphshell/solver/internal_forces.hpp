@@ -100,11 +100,8 @@ class InternalForceAssembler {
     const std::size_t untied = points.untied_corner();
     // Each group's Φ, ∂Φ/∂X1, ∂Φ/∂X2, picked by whether the entry's point is a
     // particle point (those follow the stress points).
-    const approx::ShapeFunctions &stress_shape = points.shape(PointGroup::stress_points),
-                                 &particle_shape = points.shape(PointGroup::particles);
-    const double* const phi_of[2] = {stress_shape.phi.data(), particle_shape.phi.data()};
-    const double* const dphi_d1_of[2] = {stress_shape.dphi_d1.data(), particle_shape.dphi_d1.data()};
-    const double* const dphi_d2_of[2] = {stress_shape.dphi_d2.data(), particle_shape.dphi_d2.data()};
+    const approx::ShapeValue* const value_of[2] = {points.shape(PointGroup::stress_points).value.data(),
+                                                   points.shape(PointGroup::particles).value.data()};
     const std::size_t first_particle_point = points.point(PointGroup::particles, 0);
     parallel::for_each(std::size_t{0}, forces.internal.size(), [&](std::size_t i) noexcept {
       Vector3 force = Vector3::Zero(), director_force = Vector3::Zero();
@@ -112,8 +109,8 @@ class InternalForceAssembler {
         const auto& entry = entries[k];
         const shell::ConjugateForces& f = conjugate[entry.point];
         const std::size_t g = entry.point >= first_particle_point ? 1 : 0;
-        const double phi = phi_of[g][entry.slot], dphi_d1 = dphi_d1_of[g][entry.slot],
-                     dphi_d2 = dphi_d2_of[g][entry.slot];
+        const approx::ShapeValue& value = value_of[g][entry.slot];
+        const double phi = value.phi, dphi_d1 = value.dphi_d1, dphi_d2 = value.dphi_d2;
         Vector3 slot_force = dphi_d1 * f.a1 + dphi_d2 * f.a2;
         Vector3 slot_director_force = phi * f.n + dphi_d1 * f.n1 + dphi_d2 * f.n2;
         if (entry.tied_corner != untied) {

@@ -36,11 +36,12 @@ struct RowWorkspace {
   std::vector<double> xi1, xi2;          // tangent-plane coordinates of x_j − x
   std::vector<double> weight;            // V_j W(|x_j − x|)
   std::vector<double> dweight_d1, dweight_d2;  // its derivative w.r.t. the evaluation point along e1, e2
+  std::vector<double> phi, dphi_d1, dphi_d2;   // the method's Φ_j, ∇Φ_j, before they go to the row's slots
   std::size_t count = 0;
 
   void reserve(std::size_t n) {
     if (ordered.size() >= n) return;
-    for (auto* v : {&xi1, &xi2, &weight, &dweight_d1, &dweight_d2}) v->resize(n);
+    for (auto* v : {&xi1, &xi2, &weight, &dweight_d1, &dweight_d2, &phi, &dphi_d1, &dphi_d2}) v->resize(n);
     ordered.resize(n);
   }
 };
@@ -156,21 +157,18 @@ void compute_row(ShapeFunctions& sf, std::size_t row, const std::vector<Vector3>
   }
   ws.count = visible_count;
 
-  double* phi = sf.phi.data() + begin;
-  double* d1 = sf.dphi_d1.data() + begin;
-  double* d2 = sf.dphi_d2.data() + begin;
   // A first-order fit needs three neighbours not on one line; Method reports
   // a (nearly) singular system by returning false.
-  const bool linear = visible_count >= 3 && weight_sum > 0.0 && Method::solve(ws, h, phi, d1, d2);
-  if (!linear) {
+  const bool linear = visible_count >= 3 && weight_sum > 0.0 &&
+                      Method::solve(ws, h, ws.phi.data(), ws.dphi_d1.data(), ws.dphi_d2.data());
+  ShapeValue* const value = sf.value.data() + begin;
+  if (linear) {
+    for (std::size_t k = 0; k < visible_count; ++k) value[k] = ShapeValue{ws.phi[k], ws.dphi_d1[k], ws.dphi_d2[k]};
+  } else {
     if (!(weight_sum > 0.0)) throw_no_visible_neighbour(row, x, Kernel::support_radius_factor * h, capacity);
-    for (std::size_t k = 0; k < visible_count; ++k) {
-      phi[k] = ws.weight[k] / weight_sum;
-      d1[k] = 0.0;
-      d2[k] = 0.0;
-    }
+    for (std::size_t k = 0; k < visible_count; ++k) value[k] = ShapeValue{ws.weight[k] / weight_sum, 0.0, 0.0};
   }
-  for (std::size_t k = visible_count; k < capacity; ++k) phi[k] = d1[k] = d2[k] = 0.0;
+  for (std::size_t k = visible_count; k < capacity; ++k) value[k] = ShapeValue{};
   sf.row_size[row] = static_cast<int>(visible_count);
   sf.shepard[row] = linear ? 0 : 1;
 }
@@ -326,9 +324,7 @@ ShapeFunctions build_all_unguarded(const std::vector<Vector3>& particles,
   for (std::size_t r = 0; r < rows; ++r) sf.row_begin[r + 1] += sf.row_begin[r];
   const std::size_t slots = sf.row_begin[rows];
   sf.neighbour.resize(slots);
-  sf.phi.resize(slots);
-  sf.dphi_d1.resize(slots);
-  sf.dphi_d2.resize(slots);
+  sf.value.resize(slots);
   parallel::for_each(std::ptrdiff_t{0}, block_count, [&](std::ptrdiff_t block) noexcept {
     std::vector<int>& list = gathered[static_cast<std::size_t>(block)];
     std::copy(list.begin(), list.end(),
