@@ -73,9 +73,6 @@ struct ResultantState {
 
 template <class Law>
 class Section<Global, Law> {
-  using Vector6 = Eigen::Matrix<double, 6, 1>;
-  using Matrix6 = Eigen::Matrix<double, 6, 6>;
-
  public:
   static constexpr int num_points = 0;
   static constexpr int output_points = 1;
@@ -99,34 +96,22 @@ class Section<Global, Law> {
     Matrix3 xi;
     xi << 1.0, -0.5, 0.0, -0.5, 1.0, 0.0, 0.0, 0.0, 3.0;
 
-    stiffness_.setZero();
-    stiffness_.template topLeftCorner<3, 3>() = d * gamma;
-    stiffness_.template bottomRightCorner<3, 3>() = d * d * d / 12.0 * gamma;
-    compliance_.setZero();
-    compliance_.template topLeftCorner<3, 3>() = (d * gamma).inverse();
-    compliance_.template bottomRightCorner<3, 3>() = (d * d * d / 12.0 * gamma).inverse();
-
-    uncoupled_metric_.setZero();
-    uncoupled_metric_.template topLeftCorner<3, 3>() = xi / (d * d);
-    uncoupled_metric_.template bottomRightCorner<3, 3>() = 16.0 * xi / (d * d * d * d);
-    coupling_metric_.setZero();
-    coupling_metric_.template topRightCorner<3, 3>() = 2.0 * xi / (std::sqrt(3.0) * d * d * d);
-    coupling_metric_.template bottomLeftCorner<3, 3>() = 2.0 * xi / (std::sqrt(3.0) * d * d * d);
+    membrane_stiffness_ = d * gamma;
+    bending_stiffness_ = d * d * d / 12.0 * gamma;
+    membrane_compliance_ = membrane_stiffness_.inverse();
+    bending_compliance_ = bending_stiffness_.inverse();
 
     // Γ and Ξ share the eigenvectors q_i (docs/method.md §5), so the 6×6 return decouples
-    // into three 2×2 systems in (N·q_i, M·q_i); ΓΞ q_i = λ_i q_i.
-    modal_basis_ << 1.0 / std::sqrt(2.0), 1.0 / std::sqrt(2.0), 0.0,
-                    1.0 / std::sqrt(2.0), -1.0 / std::sqrt(2.0), 0.0,
-                    0.0, 0.0, 1.0;
+    // into three 2×2 systems in (N·q_i, M·q_i); ΓΞ q_i = λ_i q_i, Ξ q_i = w_i q_i.
+    const double r = 1.0 / std::sqrt(2.0);
+    const Vector3 q[3] = {Vector3(r, r, 0.0), Vector3(r, -r, 0.0), Vector3(0.0, 0.0, 1.0)};
     for (int i = 0; i < 3; ++i) {
-      const Vector3 q = modal_basis_.col(i);
-      mises_eigenvalues_[std::size_t(i)] = q.dot(xi * q);
-      flow_eigenvalues_[std::size_t(i)] = q.dot(gamma * xi * q);
+      mises_eigenvalues_[std::size_t(i)] = q[i].dot(xi * q[i]);
+      flow_eigenvalues_[std::size_t(i)] = q[i].dot(gamma * xi * q[i]);
     }
-    section_stiffness_ << d, 0.0, 0.0, d * d * d / 12.0;
-    uncoupled_modal_metric_ << 1.0 / (d * d), 0.0, 0.0, 16.0 / (d * d * d * d);
-    coupling_modal_metric_ << 0.0, 2.0 / (std::sqrt(3.0) * d * d * d),
-                              2.0 / (std::sqrt(3.0) * d * d * d), 0.0;
+    membrane_scale_ = 1.0 / d;
+    moment_scale_ = 4.0 / (d * d);
+    for (int side = 0; side < 3; ++side) side_metrics_[std::size_t(side)] = ridge_metric(double(side - 1));
 
     if constexpr (Law::has_plasticity) {
       const material::HardeningParameters hardening = law.hardening();
@@ -153,14 +138,20 @@ class Section<Global, Law> {
       sphshell::detail::invalid_parameter("strain increment", "non-finite",
                                           "membrane strain and curvature increments must be finite");
     if (state.failed) return {};
-    Vector6 d_generalized_strain;
-    d_generalized_strain << d_membrane_strain, d_curvature;
-    const Vector6 trial = pack(state) / (1.0 - state.D) + stiffness_ * d_generalized_strain;
-    Vector6 effective = trial;
+    // Elastic predictor on the effective resultants, block by block (the section
+    // stiffness diag(dΓ, d³/12 Γ) has no membrane–bending coupling).
+    Vector3 membrane = state.membrane, moment = state.moment;
+    if constexpr (Law::has_damage) {
+      membrane /= 1.0 - state.D;
+      moment /= 1.0 - state.D;
+    }
+    membrane += membrane_stiffness_ * d_membrane_strain;
+    moment += bending_stiffness_ * d_curvature;
     if constexpr (Law::has_plasticity) {
-      if (equivalent(trial) > state.sigma_y) {
+      const Modal trial = modal(membrane, moment);
+      if (equivalent_squared(trial) > state.sigma_y * state.sigma_y) {
         const ReturnResult result = plastic_return(trial, state.sigma_y);
-        effective = result.resultants;
+        if (result.d_eps_p > 0.0) cartesian(result.resultants, membrane, moment);
         state.eps_p += result.d_eps_p;
         state.sigma_y += hardening_modulus_ * result.d_eps_p;
         if constexpr (Law::has_damage) grow_damage(state, result.d_eps_p);
@@ -171,9 +162,12 @@ class Section<Global, Law> {
       state.moment.setZero();
       return {};
     }
-    const Vector6 nominal = (1.0 - state.D) * effective;
-    state.membrane = nominal.template head<3>();
-    state.moment = nominal.template tail<3>();
+    if constexpr (Law::has_damage) {
+      membrane *= 1.0 - state.D;
+      moment *= 1.0 - state.D;
+    }
+    state.membrane = membrane;
+    state.moment = moment;
     return resultants(state);
   }
 
@@ -182,7 +176,7 @@ class Section<Global, Law> {
   // The single output point is the Ilyushin generalized equivalent stress σ̄_I.
   double equivalent_stress(const State& state, int k) const {
     check(k);
-    return equivalent(pack(state));
+    return std::sqrt(equivalent_squared(modal(state.membrane, state.moment)));
   }
   double equivalent_plastic_strain(const State& state, int k) const {
     check(k);
@@ -196,8 +190,10 @@ class Section<Global, Law> {
 
   double elastic_energy(const State& state) const {
     if (state.failed) return 0.0;
-    const Vector6 x = pack(state);
-    return 0.5 * x.dot(compliance_ * x) / (1.0 - state.D);
+    return 0.5 *
+           (state.membrane.dot(membrane_compliance_ * state.membrane) +
+            state.moment.dot(bending_compliance_ * state.moment)) /
+           (1.0 - state.D);
   }
 
   // The one output point sits on the mid-surface and stands for the whole thickness.
@@ -215,47 +211,98 @@ class Section<Global, Law> {
   // F·σs² = xᵀÂ_s x with s = sign(Q_tm): exposed so callers and tests can check
   // admissibility (F <= 1) without redoing the algebra.
   double ilyushin_function(const State& state) const {
-    const double equivalent_stress = equivalent(pack(state));
-    return equivalent_stress * equivalent_stress /
-           ((1.0 - state.D) * (1.0 - state.D) * state.sigma_y * state.sigma_y);
+    const double equivalent_squared_stress = equivalent_squared(modal(state.membrane, state.moment));
+    return equivalent_squared_stress / ((1.0 - state.D) * (1.0 - state.D) * state.sigma_y * state.sigma_y);
   }
 
  private:
+  // Resultants in the modal basis, scaled to stresses: column i holds
+  // (n_i, m_i) = (N·q_i/d, 4 M·q_i/d²), so pure tension N0 and pure bending M0
+  // both read σs. In these variables
+  //   σ̄_I² = Σ_i w_i (n_i² + m_i² + s n_i m_i/√3),  Q_tm σs²/√3 = Σ_i w_i n_i m_i/√3.
+  using Modal = Eigen::Matrix<double, 2, 3>;
+
   struct ReturnResult {
-    Vector6 resultants;
+    Modal resultants;
     double d_eps_p;
   };
+
+  // The 2×2 metric of a mode in the symmetrized variables h = (n, m √3/2),
+  //   R_s = [[1, s/3], [s/3, 4/3]] = Σ_k ω_k u_k u_kᵀ,
+  // and its eigenpairs in closed form; the flow of mode i then scales the
+  // components h·u_k by 1/(1 + λ_i ω_k Δε̄p/σs) (derivation at plastic_return).
+  struct RidgeMetric {
+    double s;
+    std::array<double, 2> omega;
+    Vector2 u0, u1;
+  };
+
+  static RidgeMetric ridge_metric(double s) {
+    RidgeMetric metric;
+    metric.s = s;
+    const double root = std::sqrt(1.0 + 4.0 * s * s);
+    metric.omega = {(7.0 - root) / 6.0, (7.0 + root) / 6.0};
+    // (R_s − ω_0 I) u_0 = 0 with u_0 ∝ (ω_0 − 4/3, s/3) ∝ (1 + √(1+4s²), −2s), never zero.
+    const Vector2 u(1.0 + root, -2.0 * s);
+    metric.u0 = u / u.norm();
+    metric.u1 = Vector2(-metric.u0.y(), metric.u0.x());
+    return metric;
+  }
 
   static void check(int k) {
     if (k != 0)
       sphshell::detail::invalid_parameter("output point index", k, "Global has only point 0");
   }
 
-  static Vector6 pack(const State& state) {
-    Vector6 x;
-    x << state.membrane, state.moment;
+  // The modal basis q_i is symmetric and orthogonal: (a, a, 0), (a, −a, 0), (0, 0, 1).
+  Modal modal(const Vector3& membrane, const Vector3& moment) const {
+    const double a = 1.0 / std::sqrt(2.0);
+    Modal x;
+    x(0, 0) = membrane_scale_ * a * (membrane.x() + membrane.y());
+    x(0, 1) = membrane_scale_ * a * (membrane.x() - membrane.y());
+    x(0, 2) = membrane_scale_ * membrane.z();
+    x(1, 0) = moment_scale_ * a * (moment.x() + moment.y());
+    x(1, 1) = moment_scale_ * a * (moment.x() - moment.y());
+    x(1, 2) = moment_scale_ * moment.z();
     return x;
   }
 
-  // 4 NᵀΞM/(√3 d³) = σs² Q_tm/√3: the signed coupling term of σ̄_I².
-  double coupling_term(const Vector6& x) const { return x.dot(coupling_metric_ * x); }
-
-  double equivalent(const Vector6& x) const {
-    return std::sqrt(x.dot(uncoupled_metric_ * x) + std::abs(coupling_term(x)));
+  void cartesian(const Modal& x, Vector3& membrane, Vector3& moment) const {
+    const double a = 1.0 / std::sqrt(2.0);
+    const double n = 1.0 / membrane_scale_, m = 1.0 / moment_scale_;
+    membrane = Vector3(n * a * (x(0, 0) + x(0, 1)), n * a * (x(0, 0) - x(0, 1)), n * x(0, 2));
+    moment = Vector3(m * a * (x(1, 0) + x(1, 1)), m * a * (x(1, 0) - x(1, 1)), m * x(1, 2));
   }
 
-  ReturnResult plastic_return(const Vector6& trial, double sigma_y_n) const {
+  // σs² Q_tm/√3 = 4 NᵀΞM/(√3 d³): the signed coupling term of σ̄_I².
+  double coupling_term(const Modal& x) const {
+    double sum = 0.0;
+    for (int i = 0; i < 3; ++i) sum += mises_eigenvalues_[std::size_t(i)] * x(0, i) * x(1, i);
+    return sum / std::sqrt(3.0);
+  }
+
+  double equivalent_squared(const Modal& x) const {
+    double uncoupled = 0.0;
+    for (int i = 0; i < 3; ++i)
+      uncoupled += mises_eigenvalues_[std::size_t(i)] * (x(0, i) * x(0, i) + x(1, i) * x(1, i));
+    return uncoupled + std::abs(coupling_term(x));
+  }
+
+  const RidgeMetric& side_metric(double side) const { return side_metrics_[std::size_t(int(side) + 1)]; }
+
+  ReturnResult plastic_return(const Modal& trial, double sigma_y_n) const {
     const double tolerance = ridge_tolerance * sigma_y_n * sigma_y_n;
     // Pure bending or pure tension: the trial is on the ridge and s = 0 keeps it there.
-    if (std::abs(coupling_term(trial)) <= tolerance) {
-      const ReturnResult uncoupled = return_onto(trial, sigma_y_n, 0.0);
+    const double trial_coupling = coupling_term(trial);
+    if (std::abs(trial_coupling) <= tolerance) {
+      const ReturnResult uncoupled = return_onto(trial, sigma_y_n, side_metric(0.0));
       if (std::abs(coupling_term(uncoupled.resultants)) <= tolerance) return uncoupled;
     }
-    const double first_side = coupling_term(trial) >= 0.0 ? 1.0 : -1.0;
-    const ReturnResult first = return_onto(trial, sigma_y_n, first_side);
+    const double first_side = trial_coupling >= 0.0 ? 1.0 : -1.0;
+    const ReturnResult first = return_onto(trial, sigma_y_n, side_metric(first_side));
     const double first_coupling = coupling_term(first.resultants);
     if (first_side * first_coupling >= -tolerance) return first;
-    const ReturnResult second = return_onto(trial, sigma_y_n, -first_side);
+    const ReturnResult second = return_onto(trial, sigma_y_n, side_metric(-first_side));
     const double second_coupling = coupling_term(second.resultants);
     if (-first_side * second_coupling >= -tolerance) return second;
 
@@ -265,7 +312,7 @@ class Section<Global, Law> {
     int retained = 0;
     for (int iteration = 0; iteration < max_ridge_iterations; ++iteration) {
       const double s = (s_a * h_b - s_b * h_a) / (h_b - h_a);
-      const ReturnResult ridge = return_onto(trial, sigma_y_n, s);
+      const ReturnResult ridge = return_onto(trial, sigma_y_n, ridge_metric(s));
       const double h = coupling_term(ridge.resultants);
       if (std::abs(h) <= tolerance || std::abs(s_b - s_a) <= bracket_tolerance) return ridge;
       if ((h > 0.0) == (h_a > 0.0)) {
@@ -284,55 +331,75 @@ class Section<Global, Law> {
   }
 
   // Closest-point return onto xᵀÂ_s x = σs² for a fixed coupling coefficient
-  // s ∈ [−1, 1], solved mode by mode: y_i = (I + c λ_i K S_s)⁻¹ y_i* with
-  // y_i = (N·q_i, M·q_i), K = diag(d, d³/12), S_s the 2×2 metric, c = d Δε̄p/σs.
-  ReturnResult return_onto(const Vector6& trial, double sigma_y_n, double s) const {
-    const Matrix2 metric = uncoupled_modal_metric_ + s * coupling_modal_metric_;
-    const Matrix2 flow = section_stiffness_ * metric;
-    Eigen::Matrix<double, 2, 3> modal_trial;
-    modal_trial.row(0) = (modal_basis_.transpose() * trial.template head<3>()).transpose();
-    modal_trial.row(1) = (modal_basis_.transpose() * trial.template tail<3>()).transpose();
-    Eigen::Matrix<double, 2, 3> modal = modal_trial;
-    const double d = thickness_;
-    const double hardening = hardening_modulus_;
-    auto residual = [&](double d_eps_p, double& derivative) {
-      const double sigma_y = sigma_y_n + hardening * d_eps_p;
-      const double c = d * d_eps_p / sigma_y;
-      const double dc_dp = d * sigma_y_n / (sigma_y * sigma_y);
-      double g = -sigma_y * sigma_y;
-      derivative = -2.0 * sigma_y * hardening;
-      for (int i = 0; i < 3; ++i) {
-        const double lambda = flow_eigenvalues_[std::size_t(i)];
-        const double weight = mises_eigenvalues_[std::size_t(i)];
-        const Matrix2 inverse = (Matrix2::Identity() + c * lambda * flow).inverse();
-        const Vector2 y = inverse * modal_trial.col(i);
-        const Vector2 dy_dc = -inverse * (lambda * flow * y);
-        modal.col(i) = y;
-        g += weight * y.dot(metric * y);
-        derivative += 2.0 * weight * y.dot(metric * dy_dc) * dc_dp;
+  // s ∈ [−1, 1], mode by mode. In the scaled modal variables z_i = (n_i, m_i) the
+  // metric is S_s = [[1, s/(2√3)], [s/(2√3), 1]] and the return of the header reads
+  //   z_i = (I + λ_i (Δε̄p/σs) W S_s)⁻¹ z_i*,  W = diag(1, 4/3)
+  // (W carries K = diag(d, d³/12) into the scaled variables). With h = W^(−1/2) z
+  // the matrix becomes the symmetric R_s = W^(1/2) S_s W^(1/2) = Σ_k ω_k u_k u_kᵀ, so
+  // with p_ik = u_k·h_i* and u_ik = σs + λ_i ω_k Δε̄p (σs = σs,n + Ep Δε̄p):
+  //   h_i = Σ_k (σs/u_ik) p_ik u_k,   σ̄_I² = σs² S,   S(Δε̄p) = Σ_ik w_i ω_k p_ik²/u_ik²,
+  // and g = σ̄_I² − σs² = σs² (S − 1). The Newton iteration runs on φ = 1/√S − 1 =
+  // σs/σ̄_I − 1 (as the J2 map of docs/method.md §5 does): φ is a power mean of the
+  // u_ik, linear in Δε̄p, so it is increasing and concave, exactly linear for a single
+  // mode, and Newton from below converges monotonically in a few steps.
+  ReturnResult return_onto(const Modal& trial, double sigma_y_n, const RidgeMetric& metric) const {
+    constexpr int terms = 6;
+    const double half_root3 = 0.5 * std::sqrt(3.0);
+    std::array<double, terms> p{}, a{}, b{}, inverse{};
+    for (int i = 0; i < 3; ++i) {
+      const Vector2 h(trial(0, i), half_root3 * trial(1, i));
+      const double w = mises_eigenvalues_[std::size_t(i)], lambda = flow_eigenvalues_[std::size_t(i)];
+      for (int k = 0; k < 2; ++k) {
+        const std::size_t j = std::size_t(2 * i + k);
+        p[j] = (k == 0 ? metric.u0 : metric.u1).dot(h);
+        a[j] = w * metric.omega[std::size_t(k)] * p[j] * p[j];
+        b[j] = lambda * metric.omega[std::size_t(k)];
       }
-      return g;
+    }
+    const double hardening = hardening_modulus_;
+    // S and dS/dΔε̄p at Δε̄p; leaves σs/u_ik in inverse (times σs after the call).
+    auto evaluate = [&](double d_eps_p, double& derivative) {
+      const double sigma_y = sigma_y_n + hardening * d_eps_p;
+      double sum = 0.0;
+      derivative = 0.0;
+      for (std::size_t j = 0; j < std::size_t(terms); ++j) {
+        inverse[j] = 1.0 / (sigma_y + b[j] * d_eps_p);
+        const double term = a[j] * inverse[j] * inverse[j];
+        sum += term;
+        derivative -= 2.0 * term * inverse[j] * (hardening + b[j]);
+      }
+      return sum;
     };
-    auto resultants_of = [&]() {
-      Vector6 x;
-      x << modal_basis_ * modal.row(0).transpose(), modal_basis_ * modal.row(1).transpose();
-      return x;
+    auto resultants_at = [&](double d_eps_p) {
+      const double sigma_y = sigma_y_n + hardening * d_eps_p;
+      Modal x;
+      for (int i = 0; i < 3; ++i) {
+        const std::size_t j = std::size_t(2 * i);
+        const Vector2 h = (sigma_y * inverse[j] * p[j]) * metric.u0 +
+                          (sigma_y * inverse[j + 1] * p[j + 1]) * metric.u1;
+        x(0, i) = h.x();
+        x(1, i) = h.y() / half_root3;
+      }
+      return ReturnResult{x, d_eps_p};
     };
 
     double derivative = 0.0;
-    if (residual(0.0, derivative) <= 0.0) return {trial, 0.0};
-    // Bracket [lower, upper] with g(lower) > 0 > g(upper); upper < 0 means not found yet.
+    double S = evaluate(0.0, derivative);
+    if (S <= 1.0) return {trial, 0.0};
+    // Bracket [lower, upper] with S(lower) > 1 > S(upper); upper < 0 means not found yet.
     double lower = 0.0, upper = -1.0, d_eps_p = 0.0;
-    const double growth_step =
-        std::sqrt(trial.dot((uncoupled_metric_ + s * coupling_metric_) * trial)) /
-        law_.youngs_modulus();
+    double trial_squared = 0.0;
+    for (double term : a) trial_squared += term;
+    const double growth_step = std::sqrt(trial_squared) / law_.youngs_modulus();
     for (int iteration = 0; iteration < max_newton_iterations; ++iteration) {
-      const double g = residual(d_eps_p, derivative);
-      const double sigma_y = sigma_y_n + hardening * d_eps_p;
-      if (std::abs(g) <= residual_tolerance * sigma_y * sigma_y) return {resultants_of(), d_eps_p};
-      if (g > 0.0) lower = d_eps_p; else upper = d_eps_p;
-      if (upper >= 0.0 && upper - lower <= bracket_tolerance * upper) return {resultants_of(), d_eps_p};
-      double next = derivative < 0.0 ? d_eps_p - g / derivative : -1.0;
+      if (iteration > 0) S = evaluate(d_eps_p, derivative);
+      if (std::abs(S - 1.0) <= residual_tolerance) return resultants_at(d_eps_p);
+      if (S > 1.0) lower = d_eps_p; else upper = d_eps_p;
+      if (upper >= 0.0 && upper - lower <= bracket_tolerance * upper) return resultants_at(d_eps_p);
+      // Newton on φ = 1/√S − 1: Δε̄p − φ/φ' = Δε̄p + 2S (√S − 1)/S'.
+      double next = derivative < 0.0
+                        ? d_eps_p - 2.0 * S * (S - 1.0) / ((std::sqrt(S) + 1.0) * derivative)
+                        : -1.0;
       const bool outside = !(next > lower) || (upper >= 0.0 && !(next < upper));
       if (outside) next = upper >= 0.0 ? 0.5 * (lower + upper) : 2.0 * lower + growth_step;
       d_eps_p = next;
@@ -353,12 +420,11 @@ class Section<Global, Law> {
 
   Law law_;
   double thickness_;
-  Matrix6 stiffness_, compliance_;
-  Matrix6 uncoupled_metric_, coupling_metric_;
-  Matrix3 modal_basis_;
+  Matrix3 membrane_stiffness_, bending_stiffness_, membrane_compliance_, bending_compliance_;
   std::array<double, 3> mises_eigenvalues_{};
   std::array<double, 3> flow_eigenvalues_{};
-  Matrix2 section_stiffness_, uncoupled_modal_metric_, coupling_modal_metric_;
+  double membrane_scale_ = 1.0, moment_scale_ = 1.0;
+  std::array<RidgeMetric, 3> side_metrics_{};  // s = −1, 0, 1
   double initial_yield_stress_ = std::numeric_limits<double>::infinity();
   double hardening_modulus_ = 0.0;
   double damage_threshold_ = 0.0;
