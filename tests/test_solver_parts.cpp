@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cmath>
 #include <new>
 #include <sstream>
@@ -279,6 +280,66 @@ TEST_CASE("A plate's step is bitwise the same on 1, 2 and 3 threads", "[core][pa
   for (std::size_t run = 1; run < positions.size(); ++run) {
     CHECK(positions[run] == positions[0]);
     CHECK(directors[run] == directors[0]);
+  }
+}
+
+TEST_CASE("The assembly schedule sums each particle once, after every point that refers to it",
+          "[solver][parallel]") {
+  // The interleaved pass (solver/assembly_schedule.hpp) may form a particle's
+  // sum only once every point in its force entries has integrated in this
+  // step: inside one segment, after the run that completes them, or after all
+  // segments. A particle summed one run too early would take a point's forces
+  // from the step before, an error too small for the mechanics tests to see.
+  const SolverOptions options;
+  const ShellModel plate = ShellModel::rectangular_plate(0.3, 0.2, 31, 21, 0.002);
+  const ShellModel cap = spherical_cap_ogrid(2.54, 0.1860, 16, 0.0099);
+  for (const ShellModel* model : {&plate, &cap}) {
+    const solver::IntegrationPoints<approx::MLS<kernel::CubicSpline>> points(*model, options.physics(),
+                                                                              options.particle_integration(), 80e9);
+    for (std::size_t segments : {std::size_t{1}, std::size_t{2}, std::size_t{8}}) {
+      INFO(model->particle_count() << " particles, " << segments << " segments");
+      solver::AssemblySchedule schedule;
+      schedule.update(points, model->particle_count(), segments);
+      REQUIRE(schedule.segments() == segments);
+      // Every point in one run, each group's rows in order.
+      std::vector<std::size_t> run_of(points.size(), points.size());
+      std::size_t next_row[2] = {0, 0};
+      bool rows_in_order = true;
+      for (std::size_t s = 0; s < segments; ++s)
+        for (std::size_t r = schedule.first_run(s); r < schedule.end_run(s); ++r) {
+          const solver::AssemblySchedule::Run& run = schedule.run(r);
+          const std::size_t g = solver::index_of(run.group);
+          rows_in_order = rows_in_order && run.first_row == next_row[g] && run.end_row > run.first_row;
+          next_row[g] = run.end_row;
+          for (std::size_t row = run.first_row; row < run.end_row; ++row) run_of[points.point(run.group, row)] = r;
+        }
+      CHECK(rows_in_order);
+      CHECK(next_row[0] == points.count(solver::PointGroup::stress_points));
+      CHECK(next_row[1] == points.count(solver::PointGroup::particles));
+      // Each particle once; a particle summed in a segment only after all its points.
+      std::vector<int> summed(model->particle_count(), 0);
+      const std::vector<std::size_t>& begin = points.particle_slot_begin();
+      bool after_its_points = true;
+      std::size_t in_segments = 0;
+      for (std::size_t s = 0; s < segments; ++s)
+        for (std::size_t r = schedule.first_run(s); r < schedule.end_run(s); ++r)
+          for (const std::uint32_t i : schedule.completed_by(r)) {
+            ++summed[i];
+            ++in_segments;
+            for (std::size_t k = begin[i]; k < begin[i + 1]; ++k) {
+              const std::size_t point_run = run_of[points.force_entries()[k].point];
+              after_its_points = after_its_points && point_run >= schedule.first_run(s) && point_run <= r;
+            }
+          }
+      for (const std::uint32_t i : schedule.straddling()) ++summed[i];
+      CHECK(after_its_points);
+      CHECK(std::all_of(summed.begin(), summed.end(), [](int n) { return n == 1; }));
+      // With one segment no particle waits for the end; with two, most of a
+      // grid's particles are summed inside theirs (a band of rows about the
+      // cut straddles it).
+      if (segments == 1) CHECK(schedule.straddling().empty());
+      if (segments == 2 && model == &plate) CHECK(in_segments > model->particle_count() * 3 / 4);
+    }
   }
 }
 

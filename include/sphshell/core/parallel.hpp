@@ -383,6 +383,33 @@ void for_each(Index begin, Index end, Body&& body, OnFailure&& on_failure) {
   }
 }
 
+// Calls body(k) for k in [0, count), each k its own task: for a few large
+// pieces of work (a handful per thread) that for_each would not share out.
+// The rule of for_each holds (each thread takes its own block of tasks first,
+// then the tasks left at the back of the others'); body must not throw.
+template <class Body>
+void for_each_task(std::size_t count, Body&& body) {
+  static_assert(std::is_nothrow_invocable_v<Body&, std::size_t>,
+                "parallel::for_each_task: declare the body noexcept (catch inside and report after the loop)");
+  struct Job {
+    Body& body;
+    static void run_task(void* context, std::size_t task) { static_cast<Job*>(context)->body(task); }
+  };
+  Job job{body};
+  const int threads = thread_count();
+  detail::Team* team = nullptr;
+  if (threads > 1 && count > 1) {
+    team = &detail::Team::instance();
+    if (!team->try_acquire()) team = nullptr;
+  }
+  if (team) {
+    team->run(count, threads, &Job::run_task, &job);
+    team->release();
+  } else {
+    for (std::size_t k = 0; k < count; ++k) body(k);
+  }
+}
+
 // As above; the lowest failing index's exception is rethrown as it is.
 template <class Index, class Body>
 void for_each(Index begin, Index end, Body&& body) {

@@ -24,6 +24,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -413,6 +414,10 @@ class IntegrationPoints {
     std::uint32_t slot;
   };
   const std::vector<ForceEntry>& force_entries() const { return force_entries_; }
+  // Changes whenever the entries are rebuilt (a stamp unique in the process,
+  // so that one kept for another IntegrationPoints never matches), for what
+  // is derived from them (the assembler's schedule).
+  std::uint64_t force_entries_stamp() const { return force_entries_stamp_; }
   std::size_t untied_corner() const { return count(PointGroup::stress_points) * shell::max_cell_corners; }
 
   // Maps every particle to the shape-function slots that reference it, so the
@@ -441,6 +446,8 @@ class IntegrationPoints {
     // Exactly sized: a rebuilt transpose (a checkpoint load) must not keep a
     // larger one's capacity.
     std::vector<ForceEntry>(count_of.back()).swap(force_entries_);
+    static std::atomic<std::uint64_t> next_stamp{1};
+    force_entries_stamp_ = next_stamp.fetch_add(1, std::memory_order_relaxed);
     for (PointGroup group : point_groups) {
       const approx::ShapeFunctions& sf = shape(group);
       for (std::size_t row = 0; row < count(group); ++row) {
@@ -572,6 +579,7 @@ class IntegrationPoints {
   std::vector<shell::ReferenceProducts> reference_products_;
   std::vector<std::size_t> particle_slot_begin_;
   std::vector<ForceEntry> force_entries_;  // per particle, from particle_slot_begin_
+  std::uint64_t force_entries_stamp_ = 0;
   std::array<std::vector<unsigned char>, 2> rebuilt_;  // per row: changed by a crack since construction
   std::array<std::vector<std::size_t>, 2> global_row_;  // a subset's global rows (empty: the whole model)
 };

@@ -10,12 +10,21 @@
 // count). The per-slot forces are formed where they are added, so no array of
 // them is written and read back. The work of each point over the step is kept
 // for the energy ledger.
+//
+// The two passes are interleaved (AssemblySchedule): the points integrate in
+// runs of rows, and a particle is summed as soon as the run that completes
+// its points is done, while those points' forces and shape functions are
+// still in the cache. Done as two separate passes, the sum read them back
+// from memory once the model outgrew the cache (a 401×401 plate's step cost
+// 1.6 times a 51×51 plate's per particle; README, "Performance"). A particle's
+// sum is the same whenever it is formed, so results do not change.
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/parallel.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/shell/cell_shear.hpp>
 #include <sphshell/shell/kinematics.hpp>
+#include <sphshell/solver/assembly_schedule.hpp>
 #include <sphshell/solver/integration_points.hpp>
 #include <sphshell/solver/particles.hpp>
 #include <sphshell/solver/section_states.hpp>
@@ -23,7 +32,10 @@
 #include <algorithm>
 #include <array>
 #include <cstddef>
+#include <cstdint>
+#include <exception>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace sphshell::solver {
@@ -43,21 +55,33 @@ class InternalForceAssembler {
   void compute(const StepTime& at, const ParticleState& particles, const IntegrationPoints<Approx>& points,
                SectionStates<Rule, Law>& states, ParticleForces& forces) {
     prepare(points);
+    schedule_.update(points, forces.internal.size(), segment_count());
     packed_.resize(particles.size());
     parallel::for_each(std::size_t{0}, particles.size(), [&](std::size_t i) noexcept {
       packed_[i] = PackedKinematics{particles.position[i], particles.director[i]};
     });
-    for (PointGroup group : point_groups)
-      parallel::for_each(
-          std::size_t{0}, points.count(group),
-          [&](std::size_t row) { integrate_point(group, row, points, states); },
-          [&](std::size_t row, const std::exception_ptr& error) {
-            failed_point_ = points.point(group, row);
-            detail::fail_unstable(at, std::string(name_of(group)) + " " +
-                                          std::to_string(points.global_row(group, row)) + ": " +
-                                          parallel::what(error));
-          });
-    sum_particle_forces(points, forces);
+    // Each segment integrates its runs and sums the particles that each run
+    // completes; the particles whose points lie in two segments follow.
+    const ForceSum<Approx> sum(points, *this);
+    failures_.assign(schedule_.segments(), PointFailure{});
+    parallel::for_each_task(schedule_.segments(), [&](std::size_t segment) noexcept {
+      PointFailure& failure = failures_[segment];
+      for (std::size_t run = schedule_.first_run(segment); run < schedule_.end_run(segment); ++run) {
+        const AssemblySchedule::Run& rows = schedule_.run(run);
+        for (std::size_t row = rows.first_row; row < rows.end_row; ++row) {
+          try {
+            integrate_point(rows.group, row, points, states);
+          } catch (...) {
+            failure.keep_lowest(rows.group, row, std::current_exception());
+          }
+        }
+        for (const std::uint32_t i : schedule_.completed_by(run)) sum(i, forces);
+      }
+    });
+    const std::vector<std::uint32_t>& straddling = schedule_.straddling();
+    parallel::for_each(std::size_t{0}, straddling.size(),
+                       [&](std::size_t k) noexcept { sum(straddling[k], forces); });
+    report_failure(at, points);
   }
 
   // Forces of one point's stored resultants (no material update), from the
@@ -91,38 +115,11 @@ class InternalForceAssembler {
   // instead of being skipped. Adding a zero changes no bit of the sum: it
   // starts at +0 and a sum of doubles is −0 only when both terms are, so it is
   // never −0, and x + (±0) is x for any other x.
+  // (compute() forms the same sums interleaved with the points' updates.)
   template <class Approx>
   void sum_particle_forces(const IntegrationPoints<Approx>& points, ParticleForces& forces) const {
-    const std::vector<std::size_t>& begin = points.particle_slot_begin();
-    const auto* const entries = points.force_entries().data();
-    const shell::ConjugateForces* const conjugate = conjugate_.data();
-    const Vector3 *const tied_force = tied_force_.data(), *const tied_director_force = tied_director_force_.data();
-    const std::size_t untied = points.untied_corner();
-    // Each group's Φ, ∂Φ/∂X1, ∂Φ/∂X2, picked by whether the entry's point is a
-    // particle point (those follow the stress points).
-    const approx::ShapeValue* const value_of[2] = {points.shape(PointGroup::stress_points).value.data(),
-                                                   points.shape(PointGroup::particles).value.data()};
-    const std::size_t first_particle_point = points.point(PointGroup::particles, 0);
-    parallel::for_each(std::size_t{0}, forces.internal.size(), [&](std::size_t i) noexcept {
-      Vector3 force = Vector3::Zero(), director_force = Vector3::Zero();
-      for (std::size_t k = begin[i]; k < begin[i + 1]; ++k) {
-        const auto& entry = entries[k];
-        const shell::ConjugateForces& f = conjugate[entry.point];
-        const std::size_t g = entry.point >= first_particle_point ? 1 : 0;
-        const approx::ShapeValue& value = value_of[g][entry.slot];
-        const double phi = value.phi, dphi_d1 = value.dphi_d1, dphi_d2 = value.dphi_d2;
-        Vector3 slot_force = dphi_d1 * f.a1 + dphi_d2 * f.a2;
-        Vector3 slot_director_force = phi * f.n + dphi_d1 * f.n1 + dphi_d2 * f.n2;
-        if (entry.tied_corner != untied) {
-          slot_force += tied_force[entry.tied_corner];
-          slot_director_force += tied_director_force[entry.tied_corner];
-        }
-        force += slot_force;
-        director_force += slot_director_force;
-      }
-      forces.internal[i] = force;
-      forces.internal_director[i] = director_force;
-    });
+    const ForceSum<Approx> sum(points, *this);
+    parallel::for_each(std::size_t{0}, forces.internal.size(), [&](std::size_t i) noexcept { sum(i, forces); });
   }
 
   // The point whose failure stopped the last compute() (the lowest failing
@@ -143,6 +140,91 @@ class InternalForceAssembler {
   }
 
  private:
+  // One particle's sum (sum_particle_forces): what it reads, gathered once per pass.
+  template <class Approx>
+  class ForceSum {
+   public:
+    ForceSum(const IntegrationPoints<Approx>& points, const InternalForceAssembler& assembler)
+        : begin_(points.particle_slot_begin().data()),
+          entries_(points.force_entries().data()),
+          conjugate_(assembler.conjugate_.data()),
+          tied_force_(assembler.tied_force_.data()),
+          tied_director_force_(assembler.tied_director_force_.data()),
+          untied_(points.untied_corner()),
+          // Each group's Φ, ∂Φ/∂X1, ∂Φ/∂X2, picked by whether the entry's point
+          // is a particle point (those follow the stress points).
+          value_of_{points.shape(PointGroup::stress_points).value.data(),
+                    points.shape(PointGroup::particles).value.data()},
+          first_particle_point_(points.point(PointGroup::particles, 0)) {}
+
+    void operator()(std::size_t i, ParticleForces& forces) const {
+      Vector3 force = Vector3::Zero(), director_force = Vector3::Zero();
+      for (std::size_t k = begin_[i]; k < begin_[i + 1]; ++k) {
+        const auto& entry = entries_[k];
+        const shell::ConjugateForces& f = conjugate_[entry.point];
+        const std::size_t g = entry.point >= first_particle_point_ ? 1 : 0;
+        const approx::ShapeValue& value = value_of_[g][entry.slot];
+        const double phi = value.phi, dphi_d1 = value.dphi_d1, dphi_d2 = value.dphi_d2;
+        Vector3 slot_force = dphi_d1 * f.a1 + dphi_d2 * f.a2;
+        Vector3 slot_director_force = phi * f.n + dphi_d1 * f.n1 + dphi_d2 * f.n2;
+        if (entry.tied_corner != untied_) {
+          slot_force += tied_force_[entry.tied_corner];
+          slot_director_force += tied_director_force_[entry.tied_corner];
+        }
+        force += slot_force;
+        director_force += slot_director_force;
+      }
+      forces.internal[i] = force;
+      forces.internal_director[i] = director_force;
+    }
+
+   private:
+    const std::size_t* begin_;
+    const typename IntegrationPoints<Approx>::ForceEntry* entries_;
+    const shell::ConjugateForces* conjugate_;
+    const Vector3 *tied_force_, *tied_director_force_;
+    std::size_t untied_;
+    const approx::ShapeValue* value_of_[2];
+    std::size_t first_particle_point_;
+  };
+
+  // The lowest failing point of a segment, in the order of the separate
+  // passes (every stress point before every particle point), so that the
+  // error names the same point for any number of threads.
+  struct PointFailure {
+    std::size_t group = point_groups.size();  // index_of(group); point_groups.size(): none
+    std::size_t row = 0;
+    std::exception_ptr error;
+    void keep_lowest(PointGroup failed_group, std::size_t failed_row, std::exception_ptr failed) {
+      const std::size_t g = index_of(failed_group);
+      if (g < group || (g == group && failed_row < row)) {
+        group = g;
+        row = failed_row;
+        error = std::move(failed);
+      }
+    }
+  };
+
+  template <class Approx>
+  void report_failure(const StepTime& at, const IntegrationPoints<Approx>& points) {
+    PointFailure lowest;
+    for (const PointFailure& failure : failures_)
+      if (failure.error) lowest.keep_lowest(point_groups[failure.group], failure.row, failure.error);
+    if (!lowest.error) return;
+    const PointGroup group = point_groups[lowest.group];
+    failed_point_ = points.point(group, lowest.row);
+    detail::fail_unstable(at, std::string(name_of(group)) + " " + std::to_string(points.global_row(group, lowest.row)) +
+                                  ": " + parallel::what(lowest.error));
+  }
+
+  // Segments of the interleaved pass: one with one thread; with more, a few
+  // per thread, so that a thread the system holds back leaves some of its
+  // share to the others (core/parallel.hpp).
+  static std::size_t segment_count() {
+    const int threads = parallel::thread_count();
+    return threads == 1 ? 1 : std::size_t(threads) * AssemblySchedule::segments_per_thread;
+  }
+
   // Per-point arrays are sized once; the work is zero for points that do not integrate.
   template <class Approx>
   void prepare(const IntegrationPoints<Approx>& points) {
@@ -242,6 +324,8 @@ class InternalForceAssembler {
   std::vector<Vector3> tied_force_, tied_director_force_;
   std::vector<double> work_increment_;
   std::vector<PackedKinematics> packed_;  // this step's positions and directors
+  AssemblySchedule schedule_;
+  std::vector<PointFailure> failures_;  // per segment of the last compute()
 };
 
 }  // namespace sphshell::solver

@@ -1,0 +1,160 @@
+#pragma once
+// The order of the internal-force assembler's interleaved pass
+// (solver/internal_forces.hpp): which points integrate together, and where
+// each particle's force sum can follow them.
+//
+// The points integrate in runs of consecutive rows of one group; the two
+// groups' runs alternate in proportion to their sizes, so that the stress
+// points and the particle points of one region of the model come together
+// (rows of a group are numbered region by region: a structured grid's rows,
+// or a mesh's element order). A particle's sum needs every point that refers
+// to it; it is formed right after the run that completes them. The runs are
+// cut into segments of about equal size, one task each: a particle whose
+// points all lie in one segment is summed inside it ("completed by" a run),
+// one whose points lie in two or more ("straddling") after every segment is
+// done. Nothing here changes a result: each particle's sum keeps its order
+// (IntegrationPoints::force_entries).
+
+#include <sphshell/solver/integration_points.hpp>
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+namespace sphshell::solver {
+
+class AssemblySchedule {
+ public:
+  // Rows of one group integrated before the other group's turn. One row at a
+  // time (the groups strictly alternating) made the point updates slower than
+  // two separate passes; runs of 32 to 128 rows measured alike
+  // (README, "Performance").
+  static constexpr std::size_t rows_per_run = 64;
+  // Segments per thread when several threads share the pass.
+  static constexpr std::size_t segments_per_thread = 4;
+
+  struct Run {
+    PointGroup group;
+    std::size_t first_row, end_row;
+  };
+
+  // Rebuilds the schedule when the points' force entries, the particle count
+  // or the segment count changed since the last call.
+  template <class Approx>
+  void update(const IntegrationPoints<Approx>& points, std::size_t particle_count, std::size_t segments) {
+    if (points.force_entries_stamp() == stamp_ && particle_count == particle_count_ && segments == segment_count_)
+      return;
+    stamp_ = points.force_entries_stamp();
+    particle_count_ = particle_count;
+    segment_count_ = segments;
+    const std::vector<std::uint32_t> run_of = build_runs(points);
+    cut_segments(points.size());
+    order_sums(points, run_of);
+  }
+
+  std::size_t segments() const { return segment_count_; }
+  std::size_t first_run(std::size_t segment) const { return segment_first_run_[segment]; }
+  std::size_t end_run(std::size_t segment) const { return segment_first_run_[segment + 1]; }
+  const Run& run(std::size_t r) const { return runs_[r]; }
+
+  // The particles whose sums the run completes (within its segment), by index.
+  struct Particles {
+    const std::uint32_t *first, *last;
+    const std::uint32_t* begin() const { return first; }
+    const std::uint32_t* end() const { return last; }
+  };
+  Particles completed_by(std::size_t r) const {
+    return {sum_order_.data() + run_sum_begin_[r], sum_order_.data() + run_sum_begin_[r + 1]};
+  }
+  // The particles summed after the segments, by index.
+  const std::vector<std::uint32_t>& straddling() const { return straddling_; }
+
+ private:
+  // Runs in the order they integrate; returns each point's run.
+  template <class Approx>
+  std::vector<std::uint32_t> build_runs(const IntegrationPoints<Approx>& points) {
+    runs_.clear();
+    std::vector<std::uint32_t> run_of(points.size());
+    const std::size_t count[2] = {points.count(PointGroup::stress_points), points.count(PointGroup::particles)};
+    std::size_t next[2] = {0, 0};
+    while (next[0] < count[0] || next[1] < count[1]) {
+      // The group less far through its rows goes next (next/count compared
+      // without division).
+      const std::size_t g = next[1] >= count[1]   ? 0
+                            : next[0] >= count[0] ? 1
+                            : next[0] * count[1] <= next[1] * count[0] ? 0
+                                                                       : 1;
+      const PointGroup group = point_groups[g];
+      const std::size_t end = std::min(count[g], next[g] + rows_per_run);
+      for (std::size_t row = next[g]; row < end; ++row)
+        run_of[points.point(group, row)] = static_cast<std::uint32_t>(runs_.size());
+      runs_.push_back(Run{group, next[g], end});
+      next[g] = end;
+    }
+    return run_of;
+  }
+
+  // Segment s starts at the first run that begins at or past s/segments of
+  // the points.
+  void cut_segments(std::size_t point_count) {
+    segment_first_run_.assign(segment_count_ + 1, runs_.size());
+    segment_first_run_[0] = 0;
+    std::size_t segment = 1, done = 0;
+    for (std::size_t r = 0; r < runs_.size(); ++r) {
+      while (segment < segment_count_ && done * segment_count_ >= segment * point_count)
+        segment_first_run_[segment++] = r;
+      done += runs_[r].end_row - runs_[r].first_row;
+    }
+    segment_of_run_.resize(runs_.size());
+    for (std::size_t s = 0; s < segment_count_; ++s)
+      for (std::size_t r = segment_first_run_[s]; r < segment_first_run_[s + 1]; ++r) segment_of_run_[r] = s;
+  }
+
+  // Each particle after the last run among its points, if they all lie in
+  // one segment; with the straddling ones otherwise (and those that no point
+  // refers to: their sum is zero).
+  template <class Approx>
+  void order_sums(const IntegrationPoints<Approx>& points, const std::vector<std::uint32_t>& run_of) {
+    constexpr std::uint32_t straddles = std::numeric_limits<std::uint32_t>::max();
+    const std::vector<std::size_t>& begin = points.particle_slot_begin();
+    const auto& entries = points.force_entries();
+    std::vector<std::uint32_t> completing_run(particle_count_, straddles);
+    run_sum_begin_.assign(runs_.size() + 1, 0);
+    straddling_.clear();
+    for (std::size_t i = 0; i < particle_count_; ++i) {
+      if (begin[i] == begin[i + 1]) {
+        straddling_.push_back(static_cast<std::uint32_t>(i));
+        continue;
+      }
+      std::uint32_t first = straddles, last = 0;
+      for (std::size_t k = begin[i]; k < begin[i + 1]; ++k) {
+        first = std::min(first, run_of[entries[k].point]);
+        last = std::max(last, run_of[entries[k].point]);
+      }
+      if (segment_of_run_[first] == segment_of_run_[last]) {
+        completing_run[i] = last;
+        ++run_sum_begin_[last + 1];
+      } else {
+        straddling_.push_back(static_cast<std::uint32_t>(i));
+      }
+    }
+    for (std::size_t r = 0; r < runs_.size(); ++r) run_sum_begin_[r + 1] += run_sum_begin_[r];
+    sum_order_.resize(run_sum_begin_.back());
+    std::vector<std::size_t> next(run_sum_begin_.begin(), run_sum_begin_.end() - 1);
+    for (std::size_t i = 0; i < particle_count_; ++i)
+      if (completing_run[i] != straddles) sum_order_[next[completing_run[i]]++] = static_cast<std::uint32_t>(i);
+  }
+
+  std::uint64_t stamp_ = 0;  // IntegrationPoints::force_entries_stamp() of the last build (0: none)
+  std::size_t particle_count_ = 0, segment_count_ = 0;
+  std::vector<Run> runs_;
+  std::vector<std::size_t> segment_first_run_;  // size segments + 1
+  std::vector<std::size_t> segment_of_run_;
+  std::vector<std::size_t> run_sum_begin_;  // size runs + 1: completed_by(r) is sum_order_[r's range]
+  std::vector<std::uint32_t> sum_order_;
+  std::vector<std::uint32_t> straddling_;
+};
+
+}  // namespace sphshell::solver
