@@ -18,6 +18,7 @@
 #include <sphshell/solver/integration_points.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -49,9 +50,9 @@ class AssemblySchedule {
     stamp_ = points.force_entries_stamp();
     particle_count_ = particle_count;
     segment_count_ = segments;
-    const std::vector<std::uint32_t> run_of = build_runs(points);
+    build_runs(points);
     cut_segments(points.size());
-    order_sums(points, run_of);
+    order_sums(points);
   }
 
   std::size_t segments() const { return segment_count_; }
@@ -72,11 +73,12 @@ class AssemblySchedule {
   const std::vector<std::uint32_t>& straddling() const { return straddling_; }
 
  private:
-  // Runs in the order they integrate; returns each point's run.
+  // Runs in the order they integrate, and each group's runs by first row.
   template <class Approx>
-  std::vector<std::uint32_t> build_runs(const IntegrationPoints<Approx>& points) {
+  void build_runs(const IntegrationPoints<Approx>& points) {
     runs_.clear();
-    std::vector<std::uint32_t> run_of(points.size());
+    for (std::vector<std::size_t>& first_rows : group_run_first_row_) first_rows.clear();
+    for (std::vector<std::uint32_t>& index : group_run_index_) index.clear();
     const std::size_t count[2] = {points.count(PointGroup::stress_points), points.count(PointGroup::particles)};
     std::size_t next[2] = {0, 0};
     while (next[0] < count[0] || next[1] < count[1]) {
@@ -86,14 +88,21 @@ class AssemblySchedule {
                             : next[0] >= count[0] ? 1
                             : next[0] * count[1] <= next[1] * count[0] ? 0
                                                                        : 1;
-      const PointGroup group = point_groups[g];
       const std::size_t end = std::min(count[g], next[g] + rows_per_run);
-      for (std::size_t row = next[g]; row < end; ++row)
-        run_of[points.point(group, row)] = static_cast<std::uint32_t>(runs_.size());
-      runs_.push_back(Run{group, next[g], end});
+      group_run_first_row_[g].push_back(next[g]);
+      group_run_index_[g].push_back(static_cast<std::uint32_t>(runs_.size()));
+      runs_.push_back(Run{point_groups[g], next[g], end});
       next[g] = end;
     }
-    return run_of;
+  }
+
+  // The run of a point (a search among its group's runs: no array per point).
+  template <class Approx>
+  std::uint32_t run_of(const IntegrationPoints<Approx>& points, std::size_t point) const {
+    const std::size_t g = index_of(points.group_of(point)), row = points.row_of(point);
+    const std::vector<std::size_t>& first_rows = group_run_first_row_[g];
+    const auto after = std::upper_bound(first_rows.begin(), first_rows.end(), row);
+    return group_run_index_[g][std::size_t(after - first_rows.begin()) - 1];
   }
 
   // Segment s starts at the first run that begins at or past s/segments of
@@ -115,41 +124,52 @@ class AssemblySchedule {
   // Each particle after the last run among its points, if they all lie in
   // one segment; with the straddling ones otherwise (and those that no point
   // refers to: their sum is zero).
+  // (Two passes over the entries, counting and then placing, so that the
+  // build keeps no array per particle besides the order itself.)
   template <class Approx>
-  void order_sums(const IntegrationPoints<Approx>& points, const std::vector<std::uint32_t>& run_of) {
+  void order_sums(const IntegrationPoints<Approx>& points) {
     constexpr std::uint32_t straddles = std::numeric_limits<std::uint32_t>::max();
     const std::vector<std::size_t>& begin = points.particle_slot_begin();
     const auto& entries = points.force_entries();
-    std::vector<std::uint32_t> completing_run(particle_count_, straddles);
-    run_sum_begin_.assign(runs_.size() + 1, 0);
-    straddling_.clear();
-    for (std::size_t i = 0; i < particle_count_; ++i) {
-      if (begin[i] == begin[i + 1]) {
-        straddling_.push_back(static_cast<std::uint32_t>(i));
-        continue;
-      }
+    // The run that completes particle i's points, or `straddles`.
+    const auto completing_run = [&](std::size_t i) {
+      if (begin[i] == begin[i + 1]) return straddles;
       std::uint32_t first = straddles, last = 0;
       for (std::size_t k = begin[i]; k < begin[i + 1]; ++k) {
-        first = std::min(first, run_of[entries[k].point]);
-        last = std::max(last, run_of[entries[k].point]);
+        const std::uint32_t run = run_of(points, entries[k].point);
+        first = std::min(first, run);
+        last = std::max(last, run);
       }
-      if (segment_of_run_[first] == segment_of_run_[last]) {
-        completing_run[i] = last;
-        ++run_sum_begin_[last + 1];
-      } else {
-        straddling_.push_back(static_cast<std::uint32_t>(i));
-      }
+      return segment_of_run_[first] == segment_of_run_[last] ? last : straddles;
+    };
+    run_sum_begin_.assign(runs_.size() + 1, 0);
+    std::size_t straddling = 0;
+    for (std::size_t i = 0; i < particle_count_; ++i) {
+      const std::uint32_t run = completing_run(i);
+      if (run == straddles)
+        ++straddling;
+      else
+        ++run_sum_begin_[std::size_t(run) + 1];
     }
     for (std::size_t r = 0; r < runs_.size(); ++r) run_sum_begin_[r + 1] += run_sum_begin_[r];
-    sum_order_.resize(run_sum_begin_.back());
+    std::vector<std::uint32_t>(run_sum_begin_.back()).swap(sum_order_);
+    std::vector<std::uint32_t>().swap(straddling_);
+    straddling_.reserve(straddling);
     std::vector<std::size_t> next(run_sum_begin_.begin(), run_sum_begin_.end() - 1);
-    for (std::size_t i = 0; i < particle_count_; ++i)
-      if (completing_run[i] != straddles) sum_order_[next[completing_run[i]]++] = static_cast<std::uint32_t>(i);
+    for (std::size_t i = 0; i < particle_count_; ++i) {
+      const std::uint32_t run = completing_run(i);
+      if (run == straddles)
+        straddling_.push_back(static_cast<std::uint32_t>(i));
+      else
+        sum_order_[next[run]++] = static_cast<std::uint32_t>(i);
+    }
   }
 
   std::uint64_t stamp_ = 0;  // IntegrationPoints::force_entries_stamp() of the last build (0: none)
   std::size_t particle_count_ = 0, segment_count_ = 0;
   std::vector<Run> runs_;
+  std::array<std::vector<std::size_t>, 2> group_run_first_row_;  // per group: its runs' first rows, ascending
+  std::array<std::vector<std::uint32_t>, 2> group_run_index_;     // and those runs' indices in runs_
   std::vector<std::size_t> segment_first_run_;  // size segments + 1
   std::vector<std::size_t> segment_of_run_;
   std::vector<std::size_t> run_sum_begin_;  // size runs + 1: completed_by(r) is sum_order_[r's range]
