@@ -12,6 +12,7 @@
 #include <limits>
 #include <random>
 #include <sstream>
+#include <vector>
 
 // After the merge: namespace law = sphshell::material;
 namespace law = sphshell::material;
@@ -312,12 +313,28 @@ void exercise(const Law& material) {
   const Section<Rule, Law> section(material, d);
   auto state = section.initial_state();
   static_assert(decltype(section)::output_points == (Rule::num_points == 0 ? 1 : Rule::num_points));
+  // An integral rule's section (batched or not) must give every point exactly
+  // the state of the law's single-point update() at e + zeta_k kappa.
+  std::vector<typename Law::State> reference(std::size_t(Rule::num_points), material.initial_state());
+  bool same = true;
   Resultants result;
   for (int step = 0; step < 200; ++step) {
     const double sign = step < 100 ? 1.0 : -1.0;
-    result = section.update(state, sign * StrainVoigt(1e-4, 0.5e-4, -0.3e-4),
-                            sign * StrainVoigt(0.05, -0.02, 0.01));
+    const StrainVoigt d_membrane = sign * StrainVoigt(1e-4, 0.5e-4, -0.3e-4),
+                      d_curvature = sign * StrainVoigt(0.05, -0.02, 0.01);
+    result = section.update(state, d_membrane, d_curvature);
+    if constexpr (Rule::num_points >= 1) {
+      for (int k = 0; k < Rule::num_points; ++k) {
+        auto& point = reference[std::size_t(k)];
+        material.update(point, d_membrane + section.zeta(k) * d_curvature);
+        const auto& computed = state[std::size_t(k)];
+        same = same && computed.stress == point.stress &&
+               material.equivalent_plastic_strain(computed) == material.equivalent_plastic_strain(point) &&
+               material.damage(computed) == material.damage(point);
+      }
+    }
   }
+  CHECK(same);
   CHECK(result.membrane.allFinite());
   CHECK(result.moment.allFinite());
   CHECK(section.elastic_energy(state) >= 0.0);

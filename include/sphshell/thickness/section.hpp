@@ -9,6 +9,7 @@
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/types.hpp>
+#include <sphshell/material/lanes.hpp>
 #include <sphshell/thickness/thickness.hpp>
 
 #include <array>
@@ -28,6 +29,8 @@ class Section {
   static constexpr int output_points = Rule::num_points;
   // Contiguous per stress point so the loop over integral points stays in cache.
   using State = std::array<typename Law::State, std::size_t(num_points)>;
+  // Whether update() takes the law's batched path.
+  static constexpr bool batched = material::has_update_lanes_v<Law, num_points>;
 
   Section(const Law& law, double thickness) : law_(law), thickness_(thickness) {
     sphshell::detail::require_positive("thickness", thickness);
@@ -45,11 +48,25 @@ class Section {
 
   // Δε(ζ_k) = Δe + ζ_k Δκ at every integral point (Voigt, engineering shear), then the
   // new total resultants.
+  // With a law that offers update_lanes (material/lanes.hpp) the N points go
+  // through it at once: the increments are formed component by component into
+  // structure-of-arrays form, the states gathered and scattered back. The
+  // result is bitwise that of the point-by-point loop below.
   Resultants update(State& state, const StrainVoigt& d_membrane_strain,
                     const StrainVoigt& d_curvature) const {
-    for (int k = 0; k < num_points; ++k) {
-      const StrainVoigt d_strain = d_membrane_strain + zeta_[std::size_t(k)] * d_curvature;
-      law_.update(state[std::size_t(k)], d_strain);
+    if constexpr (batched) {
+      material::VoigtLanes<num_points> d_strain;
+      for (std::size_t k = 0; k < std::size_t(num_points); ++k) {
+        d_strain.xx[k] = d_membrane_strain.x() + zeta_[k] * d_curvature.x();
+        d_strain.yy[k] = d_membrane_strain.y() + zeta_[k] * d_curvature.y();
+        d_strain.xy[k] = d_membrane_strain.z() + zeta_[k] * d_curvature.z();
+      }
+      material::update_lanes<Law, num_points>(law_, state, d_strain);
+    } else {
+      for (int k = 0; k < num_points; ++k) {
+        const StrainVoigt d_strain = d_membrane_strain + zeta_[std::size_t(k)] * d_curvature;
+        law_.update(state[std::size_t(k)], d_strain);
+      }
     }
     return resultants(state);
   }
