@@ -1,6 +1,10 @@
 // Plastic and damaged sections: the fully plastic bending limit per rule, the Global
 // (Ilyushin) resultant plasticity and its damage reduction, every Rule × Law.
 
+// The batched section update whatever the instruction set (section.hpp picks
+// it by default with AVX-512 only): "every Rule x Law" below holds it bitwise
+// to the law's single-point update().
+#define SPHSHELL_BATCHED_SECTIONS 1
 #include <sphshell/thickness/all.hpp>
 
 #include <sphshell/material/all.hpp>
@@ -12,6 +16,7 @@
 #include <limits>
 #include <random>
 #include <sstream>
+#include <type_traits>
 #include <vector>
 
 // After the merge: namespace law = sphshell::material;
@@ -324,6 +329,7 @@ void exercise(const Law& material) {
                       d_curvature = sign * StrainVoigt(0.05, -0.02, 0.01);
     result = section.update(state, d_membrane, d_curvature);
     if constexpr (Rule::num_points >= 1) {
+      static_assert(decltype(section)::batched == !std::is_same_v<Law, law::LemaitreDamage>);
       for (int k = 0; k < Rule::num_points; ++k) {
         auto& point = reference[std::size_t(k)];
         material.update(point, d_membrane + section.zeta(k) * d_curvature);

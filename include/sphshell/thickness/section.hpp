@@ -15,6 +15,21 @@
 #include <array>
 #include <cstddef>
 
+// Whether Section<Rule, Law>::update batches its integral points through the
+// law's update_lanes (material/lanes.hpp). Both paths give the same bits; the
+// batched one pays for gathering the states into lanes, scattering them back
+// and returning every lane when one yields, which the vector units repay only
+// when they are wide: by default it is taken with AVX-512 and not otherwise
+// (README, Performance). Define SPHSHELL_BATCHED_SECTIONS to 1 or 0 before
+// including to force either path.
+#ifndef SPHSHELL_BATCHED_SECTIONS
+#if defined(__AVX512F__)
+#define SPHSHELL_BATCHED_SECTIONS 1
+#else
+#define SPHSHELL_BATCHED_SECTIONS 0
+#endif
+#endif
+
 namespace sphshell::thickness {
 
 template <class Rule, class Law>
@@ -30,7 +45,7 @@ class Section {
   // Contiguous per stress point so the loop over integral points stays in cache.
   using State = std::array<typename Law::State, std::size_t(num_points)>;
   // Whether update() takes the law's batched path.
-  static constexpr bool batched = material::has_update_lanes_v<Law, num_points>;
+  static constexpr bool batched = SPHSHELL_BATCHED_SECTIONS != 0 && material::has_update_lanes_v<Law, num_points>;
 
   Section(const Law& law, double thickness) : law_(law), thickness_(thickness) {
     sphshell::detail::require_positive("thickness", thickness);
@@ -48,8 +63,8 @@ class Section {
 
   // Δε(ζ_k) = Δe + ζ_k Δκ at every integral point (Voigt, engineering shear), then the
   // new total resultants.
-  // With a law that offers update_lanes (material/lanes.hpp) the N points go
-  // through it at once: the increments are formed component by component into
+  // Batched (see SPHSHELL_BATCHED_SECTIONS above), the N points go through
+  // the law's update_lanes at once: the increments are formed component by component into
   // structure-of-arrays form, the states gathered and scattered back. The
   // result is bitwise that of the point-by-point loop below.
   Resultants update(State& state, const StrainVoigt& d_membrane_strain,
