@@ -11,6 +11,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <limits>
@@ -318,10 +319,13 @@ void exercise(const Law& material) {
   const Section<Rule, Law> section(material, d);
   auto state = section.initial_state();
   static_assert(decltype(section)::output_points == (Rule::num_points == 0 ? 1 : Rule::num_points));
-  // An integral rule's section (batched or not) must give every point exactly
-  // the state of the law's single-point update() at e + zeta_k kappa.
+  // An integral rule's section (batched or not) must give every point the
+  // state of the law's single-point update() at e + zeta_k kappa: the same
+  // bits, unless the compiler may fuse a*b + c into one rounding (FMA), which
+  // it may do in one path and not the other. The deviation is measured in
+  // stress against sigma_y0 and in plastic strain and damage against 1.
   std::vector<typename Law::State> reference(std::size_t(Rule::num_points), material.initial_state());
-  bool same = true;
+  double deviation = 0.0;
   Resultants result;
   for (int step = 0; step < 200; ++step) {
     const double sign = step < 100 ? 1.0 : -1.0;
@@ -334,13 +338,18 @@ void exercise(const Law& material) {
         auto& point = reference[std::size_t(k)];
         material.update(point, d_membrane + section.zeta(k) * d_curvature);
         const auto& computed = state[std::size_t(k)];
-        same = same && computed.stress == point.stress &&
-               material.equivalent_plastic_strain(computed) == material.equivalent_plastic_strain(point) &&
-               material.damage(computed) == material.damage(point);
+        deviation = std::max({deviation, (computed.stress - point.stress).cwiseAbs().maxCoeff() / sigma_y0,
+                              std::abs(material.equivalent_plastic_strain(computed) -
+                                       material.equivalent_plastic_strain(point)),
+                              std::abs(material.damage(computed) - material.damage(point))});
       }
     }
   }
-  CHECK(same);
+#if defined(__FMA__)
+  CHECK(deviation <= 1e-12);
+#else
+  CHECK(deviation == 0.0);
+#endif
   CHECK(result.membrane.allFinite());
   CHECK(result.moment.allFinite());
   CHECK(section.elastic_energy(state) >= 0.0);

@@ -16,8 +16,9 @@
 #include <cstddef>
 
 // Whether Section<Rule, Law>::update batches its integral points through the
-// law's update_lanes (material/lanes.hpp). Both paths give the same bits; the
-// batched one pays for gathering the states into lanes, scattering them back
+// law's update_lanes (material/lanes.hpp). Both paths give the same bits,
+// unless the compiler fuses multiply-adds (FMA) in one and not the other
+// (last-bit differences). The batched one pays for gathering the states into lanes, scattering them back
 // and returning every lane when one yields, which the vector units repay only
 // when they are wide: by default it is taken with AVX-512 and not otherwise
 // (README, Performance). Define SPHSHELL_BATCHED_SECTIONS to 1 or 0 before
@@ -65,8 +66,8 @@ class Section {
   // new total resultants.
   // Batched (see SPHSHELL_BATCHED_SECTIONS above), the N points go through
   // the law's update_lanes at once: the increments are formed component by component into
-  // structure-of-arrays form, the states gathered and scattered back. The
-  // result is bitwise that of the point-by-point loop below.
+  // structure-of-arrays form, the states gathered and scattered back. Without
+  // FMA contraction the result is bitwise that of the point-by-point loop below.
   Resultants update(State& state, const StrainVoigt& d_membrane_strain,
                     const StrainVoigt& d_curvature) const {
     if constexpr (batched) {
