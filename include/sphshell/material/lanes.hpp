@@ -56,7 +56,9 @@ template <std::size_t N>
 inline void sqrt_lanes(std::array<double, N>& x) {
   std::size_t k = 0;
 #if defined(__AVX512F__)
-  for (; k + 8 <= N; k += 8) _mm512_storeu_pd(&x[k], _mm512_sqrt_pd(_mm512_loadu_pd(&x[k])));
+  // The zero-masked form with every lane selected: GCC 12's _mm512_sqrt_pd
+  // starts from an "undefined" vector that -Wmaybe-uninitialized reports.
+  for (; k + 8 <= N; k += 8) _mm512_storeu_pd(&x[k], _mm512_maskz_sqrt_pd(__mmask8(0xff), _mm512_loadu_pd(&x[k])));
 #endif
 #if defined(__AVX__)
   for (; k + 4 <= N; k += 4) _mm256_storeu_pd(&x[k], _mm256_sqrt_pd(_mm256_loadu_pd(&x[k])));

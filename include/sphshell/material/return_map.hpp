@@ -529,7 +529,9 @@ struct LaneReturn {
   bool fast;
 };
 
-inline LaneReturn closed_form_lane(const ClosedFormConstants& constants, double sum, double diff, double shear,
+// Forced inline: called out of line (as GCC did inside the section loop) the
+// lane loop around it stays scalar, a call per lane.
+[[gnu::always_inline]] inline LaneReturn closed_form_lane(const ClosedFormConstants& constants, double sum, double diff, double shear,
                                    double equibiaxial, double deviatoric, double trial_equivalent,
                                    double yield_stress) {
   const double trial_squared = equibiaxial + deviatoric;

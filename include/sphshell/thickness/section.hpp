@@ -9,10 +9,27 @@
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/types.hpp>
+#include <sphshell/material/lanes.hpp>
 #include <sphshell/thickness/thickness.hpp>
 
 #include <array>
 #include <cstddef>
+
+// Whether Section<Rule, Law>::update batches its integral points through the
+// law's update_lanes (material/lanes.hpp). Both paths give the same bits,
+// unless the compiler fuses multiply-adds (FMA) in one and not the other
+// (last-bit differences). The batched one pays for gathering the states into lanes, scattering them back
+// and returning every lane when one yields, which the vector units repay only
+// when they are wide: by default it is taken with AVX-512 and not otherwise
+// (README, Performance). Define SPHSHELL_BATCHED_SECTIONS to 1 or 0 before
+// including to force either path.
+#ifndef SPHSHELL_BATCHED_SECTIONS
+#if defined(__AVX512F__)
+#define SPHSHELL_BATCHED_SECTIONS 1
+#else
+#define SPHSHELL_BATCHED_SECTIONS 0
+#endif
+#endif
 
 namespace sphshell::thickness {
 
@@ -28,6 +45,8 @@ class Section {
   static constexpr int output_points = Rule::num_points;
   // Contiguous per stress point so the loop over integral points stays in cache.
   using State = std::array<typename Law::State, std::size_t(num_points)>;
+  // Whether update() takes the law's batched path.
+  static constexpr bool batched = SPHSHELL_BATCHED_SECTIONS != 0 && material::has_update_lanes_v<Law, num_points>;
 
   Section(const Law& law, double thickness) : law_(law), thickness_(thickness) {
     sphshell::detail::require_positive("thickness", thickness);
@@ -45,11 +64,25 @@ class Section {
 
   // Δε(ζ_k) = Δe + ζ_k Δκ at every integral point (Voigt, engineering shear), then the
   // new total resultants.
+  // Batched (see SPHSHELL_BATCHED_SECTIONS above), the N points go through
+  // the law's update_lanes at once: the increments are formed component by component into
+  // structure-of-arrays form, the states gathered and scattered back. Without
+  // FMA contraction the result is bitwise that of the point-by-point loop below.
   Resultants update(State& state, const StrainVoigt& d_membrane_strain,
                     const StrainVoigt& d_curvature) const {
-    for (int k = 0; k < num_points; ++k) {
-      const StrainVoigt d_strain = d_membrane_strain + zeta_[std::size_t(k)] * d_curvature;
-      law_.update(state[std::size_t(k)], d_strain);
+    if constexpr (batched) {
+      material::VoigtLanes<num_points> d_strain;
+      for (std::size_t k = 0; k < std::size_t(num_points); ++k) {
+        d_strain.xx[k] = d_membrane_strain.x() + zeta_[k] * d_curvature.x();
+        d_strain.yy[k] = d_membrane_strain.y() + zeta_[k] * d_curvature.y();
+        d_strain.xy[k] = d_membrane_strain.z() + zeta_[k] * d_curvature.z();
+      }
+      material::update_lanes<Law, num_points>(law_, state, d_strain);
+    } else {
+      for (int k = 0; k < num_points; ++k) {
+        const StrainVoigt d_strain = d_membrane_strain + zeta_[std::size_t(k)] * d_curvature;
+        law_.update(state[std::size_t(k)], d_strain);
+      }
     }
     return resultants(state);
   }
