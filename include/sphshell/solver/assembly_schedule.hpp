@@ -33,8 +33,10 @@ class AssemblySchedule {
   // two separate passes; runs of 32 to 128 rows measured alike
   // (README, "Performance").
   static constexpr std::size_t rows_per_run = 64;
-  // Segments per thread when several threads share the pass.
-  static constexpr std::size_t segments_per_thread = 4;
+  // Segments per thread when several threads share the pass: small tasks
+  // balance the threads, and 1, 2 or 4 per thread made two threads slower on
+  // the paper's plate (README, "Performance").
+  static constexpr std::size_t segments_per_thread = 8;
 
   struct Run {
     PointGroup group;
