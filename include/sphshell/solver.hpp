@@ -571,7 +571,7 @@ class Solver {
 
   EnergyReport energy() const {
     std::vector<double> stored(states_.size(), 0.0);
-    parallel::for_each(std::size_t{0}, stored.size(), [&](std::size_t p) noexcept {
+    assembler_.for_each_point(points_, [&](std::size_t p) noexcept {
       if (states_.active(p))
         stored[p] = states_.stored_energy(p, points_.membrane_bending_weight(p), points_.shear_weight(p));
     });

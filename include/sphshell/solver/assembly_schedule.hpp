@@ -33,10 +33,15 @@ class AssemblySchedule {
   // two separate passes; runs of 32 to 128 rows measured alike
   // (README, "Performance").
   static constexpr std::size_t rows_per_run = 64;
-  // Segments per thread when several threads share the pass: small tasks
-  // balance the threads, and 1, 2 or 4 per thread made two threads slower on
-  // the paper's plate (README, "Performance").
-  static constexpr std::size_t segments_per_thread = 8;
+  // Segments per thread when several threads share the pass. A particle
+  // whose points lie in two segments is summed after the pass, away from the
+  // cache that held its points: with eight per thread on the paper's plate
+  // (segments of about three grid rows) that was 94 % of the particles, and
+  // two threads took 0.63-0.64 of one thread's time on an idle machine
+  // against 0.53 with one, two or four; under load all four measured alike
+  // (README, "Thread counts"). Two keeps a spare task for a thread the
+  // system holds back.
+  static constexpr std::size_t segments_per_thread = 2;
 
   struct Run {
     PointGroup group;
@@ -55,6 +60,12 @@ class AssemblySchedule {
     build_runs(points);
     cut_segments(points.size());
     order_sums(points);
+  }
+
+  // Whether the schedule was built for these points' current force entries and this segment count.
+  template <class Approx>
+  bool is_current(const IntegrationPoints<Approx>& points, std::size_t segments) const {
+    return stamp_ != 0 && points.force_entries_stamp() == stamp_ && segments == segment_count_;
   }
 
   std::size_t segments() const { return segment_count_; }

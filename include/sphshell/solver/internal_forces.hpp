@@ -122,6 +122,26 @@ class InternalForceAssembler {
     parallel::for_each(std::size_t{0}, forces.internal.size(), [&](std::size_t i) noexcept { sum(i, forces); });
   }
 
+  // Calls body(p) for every point p, each thread taking the points it updates
+  // in compute(), whose data its core's cache then still holds; a pass over
+  // all points in index order would move a quarter of them to the other
+  // core and back on two threads (README, "Thread counts"). Before the first
+  // compute(), or after the points' force entries or the thread count
+  // changed, the points in index order. body must not throw and writes only what belongs to p.
+  template <class Approx, class Body>
+  void for_each_point(const IntegrationPoints<Approx>& points, Body&& body) const {
+    if (!schedule_.is_current(points, segment_count())) {
+      parallel::for_each(std::size_t{0}, points.size(), [&](std::size_t p) noexcept { body(p); });
+      return;
+    }
+    parallel::for_each_task(schedule_.segments(), [&](std::size_t segment) noexcept {
+      for (std::size_t run = schedule_.first_run(segment); run < schedule_.end_run(segment); ++run) {
+        const AssemblySchedule::Run& rows = schedule_.run(run);
+        for (std::size_t row = rows.first_row; row < rows.end_row; ++row) body(points.point(rows.group, row));
+      }
+    });
+  }
+
   // The point whose failure stopped the last compute() (the lowest failing
   // index of its group).
   std::size_t failed_point() const { return failed_point_; }
@@ -235,7 +255,10 @@ class InternalForceAssembler {
       tied_force_.assign(points.untied_corner(), zero);
       tied_director_force_.assign(points.untied_corner(), zero);
     }
-    work_increment_.assign(points.size(), 0.0);
+    // Every compute() writes every point's work (zero for an inactive one), so
+    // it is zeroed only when sized: zeroing it serially every step moved half
+    // of it between the cores' caches on two threads.
+    if (work_increment_.size() != points.size()) work_increment_.assign(points.size(), 0.0);
   }
 
   // The tied corner forces of a stress point whose cell's shear is left out.
@@ -250,7 +273,10 @@ class InternalForceAssembler {
   void integrate_point(PointGroup group, std::size_t row, const IntegrationPoints<Approx>& points,
                        SectionStates<Rule, Law>& states) {
     const std::size_t p = points.point(group, row);
-    if (!states.active(p)) return;
+    if (!states.active(p)) {
+      work_increment_[p] = 0.0;
+      return;
+    }
     const shell::SurfaceGradients current = points.gather(group, row, packed_);
     const shell::Strains strains = strains_of(current, points, p);
     const StrainVoigt d_membrane = strains.membrane - states.membrane_strain(p);
