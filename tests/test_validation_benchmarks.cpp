@@ -118,6 +118,72 @@ TEST_CASE("Static shell: displacement control follows the load-controlled path",
   CHECK_THROWS_WITH(statics.solve_to_displacement(tip_w, 1.0, 0.0), Catch::Contains("displacement step must be positive"));
 }
 
+TEST_CASE("Static shell: the arc length follows the load-controlled path", "[static][benchmarks]") {
+  // The cantilever of the test above, followed by arc length (steps of 0.2
+  // in the particles' root-mean-square motion, the load factor solved for):
+  // the same equilibria as load control, read at the same load factors.
+  const std::vector<double> factors{0.5, 1.0};
+  const CantileverRun by_load = run_cantilever<NonlinearSolver>(EndLoad::shear, 21, 3, factors, 0.1);
+  CantileverStrip strip = cantilever_strip(10.0, 21, 3);
+  const std::vector<double> share = edge_shares(3);
+  for (int k = 0; k < 3; ++k) strip.conditions.add_force({strip.tip[k]}, Vector3(0.0, 0.0, 4.0 * share[k]));
+  const ControlDisplacement tip_w{{{strip.tip_mid, 1.0}}, Vector3::UnitZ()};
+  const ControlDisplacement tip_u{{{strip.tip_mid, 1.0}}, -Vector3::UnitX()};
+  const PathRun path =
+      follow_arc_length<NonlinearSolver>(strip.model, 1.2e6, 0.0, strip.conditions, {tip_w, tip_u}, 0.2, 1.0, 60);
+  REQUIRE(path.stopped.empty());
+  REQUIRE(path.path.back().load_factor >= 1.0);
+  for (std::size_t k = 1; k < path.path.size(); ++k) {  // forward along the path, never back
+    CHECK(path.path[k].load_factor > path.path[k - 1].load_factor);
+    CHECK(path.path[k].control > path.path[k - 1].control);
+  }
+  for (std::size_t k = 0; k < factors.size(); ++k) {
+    const std::vector<double> on_path = readings_at_load_factor(path.path, factors[k]);
+    REQUIRE(on_path.size() == 2);
+    std::printf("arc length at P/Pmax = %.2f: w %.6f (load control %.6f), -u %.6f (%.6f)\n", factors[k], on_path[0],
+                by_load.points[k].w, on_path[1], by_load.points[k].u);
+    CHECK(on_path[0] == Approx(by_load.points[k].w).epsilon(2e-3));
+    CHECK(on_path[1] == Approx(by_load.points[k].u).epsilon(4e-3));
+  }
+  NonlinearSolver solver(strip.model, {1.2e6, 0.0});
+  StaticShell<NonlinearSolver> statics(solver, strip.conditions);
+  CHECK_THROWS_WITH(statics.arc_length_step(0.0), Catch::Contains("arc length must be positive"));
+}
+
+TEST_CASE("Static shell: the tangent's inertia finds the Euler load of a compressed strip", "[static][benchmarks]") {
+  // The Sze cantilever strip (L = 10, EI = 100, ν = 0; 21 × 3) under an axial
+  // dead load P at its free end stays straight; it loses stability at
+  // Euler's P_cr = π² EI / (4 L²) (Mindlin's shear lowers it by P_cr / (κ G A),
+  // 5·10⁻⁵ here). Below P_cr the tangent is positive definite; above it one
+  // eigenvalue is negative, its mode the transverse bending one, orthogonal
+  // to the load (a bifurcation, not a limit point of the load).
+  CantileverStrip strip = cantilever_strip(10.0, 21, 3);
+  const double euler = benchmark_pi * benchmark_pi * strip.EI / (4.0 * strip.L * strip.L);
+  const std::vector<double> share = edge_shares(3);
+  for (int k = 0; k < 3; ++k) strip.conditions.add_force({strip.tip[k]}, Vector3(-euler * share[k], 0.0, 0.0));
+  NonlinearSolver solver(strip.model, {1.2e6, 0.0});
+  StaticShell<NonlinearSolver> statics(solver, strip.conditions);
+  statics.solve_to(0.99, 0.5);
+  const auto below = statics.stability();
+  statics.solve_to(1.01, 0.5);
+  const auto above = statics.stability();
+  CHECK(std::abs(statics.displacement(strip.tip_mid).z()) < 1e-9);  // still straight
+  CHECK(below.negative_eigenvalues == 0);
+  CHECK(above.negative_eigenvalues == 1);
+  CHECK(below.eigenvalue_nearest_zero > 0.0);
+  CHECK(above.eigenvalue_nearest_zero < 0.0);
+  // The eigenvalue falls linearly with the load: its zero is the discrete model's buckling load.
+  const double critical = 0.99 + 0.02 * below.eigenvalue_nearest_zero /
+                                     (below.eigenvalue_nearest_zero - above.eigenvalue_nearest_zero);
+  std::printf("Euler strip (21 x 3): buckling at %.5f P_cr\n", critical);
+  CHECK(critical == Approx(1.0).epsilon(5e-3));
+  CHECK(above.load_share < 1e-8);
+  // The mode bends the strip out of its plane: the tip moves most, along z.
+  const Vector3 tip = above.mode[static_cast<std::size_t>(strip.tip_mid)];
+  CHECK(std::abs(tip.z()) > 10.0 * std::abs(tip.x()));
+  for (const Vector3& motion : above.mode) CHECK(motion.norm() <= std::abs(tip.z()) * (1.0 + 1e-6));
+}
+
 TEST_CASE("Benchmark: Scordelis-Lo roof (linear)", "[validation][benchmarks]") {
   // Reference 0.3024 (MacNeal & Harder 1985). Measured −0.52 % at 33 x 33
   // (+0.07 % at 17, −0.37 % at 25; −0.56 % at 41 in the example).

@@ -564,6 +564,37 @@ struct PathRun {
 // A displacement to read along the path: Σ w_j u_j · direction.
 using PathReading = ControlDisplacement;
 
+namespace detail {
+// The loop both path followers share: advance(statics) takes one step and
+// returns the path's control after it.
+template <class NonlinearSolver, class Advance>
+PathRun follow(const ShellModel& model, double E, double nu, const StaticConditions& conditions,
+               const std::vector<PathReading>& readings, double last_factor, int max_steps, NewtonOptions newton,
+               const std::function<void(const PathPoint&, const NewtonReport&)>& progress, Advance&& advance) {
+  const auto start = std::chrono::steady_clock::now();
+  NonlinearSolver solver(model, {E, nu});
+  StaticShell<NonlinearSolver> statics(solver, conditions, newton);
+  PathRun run;
+  run.path.push_back({0.0, 0.0, std::vector<double>(readings.size(), 0.0)});
+  for (int k = 1; k <= max_steps && run.path.back().load_factor < last_factor; ++k) {
+    double control = 0.0;
+    try {
+      control = advance(statics, k);
+    } catch (const std::runtime_error& error) {  // Newton gave up: keep the path so far
+      run.stopped = error.what();
+      break;
+    }
+    PathPoint point{control, statics.load_factor(), {}};
+    for (const PathReading& reading : readings) point.values.push_back(statics.displacement_of(reading));
+    run.path.push_back(std::move(point));
+    if (progress) progress(run.path.back(), statics.report());
+  }
+  run.report = statics.report();
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return run;
+}
+}  // namespace detail
+
 // Follows the path of `conditions` on a new solver of `model` in steps of
 // `step` of the control displacement until the load factor reaches
 // `last_factor` (or `max_steps` steps were taken, or Newton failed: the path
@@ -573,26 +604,30 @@ PathRun follow_path(const ShellModel& model, double E, double nu, const StaticCo
                     const ControlDisplacement& control, const std::vector<PathReading>& readings, double step,
                     double last_factor, int max_steps, NewtonOptions newton = {},
                     const std::function<void(const PathPoint&, const NewtonReport&)>& progress = {}) {
-  const auto start = std::chrono::steady_clock::now();
-  NonlinearSolver solver(model, {E, nu});
-  StaticShell<NonlinearSolver> statics(solver, conditions, newton);
-  PathRun run;
-  run.path.push_back({0.0, 0.0, std::vector<double>(readings.size(), 0.0)});
-  for (int k = 1; k <= max_steps && run.path.back().load_factor < last_factor; ++k) {
-    try {
-      statics.solve_to_displacement(control, k * step, step);
-    } catch (const std::runtime_error& error) {  // Newton gave up: keep the path so far
-      run.stopped = error.what();
-      break;
-    }
-    PathPoint point{statics.displacement_of(control), statics.load_factor(), {}};
-    for (const PathReading& reading : readings) point.values.push_back(statics.displacement_of(reading));
-    run.path.push_back(std::move(point));
-    if (progress) progress(run.path.back(), statics.report());
-  }
-  run.report = statics.report();
-  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return run;
+  return detail::follow<NonlinearSolver>(model, E, nu, conditions, readings, last_factor, max_steps, newton, progress,
+                                         [&](StaticShell<NonlinearSolver>& statics, int k) {
+                                           statics.solve_to_displacement(control, k * step, step);
+                                           return statics.displacement_of(control);
+                                         });
+}
+
+// As follow_path, by arc length (StaticShell::arc_length_step): steps of at
+// most `length` (m) of the particles' root-mean-square motion, a step after one taken whole
+// half as long again (up to `length`), one after a halved step as long as
+// that. PathPoint::control is the length of the path so far.
+template <class NonlinearSolver>
+PathRun follow_arc_length(const ShellModel& model, double E, double nu, const StaticConditions& conditions,
+                          const std::vector<PathReading>& readings, double length, double last_factor, int max_steps,
+                          NewtonOptions newton = {},
+                          const std::function<void(const PathPoint&, const NewtonReport&)>& progress = {}) {
+  double next = length, travelled = 0.0;
+  return detail::follow<NonlinearSolver>(model, E, nu, conditions, readings, last_factor, max_steps, newton, progress,
+                                         [&](StaticShell<NonlinearSolver>& statics, int) {
+                                           const double taken = statics.arc_length_step(next);
+                                           travelled += taken;
+                                           next = taken < next ? taken : std::min(length, 1.5 * taken);
+                                           return travelled;
+                                         });
 }
 
 // The path's readings where its load factor first reaches `lambda` (what load

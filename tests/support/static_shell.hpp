@@ -16,6 +16,11 @@
 //   factor is an unknown of each Newton iteration, so the path is followed
 //   through limit points of the load (a snap-through), where load control
 //   fails.
+// - Or by arc length (Riks, IJSS 15 (1979) 529–551, in its hyperplane form):
+//   each step moves the particles a given length along the path's direction
+//   (the last step's motion), the load factor solved for with it, so the
+//   path passes limit points of any single displacement too (a snap-back,
+//   where displacement control stalls: the control cannot grow past them).
 //
 // The assembly perturbs many particles at once. A particle's motion changes
 // the forces only within two support radii (the stress points that see it and
@@ -121,6 +126,15 @@ struct ControlDisplacement {
   Vector3 direction;
 };
 
+// An arc-length step's control: Σ_j a_j · u_j − start, with a_j the motion of
+// particle j over the path's last step divided by √N times its length ‖Δx‖
+// (N particles: the control grows by the root-mean-square motion of the
+// particles along that direction), start its value where the step begins.
+struct PathDirection {
+  std::vector<std::pair<int, Vector3>> motion;
+  double start = 0.0;
+};
+
 struct NewtonReport {
   int load_steps = 0;         // converged steps, halved ones included
   int iterations = 0;         // Newton iterations (tangent assemblies) in all
@@ -200,6 +214,68 @@ class StaticShell {
     }
   }
 
+  // One arc-length step: the particles move a root-mean-square `length` (m)
+  // along the path's direction, on the hyperplane normal to it, with the load factor solved
+  // for. The direction is the motion of the last step (before any step: the
+  // response K⁻¹f to the load, the way the load factor grows). Halved when
+  // Newton fails (at most max_halvings times); returns the length taken.
+  double arc_length_step(double length) {
+    if (!(length > 0.0)) throw std::invalid_argument("StaticShell: the arc length must be positive");
+    const std::vector<Vector3> x0 = solver_.positions(), d0 = solver_.directors();
+    PathDirection direction;
+    double last_length = 0.0;
+    if (previous_.x.empty()) {
+      const Dofs dofs = current_dofs();
+      const Eigen::VectorXd response = solve_tangent(dofs, external_load(dofs), Factorisation::general).col(0);
+      for (int i = 0; i + 1 < static_cast<int>(dofs.first.size()); ++i) {
+        Vector3 motion = Vector3::Zero();
+        for (int k = dofs.first[i]; k < dofs.first[i + 1]; ++k)
+          if (!dofs.is_rotation[k]) motion += response[k] * dofs.direction[k];
+        direction.motion.push_back({i, motion});
+      }
+    } else {
+      for (int i = 0; i < static_cast<int>(x0.size()); ++i) direction.motion.push_back({i, x0[i] - previous_.x[i]});
+    }
+    double norm = 0.0;
+    for (const auto& [particle, motion] : direction.motion) norm += motion.squaredNorm();
+    norm = std::sqrt(norm);
+    if (!(norm > 0.0)) throw std::runtime_error("StaticShell: the path has no direction (no load, or no last step)");
+    // Lengths are root-mean-square motions of the particles (independent of their number).
+    const double particles = std::sqrt(static_cast<double>(direction.motion.size()));
+    for (auto& [particle, motion] : direction.motion) motion /= norm * particles;
+    last_length = previous_.x.empty() ? 0.0 : norm / particles;
+    direction.start = displacement_of(direction);
+    const double value = 0.0;
+    double step = length;
+    for (int halvings = 0;; ++halvings) {
+      const double lambda0 = lambda_;
+      const double next = value + step;
+      if (last_length > 0.0) {
+        previous_.control = value - last_length;  // the last step, measured along its own direction
+        predict_displacement(next, value);
+      }
+      if (converge_displacement(direction, next)) {
+        previous_ = {x0, d0, lambda0, value};
+        ++report_.load_steps;
+        return step;
+      }
+      solver_.set_configuration(x0, d0);
+      ++report_.force_evaluations;
+      lambda_ = lambda0;
+      step *= 0.5;
+      if (halvings + 1 > options_.max_halvings)
+        throw std::runtime_error("StaticShell: Newton did not converge on an arc-length step of " +
+                                 std::to_string(2.0 * step) + " (load factor " + std::to_string(lambda_) + ")");
+    }
+  }
+
+  // The control of an arc-length step in the current configuration.
+  double displacement_of(const PathDirection& control) const {
+    double value = 0.0;
+    for (const auto& [particle, motion] : control.motion) value += displacement(particle).dot(motion);
+    return value - control.start;
+  }
+
   // The control displacement in the current configuration.
   double displacement_of(const ControlDisplacement& control) const {
     double value = 0.0;
@@ -217,6 +293,46 @@ class StaticShell {
   void linear_solve(double lambda) {
     lambda_ = lambda;
     newton_iteration(lambda, Factorisation::symmetric);
+  }
+
+  // The stability of the current state, for telling where a path turns
+  // unstable (a bifurcation, or a limit point of the load): the number of
+  // negative eigenvalues of the symmetrised tangent stiffness, read off the
+  // signs of its LDLᵀ pivots (Sylvester's law of inertia), and its eigenvalue
+  // nearest zero by inverse iteration on the same factorisation. The
+  // eigenvalue mixes N/m and N·m/rad: compare it along one path, not across models.
+  struct Stability {
+    int negative_eigenvalues = 0;
+    double eigenvalue_nearest_zero = 0.0;
+    // Its mode: |φ · f| / (‖φ‖ ‖f‖) with the load f (near 0 at a bifurcation,
+    // not at a limit point of the load), and each particle's translation in it.
+    double load_share = 0.0;
+    std::vector<Vector3> mode;
+  };
+  Stability stability() {
+    constexpr int inverse_iterations = 60;
+    const Dofs dofs = current_dofs();
+    Eigen::SparseMatrix<double> k = tangent(dofs);
+    const Eigen::SparseMatrix<double> transposed = k.transpose();
+    const Eigen::SparseMatrix<double> symmetric = 0.5 * (k + transposed);
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(symmetric);
+    if (ldlt.info() != Eigen::Success) throw std::runtime_error("StaticShell: the tangent has a zero pivot");
+    Stability result;
+    for (Eigen::Index i = 0; i < ldlt.vectorD().size(); ++i)
+      if (ldlt.vectorD()[i] < 0.0) ++result.negative_eigenvalues;
+    // A start with a part along every mode (no symmetry of the model is orthogonal to it).
+    Eigen::VectorXd x(symmetric.rows());
+    for (Eigen::Index i = 0; i < x.size(); ++i) x[i] = std::sin(1.0 + 0.7548776662 * static_cast<double>(i));
+    x.normalize();
+    for (int iteration = 0; iteration < inverse_iterations; ++iteration) x = ldlt.solve(x).normalized();
+    result.eigenvalue_nearest_zero = x.dot(symmetric * x);
+    const Eigen::VectorXd f = external_load(dofs);
+    result.load_share = f.norm() > 0.0 ? std::abs(x.dot(f)) / f.norm() : 0.0;
+    result.mode.assign(dofs.first.size() - 1, Vector3::Zero());
+    for (std::size_t i = 0; i + 1 < dofs.first.size(); ++i)
+      for (int k = dofs.first[i]; k < dofs.first[i + 1]; ++k)
+        if (!dofs.is_rotation[k]) result.mode[i] += x[k] * dofs.direction[k];
+    return result;
   }
 
   double load_factor() const { return lambda_; }
@@ -443,6 +559,15 @@ class StaticShell {
     return f;
   }
 
+  // An arc-length control's gradient in the dofs.
+  Eigen::VectorXd control_gradient(const Dofs& dofs, const PathDirection& control) const {
+    Eigen::VectorXd g = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(dofs.direction.size()));
+    for (const auto& [particle, motion] : control.motion)
+      for (int k = dofs.first[particle]; k < dofs.first[particle + 1]; ++k)
+        if (!dofs.is_rotation[k]) g[k] += motion.dot(dofs.direction[k]);
+    return g;
+  }
+
   // The control displacement's gradient in the dofs (it is linear in the translations).
   Eigen::VectorXd control_gradient(const Dofs& dofs, const ControlDisplacement& control) const {
     Eigen::VectorXd g = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(dofs.direction.size()));
@@ -456,7 +581,8 @@ class StaticShell {
   // the load factor lambda_ an unknown: with K δu_r = r and K δu_f = f_ext,
   // the update δu_r + δλ δu_f meets the displacement to first order (it is
   // linear in the translations, so exactly).
-  bool converge_displacement(const ControlDisplacement& control, double target) {
+  template <class Control>
+  bool converge_displacement(const Control& control, double target) {
     // A relative residual this much above the step's smallest so far means
     // the iteration left the path's basin (a wrong branch, a wild load
     // factor): halving the step is cheaper than iterating on.
