@@ -81,72 +81,81 @@ TEST_CASE("Static shell: the elastica by shooting matches the tabulated cantilev
   CHECK(small.w == Approx(1e-4 * 1000.0 / 300.0).epsilon(1e-6));
 }
 
-TEST_CASE("Static shell: displacement control follows the load-controlled path", "[static][benchmarks]") {
-  // The cantilever under end shear (21 x 3) solved twice: by load control to
-  // P/P_max = 0.5 and 1, and by prescribing the tip's deflection in steps of
-  // 0.5 (the load factor then an unknown). Both are equilibria of the same
-  // discrete model, so the path read at those load factors must give the load
-  // control's tip (to the Newton tolerance and the path's quadratic
-  // interpolation), and both stay near the elastica.
-  const std::vector<double> factors{0.5, 1.0};
-  const CantileverRun by_load = run_cantilever<NonlinearSolver>(EndLoad::shear, 21, 3, factors, 0.1);
+namespace {
+
+// The cantilever under end shear (21 x 3, P_max = 4 shared by the tip
+// particles), its tip's w and −u as path readings, and load control's tip at
+// P/P_max = 0.5 and 1.
+struct EndShearPaths {
   CantileverStrip strip = cantilever_strip(10.0, 21, 3);
-  const std::vector<double> share = edge_shares(3);
-  for (int k = 0; k < 3; ++k) strip.conditions.add_force({strip.tip[k]}, Vector3(0.0, 0.0, 4.0 * share[k]));
-  const ControlDisplacement tip_w{{{strip.tip_mid, 1.0}}, Vector3::UnitZ()};
-  const ControlDisplacement tip_u{{{strip.tip_mid, 1.0}}, -Vector3::UnitX()};
-  const PathRun path = follow_path<NonlinearSolver>(strip.model, 1.2e6, 0.0, strip.conditions, tip_w, {tip_w, tip_u},
-                                                    0.5, 1.0, 40);
-  REQUIRE(path.path.back().load_factor >= 1.0);
+  ControlDisplacement tip_w{{{strip.tip_mid, 1.0}}, Vector3::UnitZ()};
+  ControlDisplacement tip_u{{{strip.tip_mid, 1.0}}, -Vector3::UnitX()};
+  std::vector<double> factors{0.5, 1.0};
+  CantileverRun by_load = run_cantilever<NonlinearSolver>(EndLoad::shear, 21, 3, factors, 0.1);
+  EndShearPaths() {
+    const std::vector<double> share = edge_shares(3);
+    for (int k = 0; k < 3; ++k) strip.conditions.add_force({strip.tip[k]}, Vector3(0.0, 0.0, 4.0 * share[k]));
+  }
+  // A path's tip {w, −u} read at each load factor against load control's: the
+  // same equilibria of the same discrete model, to the Newton tolerance and
+  // the path's quadratic interpolation. Returns the readings.
+  std::vector<std::vector<double>> check(const char* method, const PathRun& path) const {
+    REQUIRE(path.path.back().load_factor >= 1.0);
+    std::vector<std::vector<double>> readings;
+    for (std::size_t k = 0; k < factors.size(); ++k) {
+      const std::vector<double> on_path = readings_at_load_factor(path.path, factors[k]);
+      REQUIRE(on_path.size() == 2);
+      std::printf("%s at P/Pmax = %.2f: w %.6f (load control %.6f), -u %.6f (%.6f)\n", method, factors[k], on_path[0],
+                  by_load.points[k].w, on_path[1], by_load.points[k].u);
+      CHECK(on_path[0] == Approx(by_load.points[k].w).epsilon(2e-3));
+      CHECK(on_path[1] == Approx(by_load.points[k].u).epsilon(4e-3));
+      readings.push_back(on_path);
+    }
+    return readings;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("Static shell: displacement control follows the load-controlled path", "[static][benchmarks]") {
+  // The cantilever under end shear solved twice: by load control to
+  // P/P_max = 0.5 and 1, and by prescribing the tip's deflection in steps of
+  // 0.5 (the load factor then an unknown); both stay near the elastica.
+  const EndShearPaths cantilever;
+  const PathRun path = follow_path<NonlinearSolver>(cantilever.strip.model, 1.2e6, 0.0, cantilever.strip.conditions,
+                                                    cantilever.tip_w, {cantilever.tip_w, cantilever.tip_u}, 0.5, 1.0,
+                                                    40);
   for (std::size_t k = 1; k < path.path.size(); ++k)  // the tip's w is what was prescribed
     CHECK(path.path[k].values[0] == Approx(0.5 * double(k)).epsilon(1e-9));
-  for (std::size_t k = 0; k < factors.size(); ++k) {
-    const std::vector<double> on_path = readings_at_load_factor(path.path, factors[k]);
-    REQUIRE(on_path.size() == 2);
-    std::printf("displacement control at P/Pmax = %.2f: w %.6f (load control %.6f), -u %.6f (%.6f)\n", factors[k],
-                on_path[0], by_load.points[k].w, on_path[1], by_load.points[k].u);
-    CHECK(on_path[0] == Approx(by_load.points[k].w).epsilon(2e-3));
-    CHECK(on_path[1] == Approx(by_load.points[k].u).epsilon(4e-3));
-    const TipDisplacement exact = elastica_tip(factors[k] * 4.0, 100.0, 10.0);
-    CHECK(on_path[0] == Approx(exact.w).epsilon(5e-3));
+  const std::vector<std::vector<double>> readings = cantilever.check("displacement control", path);
+  for (std::size_t k = 0; k < readings.size(); ++k) {
+    const TipDisplacement exact = elastica_tip(cantilever.factors[k] * 4.0, 100.0, 10.0);
+    CHECK(readings[k][0] == Approx(exact.w).epsilon(5e-3));
   }
   // A path read beyond its last load factor gives nothing.
   CHECK(readings_at_load_factor(path.path, 10.0).empty());
   // Bad input: a non-positive displacement step.
-  NonlinearSolver solver(strip.model, {1.2e6, 0.0});
-  StaticShell<NonlinearSolver> statics(solver, strip.conditions);
-  CHECK_THROWS_WITH(statics.solve_to_displacement(tip_w, 1.0, 0.0), Catch::Contains("displacement step must be positive"));
+  NonlinearSolver solver(cantilever.strip.model, {1.2e6, 0.0});
+  StaticShell<NonlinearSolver> statics(solver, cantilever.strip.conditions);
+  CHECK_THROWS_WITH(statics.solve_to_displacement(cantilever.tip_w, 1.0, 0.0),
+                    Catch::Contains("displacement step must be positive"));
 }
 
 TEST_CASE("Static shell: the arc length follows the load-controlled path", "[static][benchmarks]") {
   // The cantilever of the test above, followed by arc length (steps of 0.2
-  // in the particles' root-mean-square motion, the load factor solved for):
-  // the same equilibria as load control, read at the same load factors.
-  const std::vector<double> factors{0.5, 1.0};
-  const CantileverRun by_load = run_cantilever<NonlinearSolver>(EndLoad::shear, 21, 3, factors, 0.1);
-  CantileverStrip strip = cantilever_strip(10.0, 21, 3);
-  const std::vector<double> share = edge_shares(3);
-  for (int k = 0; k < 3; ++k) strip.conditions.add_force({strip.tip[k]}, Vector3(0.0, 0.0, 4.0 * share[k]));
-  const ControlDisplacement tip_w{{{strip.tip_mid, 1.0}}, Vector3::UnitZ()};
-  const ControlDisplacement tip_u{{{strip.tip_mid, 1.0}}, -Vector3::UnitX()};
-  const PathRun path =
-      follow_arc_length<NonlinearSolver>(strip.model, 1.2e6, 0.0, strip.conditions, {tip_w, tip_u}, 0.2, 1.0, 60);
+  // in the particles' root-mean-square motion, the load factor solved for).
+  const EndShearPaths cantilever;
+  const PathRun path = follow_arc_length<NonlinearSolver>(cantilever.strip.model, 1.2e6, 0.0,
+                                                          cantilever.strip.conditions,
+                                                          {cantilever.tip_w, cantilever.tip_u}, 0.2, 1.0, 60);
   REQUIRE(path.stopped.empty());
-  REQUIRE(path.path.back().load_factor >= 1.0);
   for (std::size_t k = 1; k < path.path.size(); ++k) {  // forward along the path, never back
     CHECK(path.path[k].load_factor > path.path[k - 1].load_factor);
     CHECK(path.path[k].control > path.path[k - 1].control);
   }
-  for (std::size_t k = 0; k < factors.size(); ++k) {
-    const std::vector<double> on_path = readings_at_load_factor(path.path, factors[k]);
-    REQUIRE(on_path.size() == 2);
-    std::printf("arc length at P/Pmax = %.2f: w %.6f (load control %.6f), -u %.6f (%.6f)\n", factors[k], on_path[0],
-                by_load.points[k].w, on_path[1], by_load.points[k].u);
-    CHECK(on_path[0] == Approx(by_load.points[k].w).epsilon(2e-3));
-    CHECK(on_path[1] == Approx(by_load.points[k].u).epsilon(4e-3));
-  }
-  NonlinearSolver solver(strip.model, {1.2e6, 0.0});
-  StaticShell<NonlinearSolver> statics(solver, strip.conditions);
+  cantilever.check("arc length", path);
+  NonlinearSolver solver(cantilever.strip.model, {1.2e6, 0.0});
+  StaticShell<NonlinearSolver> statics(solver, cantilever.strip.conditions);
   CHECK_THROWS_WITH(statics.arc_length_step(0.0), Catch::Contains("arc length must be positive"));
 }
 
