@@ -16,6 +16,7 @@
 #include "example_arguments.hpp"
 #include "support/shell_benchmarks.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -50,11 +51,14 @@ std::optional<Arguments> parse(int argc, char** argv) {
       "table printed gives the finest one's error with the two coarser ones' beside it.");
   command_line.flag("--coarse", arguments.coarse,
                     "three coarse resolutions per case, without the slit annular plate (a quick run, for checks)");
-  command_line.choice("--cases", arguments.cases, {"all", "linear", "nonlinear", "paths", "hemisphere-path"},
+  command_line.choice("--cases", arguments.cases,
+                      {"all", "linear", "nonlinear", "paths", "hemisphere-path", "pullout-stability"},
                       "which benchmarks to run: all is linear and nonlinear; paths follows the whole load paths of "
                       "Sze et al.'s hemisphere (at three resolutions), pull-out and pinched cylinder (one each) by "
                       "displacement control, about 17 min; hemisphere-path follows only the hemisphere's, at 33² and "
-                      "41² (finer than paths), about 20 min");
+                      "41² (finer than paths), about 20 min; pullout-stability follows the pull-out at 13×9 and 22×15 by "
+                      "displacement control with the tangent's stability after every step, then by arc length, "
+                      "about 2 min");
   command_line.output_folder(arguments.output);
   command_line.writes("benchmarks.csv", "every run: case, resolution, value, reference, error, seconds");
   command_line.writes("end_shear.csv", "cantilever under end shear: P/Pmax, tip w and -u, the elastica's");
@@ -75,6 +79,14 @@ std::optional<Arguments> parse(int argc, char** argv) {
   command_line.writes("pullout_path.svg", "its load-deflection chart with the paper's points");
   command_line.writes("pinched_cylinder_path.csv", "--cases paths: the pinched cylinder's path, control, P/Pmax, -W_A, U_B");
   command_line.writes("pinched_cylinder_path.svg", "its load-deflection chart with the paper's points");
+  command_line.writes("pullout_stability_NxM.csv",
+                      "--cases pullout-stability: per step of the -U_B control, P/Pmax, W_A, -U_B, -U_C, the "
+                      "tangent's negative eigenvalues, its eigenvalue nearest zero (and over the unloaded one's), "
+                      "its mode's share of the load; the last row is where the control stalled");
+  command_line.writes("pullout_arc_length_NxM.csv", "--cases pullout-stability: the arc-length path, length, P/Pmax, W_A, -U_B, -U_C");
+  command_line.writes("pullout_mode_NxM.csv",
+                      "--cases pullout-stability: that mode where the control stalled, per particle: x, y, z, "
+                      "its radial, circumferential and axial translation (largest 1)");
   if (!command_line.parse(argc, argv)) return std::nullopt;
   return arguments;
 }
@@ -133,6 +145,7 @@ int run(const Arguments& arguments) {
   const bool nonlinear = arguments.cases == "all" || arguments.cases == "nonlinear";
   const bool hemisphere_only = arguments.cases == "hemisphere-path";
   const bool paths = arguments.cases == "paths" || hemisphere_only;
+  const bool pullout_stability = arguments.cases == "pullout-stability";
   // Runs: resolution (particles), value, reference, error %, seconds; one file per case kind.
   io::CsvProbe csv(arguments.output + "/benchmarks.csv",
                    {"particles", "value", "reference", "error [%]", "seconds"});
@@ -519,6 +532,79 @@ int run(const Arguments& arguments) {
         report("pinched_cylinder_path", "Pinched cylinder, diaphragms: the path (Sze 2004)",
                "Pinched cylinder (Sze §3.6)", {{pinched_grid, pinched_path}}, {"−W_A", "U_B"}, {a, b}, {0.05, 0.1, 0.15, 1.0});
       }
+    }
+  }
+
+  if (pullout_stability) {
+    // Where the pull-out's path stops (README, "What limits them"): the
+    // tangent's stability after every step of the −U_B control, and the same
+    // path by arc length.
+    NewtonOptions newton;
+    newton.tolerance = 1e-5;
+    newton.max_iterations = 12;
+    for (const Resolution& grid : {Resolution{13, 9}, Resolution{22, 15}}) {
+      const auto start = std::chrono::steady_clock::now();
+      const SzeCylinder cylinder = sze_pullout_cylinder(grid.nx, grid.ny);
+      const std::string tag = std::to_string(grid.nx) + "x" + std::to_string(grid.ny);
+      const ControlDisplacement w_a{cylinder.a, Vector3::UnitX()}, u_b{cylinder.b, -Vector3::UnitY()},
+          u_c{cylinder.c, -Vector3::UnitY()};
+      {
+        NonlinearSolver solver(cylinder.model, {cylinder.E, cylinder.nu});
+        StaticShell<NonlinearSolver> statics(solver, cylinder.conditions, newton);
+        io::CsvProbe stability_csv(arguments.output + "/pullout_stability_" + tag + ".csv",
+                                   {"P/Pmax", "W_A", "-U_B", "-U_C", "negative eigenvalues", "eigenvalue nearest zero",
+                                    "over the unloaded one", "mode's share of the load"});
+        const auto unloaded = statics.stability();
+        std::vector<double> last_row;
+        const auto write = [&](const StaticShell<NonlinearSolver>::Stability& stability) {
+          last_row = {statics.load_factor(), statics.displacement_of(w_a), statics.displacement_of(u_b),
+                      statics.displacement_of(u_c), static_cast<double>(stability.negative_eigenvalues),
+                      stability.eigenvalue_nearest_zero,
+                      stability.eigenvalue_nearest_zero / unloaded.eigenvalue_nearest_zero, stability.load_share};
+          stability_csv.write_row(last_row);
+          std::cerr << "  P/Pmax " << last_row[0] << ": " << stability.negative_eigenvalues
+                    << " negative eigenvalues, nearest zero " << last_row[6] << " of the unloaded one ("
+                    << seconds_since(start) << " s)\n";
+        };
+        std::cerr << "Pull-out (Sze), " << grid.text() << ": -U_B in steps of 0.15, the tangent's stability\n";
+        write(unloaded);
+        for (int k = 1; k <= 60; ++k) {
+          try {
+            statics.solve_to_displacement(u_b, 0.15 * k, 0.15);
+          } catch (const std::runtime_error& error) {
+            std::cerr << "  stalled: " << error.what() << "\n";
+            const auto stalled = statics.stability();
+            write(stalled);
+            // The mode, in the cylinder's own directions, largest translation 1.
+            io::CsvProbe mode_csv(arguments.output + "/pullout_mode_" + tag + ".csv",
+                                  {"x", "y", "z", "radial", "circumferential", "axial"});
+            double largest = 0.0;
+            for (const Vector3& motion : stalled.mode) largest = std::max(largest, motion.norm());
+            for (std::size_t i = 0; i < stalled.mode.size(); ++i) {
+              const Vector3& x = cylinder.model.particle_position[i];
+              const Vector3 radial = Vector3(x.x(), x.y(), 0.0).normalized();
+              const Vector3 around = Vector3::UnitZ().cross(radial);
+              const Vector3 m = stalled.mode[i] / largest;
+              mode_csv.write_row({x.x(), x.y(), x.z(), m.dot(radial), m.dot(around), m.z()});
+            }
+            break;
+          }
+          write(statics.stability());
+        }
+      }
+      std::cerr << "Pull-out (Sze), " << grid.text() << ": arc length, RMS steps of 0.1\n";
+      const PathRun arc = follow_arc_length<NonlinearSolver>(
+          cylinder.model, cylinder.E, cylinder.nu, cylinder.conditions, {w_a, u_b, u_c}, 0.1, 1.0, 60, newton);
+      io::CsvProbe arc_csv(arguments.output + "/pullout_arc_length_" + tag + ".csv",
+                           {"length", "P/Pmax", "W_A", "-U_B", "-U_C"});
+      double highest = 0.0;
+      for (const PathPoint& point : arc.path) {
+        arc_csv.write_row({point.control, point.load_factor, point.values[0], point.values[1], point.values[2]});
+        highest = std::max(highest, point.load_factor);
+      }
+      std::cerr << "  " << arc.path.size() - 1 << " steps, highest P/Pmax " << highest << ", last "
+                << arc.path.back().load_factor << (arc.stopped.empty() ? "" : "; stopped: " + arc.stopped) << " ("
+                << seconds_since(start) << " s in all)\n";
     }
   }
 
