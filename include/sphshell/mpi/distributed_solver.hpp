@@ -874,7 +874,9 @@ class DistributedSolver {
     if (probe.kind == DistributedProbe::Kind::particle)
       probe.file->write_row(solver::ParticleProbe{probe.index}.row(OwnedView{*this}));
     else
-      probe.file->write_row(stress_probe(probe.index).row(StressPointView{*this, probe.local_point}));
+      // A row needs no column names: no rule's names are built per row.
+      probe.file->write_row(
+          solver::StressPointProbe<output_points>(probe.index).row(StressPointView{*this, probe.local_point}));
   }
   void require_new_probe_file(const std::string& csv_path) const {
     for (const DistributedProbe& probe : probes_)
