@@ -127,7 +127,8 @@ class InternalForceAssembler {
   // all points in index order would move a quarter of them to the other
   // core and back on two threads (README, "Thread counts"). Before the first
   // compute(), or after the points' force entries or the thread count
-  // changed, the points in index order. body must not throw and writes only what belongs to p.
+  // changed, the points in index order. body must not throw and writes only
+  // what belongs to p.
   template <class Approx, class Body>
   void for_each_point(const IntegrationPoints<Approx>& points, Body&& body) const {
     if (!schedule_.is_current(points, segment_count())) {
@@ -256,8 +257,7 @@ class InternalForceAssembler {
       tied_director_force_.assign(points.untied_corner(), zero);
     }
     // Every compute() writes every point's work (zero for an inactive one), so
-    // it is zeroed only when sized: zeroing it serially every step moved half
-    // of it between the cores' caches on two threads.
+    // it is zeroed only when sized, not by a serial pass every step.
     if (work_increment_.size() != points.size()) work_increment_.assign(points.size(), 0.0);
   }
 
