@@ -110,9 +110,10 @@ struct NewtonOptions {
   double rotation_step = 1e-7;      // rad
   // Perturb one particle at a time (for checking the colouring; slow).
   bool one_particle_per_colour = false;
-  // Displacement control: at most this many converged sub-steps (halved
-  // increments) per solve_to_displacement call, so a path creeping in tiny
-  // steps (a bifurcation the control cannot pass) stops with an error.
+  // Displacement control: at most this many attempted sub-steps (halved
+  // increments and failed tries included) per solve_to_displacement call, so
+  // a path creeping in tiny steps (where the control cannot pass) stops with
+  // an error.
   int max_substeps = 64;
   // Print every displacement-control iteration (load factor, relative
   // residual, control gap) to standard error.
@@ -158,24 +159,19 @@ class StaticShell {
   void solve_to(double lambda, double step) {
     if (!(step > 0.0)) throw std::invalid_argument("StaticShell: the load step must be positive");
     double increment = std::min(step, lambda - lambda_);
-    int halvings = 0;
     while (lambda_ < lambda - 1e-12 * std::abs(lambda)) {
-      const double target = std::min(lambda, lambda_ + increment);
-      const std::vector<Vector3> x0 = solver_.positions(), d0 = solver_.directors();
-      predict(target);
-      if (converge(target)) {
-        previous_ = {x0, d0, lambda_, 0.0};
-        lambda_ = target;
-        ++report_.load_steps;
-        halvings = 0;
-        increment = std::min(step, 1.5 * increment);
-      } else {
-        solver_.set_configuration(x0, d0);
-        ++report_.force_evaluations;
-        increment *= 0.5;
-        if (++halvings > options_.max_halvings)
-          throw std::runtime_error("StaticShell: Newton did not converge at load factor " + std::to_string(target));
-      }
+      double target = lambda;
+      const double taken = step_with_halving(
+          increment, 0.0,
+          [&](double trial) {
+            target = std::min(lambda, lambda_ + trial);
+            predict(target);
+            if (!converge(target)) return false;
+            lambda_ = target;
+            return true;
+          },
+          [&](double) { return "Newton did not converge at load factor " + std::to_string(target); });
+      increment = std::min(step, 1.5 * taken);
     }
   }
 
@@ -186,31 +182,28 @@ class StaticShell {
     if (!(step > 0.0)) throw std::invalid_argument("StaticShell: the displacement step must be positive");
     double value = displacement_of(control);
     double increment = step;
-    int halvings = 0, substeps = 0;
+    int substeps = 0;
     while (std::abs(target - value) > 1e-12 * std::max(std::abs(target), step)) {
-      if (++substeps > options_.max_substeps)
-        throw std::runtime_error("StaticShell: displacement control took more than " +
-                                 std::to_string(options_.max_substeps) + " sub-steps toward " + std::to_string(target) +
-                                 " (at " + std::to_string(value) + ", load factor " + std::to_string(lambda_) + ")");
-      const double next = target > value ? std::min(target, value + increment) : std::max(target, value - increment);
-      const std::vector<Vector3> x0 = solver_.positions(), d0 = solver_.directors();
-      const double lambda0 = lambda_;
-      predict_displacement(next, value);
-      if (converge_displacement(control, next)) {
-        previous_ = {x0, d0, lambda0, value};
-        value = next;
-        ++report_.load_steps;
-        halvings = 0;
-        increment = std::min(step, 1.5 * increment);
-      } else {
-        solver_.set_configuration(x0, d0);
-        ++report_.force_evaluations;
-        lambda_ = lambda0;
-        increment *= 0.5;
-        if (++halvings > options_.max_halvings)
-          throw std::runtime_error("StaticShell: Newton did not converge at control displacement " +
-                                   std::to_string(next) + " (load factor " + std::to_string(lambda_) + ")");
-      }
+      double next = value;
+      const double taken = step_with_halving(
+          increment, value,
+          [&](double trial) {
+            // Every attempt counts, the halved ones too.
+            if (++substeps > options_.max_substeps)
+              throw std::runtime_error("StaticShell: displacement control took more than " +
+                                       std::to_string(options_.max_substeps) + " sub-steps toward " +
+                                       std::to_string(target) + " (at " + std::to_string(value) + ", load factor " +
+                                       std::to_string(lambda_) + ")");
+            next = target > value ? std::min(target, value + trial) : std::max(target, value - trial);
+            predict_displacement(next, value);
+            return converge_displacement(control, next);
+          },
+          [&](double) {
+            return "Newton did not converge at control displacement " + std::to_string(next) + " (load factor " +
+                   std::to_string(lambda_) + ")";
+          });
+      value = next;
+      increment = std::min(step, 1.5 * taken);
     }
   }
 
@@ -246,27 +239,19 @@ class StaticShell {
     last_length = previous_.x.empty() ? 0.0 : norm / particles;
     direction.start = displacement_of(direction);
     const double value = 0.0;
-    double step = length;
-    for (int halvings = 0;; ++halvings) {
-      const double lambda0 = lambda_;
-      const double next = value + step;
-      if (last_length > 0.0) {
-        previous_.control = value - last_length;  // the last step, measured along its own direction
-        predict_displacement(next, value);
-      }
-      if (converge_displacement(direction, next)) {
-        previous_ = {x0, d0, lambda0, value};
-        ++report_.load_steps;
-        return step;
-      }
-      solver_.set_configuration(x0, d0);
-      ++report_.force_evaluations;
-      lambda_ = lambda0;
-      step *= 0.5;
-      if (halvings + 1 > options_.max_halvings)
-        throw std::runtime_error("StaticShell: Newton did not converge on an arc-length step of " +
-                                 std::to_string(2.0 * step) + " (load factor " + std::to_string(lambda_) + ")");
-    }
+    return step_with_halving(
+        length, value,
+        [&](double trial) {
+          if (last_length > 0.0) {
+            previous_.control = value - last_length;  // the last step, measured along its own direction
+            predict_displacement(value + trial, value);
+          }
+          return converge_displacement(direction, value + trial);
+        },
+        [&](double trial) {
+          return "Newton did not converge on an arc-length step of " + std::to_string(trial) + " (load factor " +
+                 std::to_string(lambda_) + ")";
+        });
   }
 
   // The control of an arc-length step in the current configuration.
@@ -652,6 +637,31 @@ class StaticShell {
     }
     solver_.set_configuration(std::move(x), std::move(d));
     ++report_.force_evaluations;
+  }
+
+  // The step-and-halve loop the controls share: attempt(increment) takes one
+  // step of `increment` from the current state (predictor and Newton) and
+  // returns whether it converged. After a failure the configuration and the
+  // load factor are put back and the increment halved, at most max_halvings
+  // times in a row (then an error with failure(increment)'s text). A converged
+  // step leaves the state before it (control value `control_before`) as the
+  // last one. Returns the increment that converged.
+  template <class Attempt, class Failure>
+  double step_with_halving(double increment, double control_before, Attempt&& attempt, Failure&& failure) {
+    for (int halvings = 0;; ++halvings) {
+      const std::vector<Vector3> x0 = solver_.positions(), d0 = solver_.directors();
+      const double lambda0 = lambda_;
+      if (attempt(increment)) {
+        previous_ = {x0, d0, lambda0, control_before};
+        ++report_.load_steps;
+        return increment;
+      }
+      solver_.set_configuration(x0, d0);
+      ++report_.force_evaluations;
+      lambda_ = lambda0;
+      if (halvings + 1 > options_.max_halvings) throw std::runtime_error("StaticShell: " + failure(increment));
+      increment *= 0.5;
+    }
   }
 
   bool converge(double lambda) {
