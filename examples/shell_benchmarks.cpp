@@ -555,15 +555,18 @@ int run(const Arguments& arguments) {
                                    {"P/Pmax", "W_A", "-U_B", "-U_C", "negative eigenvalues", "eigenvalue nearest zero",
                                     "over the unloaded one", "mode's share of the load"});
         const auto unloaded = statics.stability();
-        std::vector<double> last_row;
         const auto write = [&](const StaticShell<NonlinearSolver>::Stability& stability) {
-          last_row = {statics.load_factor(), statics.displacement_of(w_a), statics.displacement_of(u_b),
-                      statics.displacement_of(u_c), static_cast<double>(stability.negative_eigenvalues),
-                      stability.eigenvalue_nearest_zero,
-                      stability.eigenvalue_nearest_zero / unloaded.eigenvalue_nearest_zero, stability.load_share};
-          stability_csv.write_row(last_row);
-          std::cerr << "  P/Pmax " << last_row[0] << ": " << stability.negative_eigenvalues
-                    << " negative eigenvalues, nearest zero " << last_row[6] << " of the unloaded one ("
+          const std::vector<double> row{statics.load_factor(),
+                                        statics.displacement_of(w_a),
+                                        statics.displacement_of(u_b),
+                                        statics.displacement_of(u_c),
+                                        static_cast<double>(stability.negative_eigenvalues),
+                                        stability.eigenvalue_nearest_zero,
+                                        stability.eigenvalue_nearest_zero / unloaded.eigenvalue_nearest_zero,
+                                        stability.load_share};
+          stability_csv.write_row(row);
+          std::cerr << "  P/Pmax " << row[0] << ": " << stability.negative_eigenvalues
+                    << " negative eigenvalues, nearest zero " << row[6] << " of the unloaded one ("
                     << seconds_since(start) << " s)\n";
         };
         std::cerr << "Pull-out (Sze), " << grid.text() << ": -U_B in steps of 0.15, the tangent's stability\n";

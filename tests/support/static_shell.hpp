@@ -214,9 +214,8 @@ class StaticShell {
   // Newton fails (at most max_halvings times); returns the length taken.
   double arc_length_step(double length) {
     if (!(length > 0.0)) throw std::invalid_argument("StaticShell: the arc length must be positive");
-    const std::vector<Vector3> x0 = solver_.positions(), d0 = solver_.directors();
+    const std::vector<Vector3> x0 = solver_.positions();
     PathDirection direction;
-    double last_length = 0.0;
     if (previous_.x.empty()) {
       const Dofs dofs = current_dofs();
       const Eigen::VectorXd response = solve_tangent(dofs, external_load(dofs), Factorisation::general).col(0);
@@ -236,17 +235,17 @@ class StaticShell {
     // Lengths are root-mean-square motions of the particles (independent of their number).
     const double particles = std::sqrt(static_cast<double>(direction.motion.size()));
     for (auto& [particle, motion] : direction.motion) motion /= norm * particles;
-    last_length = previous_.x.empty() ? 0.0 : norm / particles;
+    const double last_length = previous_.x.empty() ? 0.0 : norm / particles;
+    // The control is 0 where the step begins (direction.start).
     direction.start = displacement_of(direction);
-    const double value = 0.0;
     return step_with_halving(
-        length, value,
+        length, 0.0,
         [&](double trial) {
           if (last_length > 0.0) {
-            previous_.control = value - last_length;  // the last step, measured along its own direction
-            predict_displacement(value + trial, value);
+            previous_.control = -last_length;  // the last step, measured along its own direction
+            predict_displacement(trial, 0.0);
           }
-          return converge_displacement(direction, value + trial);
+          return converge_displacement(direction, trial);
         },
         [&](double trial) {
           return "Newton did not converge on an arc-length step of " + std::to_string(trial) + " (load factor " +
@@ -297,9 +296,7 @@ class StaticShell {
   Stability stability() {
     constexpr int inverse_iterations = 60;
     const Dofs dofs = current_dofs();
-    Eigen::SparseMatrix<double> k = tangent(dofs);
-    const Eigen::SparseMatrix<double> transposed = k.transpose();
-    const Eigen::SparseMatrix<double> symmetric = 0.5 * (k + transposed);
+    const Eigen::SparseMatrix<double> symmetric = symmetrised(tangent(dofs));
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(symmetric);
     if (ldlt.info() != Eigen::Success) throw std::runtime_error("StaticShell: the tangent has a zero pivot");
     Stability result;
@@ -483,6 +480,12 @@ class StaticShell {
 
   enum class Factorisation { symmetric, general };
 
+  // ½ (K + Kᵀ): the finite differences leave the tangent symmetric only to rounding.
+  static Eigen::SparseMatrix<double> symmetrised(const Eigen::SparseMatrix<double>& k) {
+    const Eigen::SparseMatrix<double> transposed = k.transpose();
+    return 0.5 * (k + transposed);
+  }
+
   // The tangent's solutions for the columns of `rhs`, from one factorisation.
   // The stiffness is symmetrised and factorised by LDLᵀ (the linear
   // stiffness is symmetric; the finite differences leave it so to rounding),
@@ -491,9 +494,7 @@ class StaticShell {
     Eigen::SparseMatrix<double> k = tangent(dofs);
     k.makeCompressed();
     if (factorisation == Factorisation::symmetric) {
-      const Eigen::SparseMatrix<double> transposed = k.transpose();
-      const Eigen::SparseMatrix<double> symmetric = 0.5 * (k + transposed);
-      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(symmetric);
+      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(symmetrised(k));
       if (ldlt.info() != Eigen::Success)
         throw std::runtime_error("StaticShell: the stiffness is singular (a free rigid-body mode?)");
       return ldlt.solve(rhs);
