@@ -410,11 +410,12 @@ int run(const Arguments& arguments) {
                 << " Newton iterations, " << seconds_since(start) << " s)\n";
     };
     const auto follow = [&](const char* name, const std::string& grid, const ShellModel& model, double E, double nu,
-                            const StaticConditions& conditions, const ControlDisplacement& control,
-                            const std::vector<PathReading>& readings, double step, int max_steps) {
+                            const SolverOptions& options, const StaticConditions& conditions,
+                            const ControlDisplacement& control, const std::vector<PathReading>& readings, double step,
+                            int max_steps) {
       std::cerr << name << ", " << grid << ": following the path\n";
-      const PathRun run = follow_path<NonlinearSolver>(model, E, nu, conditions, control, readings, step, 1.0,
-                                                       max_steps, newton, progress);
+      const PathRun run = follow_path<NonlinearSolver>(model, E, nu, options, conditions, control, readings, step,
+                                                       1.0, max_steps, newton, progress);
       std::cerr << "  " << run.path.size() - 1 << " steps to P/Pmax = " << run.path.back().load_factor << ", "
                 << run.report.iterations << " Newton iterations, " << run.seconds << " s"
                 << (run.stopped.empty() ? "" : "; stopped: " + run.stopped) << "\n";
@@ -479,7 +480,7 @@ int run(const Arguments& arguments) {
       const ControlDisplacement pushed{hemisphere.pushed, -Vector3::UnitY()};
       const ControlDisplacement pulled{hemisphere.pulled, Vector3::UnitX()};
       const std::string grid = std::to_string(n) + "²";
-      hemisphere_runs.push_back({grid, follow("Hemisphere (Sze)", grid, hemisphere.model, 6.825e7, 0.3,
+      hemisphere_runs.push_back({grid, follow("Hemisphere (Sze)", grid, hemisphere.model, 6.825e7, 0.3, {},
                                               hemisphere.conditions, pushed, {pulled, pushed}, 0.5, 40)});
     }
     {
@@ -500,7 +501,7 @@ int run(const Arguments& arguments) {
       const SzeCylinder pullout = sze_pullout_cylinder(pullout_nx, pullout_ny);
       const std::string pullout_grid = std::to_string(pullout_nx) + "×" + std::to_string(pullout_ny);
       const PathRun pullout_path =
-          follow("Pull-out (Sze)", pullout_grid, pullout.model, pullout.E, pullout.nu, pullout.conditions,
+          follow("Pull-out (Sze)", pullout_grid, pullout.model, pullout.E, pullout.nu, pullout.options, pullout.conditions,
                  {pullout.b, -Vector3::UnitY()},
                  {{pullout.a, Vector3::UnitX()}, {pullout.b, -Vector3::UnitY()}, {pullout.c, -Vector3::UnitY()}}, 0.15, 60);
       {
@@ -521,7 +522,7 @@ int run(const Arguments& arguments) {
       const SzeCylinder pinched = sze_pinched_cylinder(pinched_n, pinched_n);
       const std::string pinched_grid = std::to_string(pinched_n) + "²";
       const PathRun pinched_path =
-          follow("Pinched cylinder (Sze)", pinched_grid, pinched.model, pinched.E, pinched.nu, pinched.conditions,
+          follow("Pinched cylinder (Sze)", pinched_grid, pinched.model, pinched.E, pinched.nu, pinched.options, pinched.conditions,
                  {pinched.a, -Vector3::UnitX()}, {{pinched.a, -Vector3::UnitX()}, {pinched.b, Vector3::UnitY()}}, 2.0, 50);
       {
         PaperSeries a{"−W_A", {}, {}}, b{"U_B", {}, {}};
@@ -549,7 +550,7 @@ int run(const Arguments& arguments) {
       const ControlDisplacement w_a{cylinder.a, Vector3::UnitX()}, u_b{cylinder.b, -Vector3::UnitY()},
           u_c{cylinder.c, -Vector3::UnitY()};
       {
-        NonlinearSolver solver(cylinder.model, {cylinder.E, cylinder.nu});
+        NonlinearSolver solver(cylinder.model, {cylinder.E, cylinder.nu}, cylinder.options);
         StaticShell<NonlinearSolver> statics(solver, cylinder.conditions, newton);
         io::CsvProbe stability_csv(arguments.output + "/pullout_stability_" + tag + ".csv",
                                    {"P/Pmax", "W_A", "-U_B", "-U_C", "negative eigenvalues", "eigenvalue nearest zero",
@@ -597,7 +598,7 @@ int run(const Arguments& arguments) {
       }
       std::cerr << "Pull-out (Sze), " << grid.text() << ": arc length, RMS steps of 0.1\n";
       const PathRun arc = follow_arc_length<NonlinearSolver>(
-          cylinder.model, cylinder.E, cylinder.nu, cylinder.conditions, {w_a, u_b, u_c}, 0.1, 1.0, 60, newton);
+          cylinder.model, cylinder.E, cylinder.nu, cylinder.options, cylinder.conditions, {w_a, u_b, u_c}, 0.1, 1.0, 60, newton);
       io::CsvProbe arc_csv(arguments.output + "/pullout_arc_length_" + tag + ".csv",
                            {"length", "P/Pmax", "W_A", "-U_B", "-U_C"});
       double highest = 0.0;

@@ -217,3 +217,16 @@ TEST_CASE("The builders' models pass the new checks", "[bad_input][geometry]") {
   CHECK_NOTHROW(ShellModel::cylindrical_panel(0.1, 0.3, 2 * M_PI, 3, 3, 0.001));
   CHECK_NOTHROW(ShellModel::cylindrical_panel(0.1, 0.3, 0.5, 4, 30, 0.001));
 }
+
+TEST_CASE("The director hourglass without the edge-tied shear or without cells is refused", "[bad_input][geometry]") {
+  SolverOptions options;
+  options.director_hourglass = true;
+  options.transverse_shear = TransverseShear::shape_functions;
+  options.particle_shear_weight = 0.01;
+  require_error([&] { ElasticSolver(ShellModel::rectangular_plate(0.1, 0.1, 6, 6, 0.01), steel, options); },
+                {"director_hourglass", "TransverseShear::cell_edges"});
+  options.transverse_shear = TransverseShear::cell_edges;
+  GeneralPlate plate;  // the general constructor: no cells
+  require_error([&] { ElasticSolver(plate.build(), steel, options); }, {"director_hourglass", "cells"});
+  CHECK_NOTHROW(ElasticSolver(ShellModel::rectangular_plate(0.1, 0.1, 6, 6, 0.01), steel, options));
+}

@@ -122,7 +122,7 @@ TEST_CASE("Static shell: displacement control follows the load-controlled path",
   // P/P_max = 0.5 and 1, and by prescribing the tip's deflection in steps of
   // 0.5 (the load factor then an unknown); both stay near the elastica.
   const EndShearPaths cantilever;
-  const PathRun path = follow_path<NonlinearSolver>(cantilever.strip.model, 1.2e6, 0.0, cantilever.strip.conditions,
+  const PathRun path = follow_path<NonlinearSolver>(cantilever.strip.model, 1.2e6, 0.0, {}, cantilever.strip.conditions,
                                                     cantilever.tip_w, {cantilever.tip_w, cantilever.tip_u}, 0.5, 1.0,
                                                     40);
   for (std::size_t k = 1; k < path.path.size(); ++k)  // the tip's w is what was prescribed
@@ -145,7 +145,7 @@ TEST_CASE("Static shell: the arc length follows the load-controlled path", "[sta
   // The cantilever of the test above, followed by arc length (steps of 0.2
   // in the particles' root-mean-square motion, the load factor solved for).
   const EndShearPaths cantilever;
-  const PathRun path = follow_arc_length<NonlinearSolver>(cantilever.strip.model, 1.2e6, 0.0,
+  const PathRun path = follow_arc_length<NonlinearSolver>(cantilever.strip.model, 1.2e6, 0.0, {},
                                                           cantilever.strip.conditions,
                                                           {cantilever.tip_w, cantilever.tip_u}, 0.2, 1.0, 60);
   REQUIRE(path.stopped.empty());
@@ -322,31 +322,79 @@ TEST_CASE("Benchmark: hemisphere with an 18 degree hole under alternating forces
   CHECK(worst < 2.6);
 }
 
-TEST_CASE("Benchmark: pull-out of an open-ended cylinder (Sze, Liu & Lo 2004, nonlinear)", "[validation][benchmarks]") {
+TEST_CASE("Static shell: the director hourglass removes the pull-out's spurious instability", "[static][benchmarks]") {
+  // The pull-out octant at 13 x 9, −U_B prescribed in steps of 0.15, the
+  // tangent's negative eigenvalues counted after every step. Without the
+  // director hourglass (shell/cell_hourglass.hpp) the tangent turns
+  // indefinite near P/P_max = 0.34 (measured: positive definite up to 0.30,
+  // one negative eigenvalue where the control stalls at 0.343) on a mode of
+  // alternating director rotations; with it, none up to P_max, past the
+  // paper's snap at 0.5–0.525 (where the load passes a maximum: only there
+  // may one appear).
+  NewtonOptions newton;
+  newton.tolerance = 1e-5;
+  newton.max_iterations = 12;
+  const auto first_indefinite = [&](bool director_hourglass) {
+    const SzeCylinder cylinder = sze_pullout_cylinder(13, 9, pullout_options(director_hourglass));
+    NonlinearSolver solver(cylinder.model, {cylinder.E, cylinder.nu}, cylinder.options);
+    StaticShell<NonlinearSolver> statics(solver, cylinder.conditions, newton);
+    const ControlDisplacement u_b{cylinder.b, -Vector3::UnitY()};
+    for (int k = 1; statics.load_factor() < 1.0 && k <= 60; ++k) {
+      try {
+        statics.solve_to_displacement(u_b, 0.15 * k, 0.15);
+      } catch (const std::runtime_error&) {
+        return statics.load_factor();  // the control stalled
+      }
+      const double lambda = statics.load_factor();
+      if (statics.stability().negative_eigenvalues > 0 && !(lambda > 0.5 && lambda < 0.6)) return lambda;
+    }
+    return statics.load_factor() >= 1.0 ? 2.0 : statics.load_factor();
+  };
+  const double without = first_indefinite(false), with = first_indefinite(true);
+  std::printf("Pull-out 13 x 9: indefinite or stalled at P/P_max %.3f without the director hourglass, %s with it\n",
+              without, with > 1.5 ? "never up to P_max" : std::to_string(with).c_str());
+  CHECK(without < 0.4);
+  CHECK(with == 2.0);
+}
+
+TEST_CASE("Benchmark: pull-out of an open-ended cylinder, the whole path (Sze, Liu & Lo 2004, nonlinear)",
+          "[validation][benchmarks]") {
   // §3.5: W_A (outward under the load), −U_B and −U_C (inward, 90° round at
-  // mid-length and at the free end) against the paper's table at P/P_max =
-  // 0.025 … 0.3. Measured at 16 x 11 particles (θ x axial; 4.5 s): largest
-  // error −0.96 % (W_A at 0.25); at 22 x 15 +0.54 % up to 0.25. Beyond 0.3 Newton under load control fails
-  // at this resolution (the paper's response snaps between 0.5 and 0.525).
-  constexpr int circumferential = 16, axial = 11;
-  const std::vector<TabulatedTriple> table = sze_pullout_table();
-  std::vector<double> factors;
-  for (const TabulatedTriple& point : table)
-    if (point.load_factor <= 0.3 + 1e-12) factors.push_back(point.load_factor);
+  // mid-length and at the free end) against the paper's table at every
+  // tabulated P/P_max up to 1, through the snap between 0.5 and 0.525 (−U_B
+  // jumps, −U_C turns back). The path is followed by prescribing −U_B in steps
+  // of 0.1 (the load factor solved for), with the director hourglass (without
+  // it the octant turns unstable at P/P_max ≈ 0.27 on a spurious mode; the
+  // test below). The readings are where the path first reaches each load
+  // factor, what load control would give.
+  constexpr int circumferential = 22, axial = 15;
+  const SzeCylinder cylinder = sze_pullout_cylinder(circumferential, axial);
   NewtonOptions newton;
   newton.tolerance = 1e-5;  // the residual floors near 1e-6 of the load here
-  const CylinderRun run =
-      run_sze_cylinder<NonlinearSolver>(sze_pullout_cylinder(circumferential, axial), factors, 0.05, newton);
-  double worst = 0.0;
-  for (std::size_t k = 0; k < run.points.size(); ++k) {
-    const TabulatedTriple& point = run.points[k];
-    const double a = error_percent(point.a, table[k].a), b = error_percent(-point.b, table[k].b),
-                 c = error_percent(-point.c, table[k].c);
+  newton.max_iterations = 12;
+  const ControlDisplacement w_a{cylinder.a, Vector3::UnitX()}, u_b{cylinder.b, -Vector3::UnitY()},
+      u_c{cylinder.c, -Vector3::UnitY()};
+  const PathRun run = follow_path<NonlinearSolver>(cylinder.model, cylinder.E, cylinder.nu, cylinder.options,
+                                                   cylinder.conditions, u_b, {w_a, u_b, u_c}, 0.1, 1.0, 80, newton);
+  INFO("stopped: " << run.stopped);
+  REQUIRE(run.stopped.empty());
+  // The paper's response jumps between 0.5 and 0.525, so the reading at
+  // 0.525 depends on where exactly each model snaps; it is held apart.
+  constexpr double at_the_snap = 0.525;
+  double worst = 0.0, worst_elsewhere = 0.0;
+  for (const TabulatedTriple& point : sze_pullout_table()) {
+    const std::vector<double> at = readings_at_load_factor(run.path, point.load_factor);
+    REQUIRE(at.size() == 3);
+    const double a = error_percent(at[0], point.a), b = error_percent(at[1], point.b), c = error_percent(at[2], point.c);
     std::printf("Pull-out (Sze), %d x %d, P/P_max = %.3f: W_A %.4g (%+.2f %%), -U_B %.4g (%+.2f %%), -U_C %.4g "
                 "(%+.2f %%)\n",
-                circumferential, axial, point.load_factor, point.a, a, -point.b, b, -point.c, c);
-    worst = std::max({worst, std::abs(a), std::abs(b), std::abs(c)});
+                circumferential, axial, point.load_factor, at[0], a, at[1], b, at[2], c);
+    const double largest = std::max({std::abs(a), std::abs(b), std::abs(c)});
+    worst = std::max(worst, largest);
+    if (std::abs(point.load_factor - at_the_snap) > 1e-12) worst_elsewhere = std::max(worst_elsewhere, largest);
   }
-  std::printf("Pull-out (Sze): largest error %.2f %%; %d Newton iterations\n", worst, run.report.iterations);
-  CHECK(worst < 1.3);
+  std::printf("Pull-out (Sze): largest error %.2f %% (%.2f %% away from P/P_max = 0.525); %d Newton iterations, %.1f s\n",
+              worst, worst_elsewhere, run.report.iterations, run.seconds);
+  CHECK(worst_elsewhere < 1.2);
+  CHECK(worst < 2.2);
 }

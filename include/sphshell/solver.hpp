@@ -104,7 +104,8 @@ class Solver {
         particles_(solver::ParticleState::at_rest(model_.particle_position, model_.particle_normal)),
         inertia_(solver::Inertia::lumped(model_, options_.density, options_.rotary_inertia_scale)),
         forces_(model_.particle_count()),
-        points_(model_, options_.physics(), options_.particle_integration(), law_.shear_modulus()),
+        points_(model_, options_.physics(), options_.particle_integration(), law_.shear_modulus(),
+                law_.poisson_ratio()),
         states_(model_, law_, points_.count(solver::PointGroup::particles)),
         assembler_(options_.nonlinear, points_),
         ledger_(options_.monitoring(), law_.youngs_modulus(), solver::shell_volume(model_)),
@@ -333,7 +334,7 @@ class Solver {
       // Rows a crack rebuilt here since construction go back to the model's.
       if (points_.any_rebuilt())
         points_ = solver::IntegrationPoints<Approx>(model_, options_.physics(), options_.particle_integration(),
-                                                    law_.shear_modulus());
+                                                    law_.shear_modulus(), law_.poisson_ratio());
       assembler_ = solver::InternalForceAssembler(options_.nonlinear, points_);
       std::int64_t steps = 0;
       in.open_section("TIME");

@@ -104,10 +104,11 @@ struct StaticBenchmark {
 // A point force at particle `at` (on the model's surface), applied as `how` says;
 // returns the weights that read the displacement under it.
 inline ParticleWeights add_point_force(const ShellModel& model, StaticConditions& conditions, int at,
-                                       const Vector3& force, PointLoad how) {
+                                       const Vector3& force, PointLoad how, double support_radius_factor = 2.0) {
   ParticleWeights weights = {{at, 1.0}};
   if (how == PointLoad::shape_functions)
-    weights = shape_function_weights(model, model.particle_position[at], model.particle_normal[at]);
+    weights = shape_function_weights(model, model.particle_position[at], model.particle_normal[at],
+                                     support_radius_factor);
   for (const auto& [particle, weight] : weights) conditions.add_force({particle}, weight * force);
   return weights;
 }
@@ -462,9 +463,10 @@ struct SzeCylinder {
   StaticConditions conditions;
   ParticleWeights a, b, c;
   double E, nu;
+  SolverOptions options;  // the solver options the case is run with
 };
 inline SzeCylinder sze_cylinder_octant(double R, double L, double t, double E, double nu, double P_max, bool diaphragm,
-                                       int n_circumferential, int n_axial) {
+                                       int n_circumferential, int n_axial, const SolverOptions& options = {}) {
   ShellModel model = ShellModel::cylindrical_panel(R, L / 2, benchmark_pi / 2, n_circumferential, n_axial, t);
   StaticConditions conditions(model.particle_count());
   if (diaphragm) {  // rigid in its plane, free along the axis
@@ -477,16 +479,28 @@ inline SzeCylinder sze_cylinder_octant(double R, double L, double t, double E, d
   const int n = n_circumferential;
   const int a = (n_axial - 1) * n, b = (n_axial - 1) * n + n - 1, c = n - 1;
   // Outward (pull-out, P_max > 0) or inward (pinching, P_max < 0) along x at A.
-  ParticleWeights at_a = add_point_force(model, conditions, a, Vector3(P_max / 4, 0.0, 0.0), PointLoad::shape_functions);
-  ParticleWeights at_b = shape_function_weights(model, model.particle_position[b], model.particle_normal[b]);
-  ParticleWeights at_c = shape_function_weights(model, model.particle_position[c], model.particle_normal[c]);
-  return {std::move(model), std::move(conditions), std::move(at_a), std::move(at_b), std::move(at_c), E, nu};
+  // The load shared and the displacements read with the solver's own support.
+  const double support = options.support_radius_factor;
+  ParticleWeights at_a =
+      add_point_force(model, conditions, a, Vector3(P_max / 4, 0.0, 0.0), PointLoad::shape_functions, support);
+  ParticleWeights at_b = shape_function_weights(model, model.particle_position[b], model.particle_normal[b], support);
+  ParticleWeights at_c = shape_function_weights(model, model.particle_position[c], model.particle_normal[c], support);
+  return {std::move(model), std::move(conditions), std::move(at_a), std::move(at_b), std::move(at_c), E, nu, options};
 }
 
 // §3.5, pull-out of an open-ended cylinder: R = 4.953, L = 10.35, t = 0.094,
-// E = 10.5e6, ν = 0.3125, both ends free, P_max = 40000 outward.
-inline SzeCylinder sze_pullout_cylinder(int n_circumferential, int n_axial) {
-  return sze_cylinder_octant(4.953, 10.35, 0.094, 10.5e6, 0.3125, 40000.0, false, n_circumferential, n_axial);
+// E = 10.5e6, ν = 0.3125, both ends free, P_max = 40000 outward. Run with the
+// director hourglass (PhysicsOptions::director_hourglass) by default: without
+// it a spurious mode of alternating director rotations turns the octant
+// unstable at P/P_max ≈ 0.27 (README, "What limits them").
+inline SolverOptions pullout_options(bool director_hourglass = true) {
+  SolverOptions options;
+  options.director_hourglass = director_hourglass;
+  return options;
+}
+inline SzeCylinder sze_pullout_cylinder(int n_circumferential, int n_axial,
+                                        const SolverOptions& options = pullout_options()) {
+  return sze_cylinder_octant(4.953, 10.35, 0.094, 10.5e6, 0.3125, 40000.0, false, n_circumferential, n_axial, options);
 }
 // §3.6, pinched cylinder on rigid diaphragms: R = 100, L = 200, t = 1,
 // E = 30e3, ν = 0.3, P_max = 12000 inward. (The linear pinched cylinder's
@@ -535,7 +549,7 @@ struct CylinderRun {
 template <class NonlinearSolver>
 CylinderRun run_sze_cylinder(const SzeCylinder& cylinder, const std::vector<double>& factors, double step,
                              NewtonOptions newton = {}) {
-  NonlinearSolver solver(cylinder.model, {cylinder.E, cylinder.nu});
+  NonlinearSolver solver(cylinder.model, {cylinder.E, cylinder.nu}, cylinder.options);
   StaticShell<NonlinearSolver> statics(solver, cylinder.conditions, newton);
   CylinderRun run;
   for (double factor : factors) {
@@ -568,11 +582,11 @@ namespace detail {
 // The loop both path followers share: advance(statics) takes one step and
 // returns the path's control after it.
 template <class NonlinearSolver, class Advance>
-PathRun follow(const ShellModel& model, double E, double nu, const StaticConditions& conditions,
-               const std::vector<PathReading>& readings, double last_factor, int max_steps, NewtonOptions newton,
+PathRun follow(const ShellModel& model, double E, double nu, const SolverOptions& options,
+               const StaticConditions& conditions, const std::vector<PathReading>& readings, double last_factor, int max_steps, NewtonOptions newton,
                const std::function<void(const PathPoint&, const NewtonReport&)>& progress, Advance&& advance) {
   const auto start = std::chrono::steady_clock::now();
-  NonlinearSolver solver(model, {E, nu});
+  NonlinearSolver solver(model, {E, nu}, options);
   StaticShell<NonlinearSolver> statics(solver, conditions, newton);
   PathRun run;
   run.path.push_back({0.0, 0.0, std::vector<double>(readings.size(), 0.0)});
@@ -595,16 +609,17 @@ PathRun follow(const ShellModel& model, double E, double nu, const StaticConditi
 }
 }  // namespace detail
 
-// Follows the path of `conditions` on a new solver of `model` in steps of
+// Follows the path of `conditions` on a new solver of `model` (E, ν, `options`) in steps of
 // `step` of the control displacement until the load factor reaches
 // `last_factor` (or `max_steps` steps were taken, or Newton failed: the path
 // so far is returned with the reason); `progress` sees every step.
 template <class NonlinearSolver>
-PathRun follow_path(const ShellModel& model, double E, double nu, const StaticConditions& conditions,
+PathRun follow_path(const ShellModel& model, double E, double nu, const SolverOptions& options,
+                    const StaticConditions& conditions,
                     const ControlDisplacement& control, const std::vector<PathReading>& readings, double step,
                     double last_factor, int max_steps, NewtonOptions newton = {},
                     const std::function<void(const PathPoint&, const NewtonReport&)>& progress = {}) {
-  return detail::follow<NonlinearSolver>(model, E, nu, conditions, readings, last_factor, max_steps, newton, progress,
+  return detail::follow<NonlinearSolver>(model, E, nu, options, conditions, readings, last_factor, max_steps, newton, progress,
                                          [&](StaticShell<NonlinearSolver>& statics, int k) {
                                            statics.solve_to_displacement(control, k * step, step);
                                            return statics.displacement_of(control);
@@ -616,12 +631,13 @@ PathRun follow_path(const ShellModel& model, double E, double nu, const StaticCo
 // half as long again (up to `length`), one after a halved step as long as
 // that. PathPoint::control is the length of the path so far.
 template <class NonlinearSolver>
-PathRun follow_arc_length(const ShellModel& model, double E, double nu, const StaticConditions& conditions,
+PathRun follow_arc_length(const ShellModel& model, double E, double nu, const SolverOptions& options,
+                          const StaticConditions& conditions,
                           const std::vector<PathReading>& readings, double length, double last_factor, int max_steps,
                           NewtonOptions newton = {},
                           const std::function<void(const PathPoint&, const NewtonReport&)>& progress = {}) {
   double next = length, travelled = 0.0;
-  return detail::follow<NonlinearSolver>(model, E, nu, conditions, readings, last_factor, max_steps, newton, progress,
+  return detail::follow<NonlinearSolver>(model, E, nu, options, conditions, readings, last_factor, max_steps, newton, progress,
                                          [&](StaticShell<NonlinearSolver>& statics, int) {
                                            const double taken = statics.arc_length_step(next);
                                            travelled += taken;

@@ -419,7 +419,8 @@ class StaticShell {
     const ShellModel& model = solver_.model();
     const SolverOptions& options = solver_.options();
     const solver::IntegrationPoints<Approx> points(model, options.physics(), options.particle_integration(),
-                                                   solver_.material().shear_modulus());
+                                                   solver_.material().shear_modulus(),
+                                                   solver_.material().poisson_ratio());
     near_ = solver::static_detail::coupling(points, model.particle_count());
     if (options_.one_particle_per_colour) {
       colours_.clear();

@@ -497,7 +497,8 @@ class DistributedSolver {
     using SectionState = typename thickness::Section<Rule, Material>::State;
     solver::check_memory<SectionState>(model_, options_);
     // The whole model's points and states, as the Solver builds them.
-    const Points all_points(model_, options_.physics(), options_.particle_integration(), law_.shear_modulus());
+    const Points all_points(model_, options_.physics(), options_.particle_integration(), law_.shear_modulus(),
+                           law_.poisson_ratio());
     const States all_states(model_, law_, all_points.count(solver::PointGroup::particles));
     stable_time_step_ = solver::stable_time_step(model_, law_, options_.physics(), all_points, all_states);
     if (options_.time_step > 0.0) {
@@ -601,7 +602,8 @@ class DistributedSolver {
     bool rebuilt = points_->any_rebuilt();
     if constexpr (Crack::enabled) rebuilt = rebuilt || all_points_->any_rebuilt();
     if (rebuilt) {
-      const Points fresh(model_, options_.physics(), options_.particle_integration(), law_.shear_modulus());
+      const Points fresh(model_, options_.physics(), options_.particle_integration(), law_.shear_modulus(),
+                           law_.poisson_ratio());
       points_.emplace(local_points(fresh));
       if constexpr (Crack::enabled) all_points_.emplace(fresh);
     }

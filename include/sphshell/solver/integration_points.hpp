@@ -14,6 +14,7 @@
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
+#include <sphshell/shell/cell_hourglass.hpp>
 #include <sphshell/shell/cell_shear.hpp>
 #include <sphshell/shell/cuts.hpp>
 #include <sphshell/shell/kinematics.hpp>
@@ -28,6 +29,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -47,8 +49,11 @@ class IntegrationPoints {
  public:
   // Shape functions at the stress points and, when the particles integrate
   // (a share or a shear weight > 0), at the particles.
+  // The material's shear modulus (the transverse shear) and, for the
+  // director hourglass (PhysicsOptions::director_hourglass), its Poisson ratio.
   IntegrationPoints(const ShellModel& model, const PhysicsOptions& physics,
-                    const ParticleIntegrationOptions& particle_integration, double shear_modulus) {
+                    const ParticleIntegrationOptions& particle_integration, double shear_modulus,
+                    double poisson_ratio = std::numeric_limits<double>::quiet_NaN()) {
     // Each point's support follows its own local spacing (solver/local_spacing.hpp).
     const LocalSpacing spacing = local_spacing(model);
     const bool particles_integrate = particle_integration.particle_integration_share > 0.0 ||
@@ -91,7 +96,7 @@ class IntegrationPoints {
     const std::size_t particle_points = particles_integrate ? model.particle_count() : 0;
     offset_ = {0, stress_points};
     keep_reference_ = !physics.nonlinear;
-    tie_shear(model, physics, shear_modulus);
+    tie_shear(model, physics, shear_modulus, poisson_ratio);
     compute_weights(model, physics, particle_integration, shear_modulus, stress_points, particle_points);
     if (keep_reference_) reference_.resize(size());
     reference_products_.resize(size());
@@ -153,6 +158,7 @@ class IntegrationPoints {
         part.tied_corners_visible_.push_back(tied_corners_visible_[row]);
         part.shear_tying_.push_back(shear_tying_[row]);
         if (keep_reference_) part.shear_edges_.push_back(shear_edges_[row]);
+        if (!hourglass_.empty()) part.hourglass_.push_back(hourglass_[row]);
         shell::CellShearTie& tying = part.shear_tying_.back();
         for (int k = 0; k < tying.corners; ++k)
           tying.particle[k] = local(tying.particle[k], PointGroup::stress_points, row);
@@ -236,6 +242,10 @@ class IntegrationPoints {
     return group == PointGroup::stress_points && !shear_tying_.empty() && shear_tying_[row].corners > 0;
   }
   const shell::CellShearTie& shear_tying(std::size_t row) const { return shear_tying_[row]; }
+  // A tied stress point's director hourglass term (null: none, the option is off).
+  const shell::CellHourglass* hourglass(std::size_t row) const {
+    return hourglass_.empty() ? nullptr : &hourglass_[row];
+  }
   // Its reference edges, which the linear analysis reads (null in a nonlinear
   // one, which keeps none: 192 bytes a stress point).
   const shell::CellShearEdges* shear_edges(std::size_t row) const {
@@ -533,11 +543,21 @@ class IntegrationPoints {
   // Ties every stress point's shear to its cell's edges (TransverseShear::cell_edges,
   // a model with cells). A corner outside the point's row would leave its forces
   // nowhere to go: the support is too small for the cell.
-  void tie_shear(const ShellModel& model, const PhysicsOptions& physics, double shear_modulus) {
+  void tie_shear(const ShellModel& model, const PhysicsOptions& physics, double shear_modulus, double poisson_ratio) {
     shear_tying_.clear();
     shear_edges_.clear();
     tied_corners_visible_.clear();
+    hourglass_.clear();
+    if (physics.director_hourglass) {
+      if (physics.transverse_shear != TransverseShear::cell_edges)
+        detail::invalid_parameter("director_hourglass", "true", "needs transverse_shear = TransverseShear::cell_edges");
+      if (model.cells().empty())
+        detail::invalid_parameter("director_hourglass", "true", "needs a model with cells (this one has none)");
+      if (!(poisson_ratio > -1.0 && poisson_ratio < 0.5))
+        detail::invalid_parameter("poisson_ratio (for director_hourglass)", poisson_ratio, "must lie in (-1, 0.5)");
+    }
     if (physics.transverse_shear != TransverseShear::cell_edges || model.cells().empty()) return;
+    if (physics.director_hourglass) hourglass_.resize(model.stress_point_count());
     const approx::ShapeFunctions& sf = shape(PointGroup::stress_points);
     shear_tying_.resize(model.stress_point_count());
     if (keep_reference_) shear_edges_.resize(shear_tying_.size());
@@ -562,6 +582,15 @@ class IntegrationPoints {
                                 model.stress_point_area[row]);
       shear_tying_[row] = tying;
       if (keep_reference_) shear_edges_[row] = tying;
+      // A triangle's directors have no ξη part: its hourglass term stays zero.
+      if (!hourglass_.empty() && cell.size() == std::size_t(shell::hourglass_corners)) {
+        const double thickness = model.stress_point_thickness(row);
+        // E d³ / (12 (1 − ν²)) with E = 2 G (1 + ν).
+        const double bending = shear_modulus * thickness * thickness * thickness / (6.0 * (1.0 - poisson_ratio));
+        hourglass_[row] = shell::tie_cell_hourglass(cell.begin(), model.particle_position, model.particle_normal,
+                                                    frame(PointGroup::stress_points, row), bending, poisson_ratio,
+                                                    model.stress_point_area[row]);
+      }
     }
   }
 
@@ -570,6 +599,7 @@ class IntegrationPoints {
   std::vector<shell::CellShearTie> shear_tying_;  // per stress point, or empty
   std::vector<shell::CellShearEdges> shear_edges_;  // per stress point with shear_tying_ when keep_reference_
   std::vector<unsigned char> tied_corners_visible_;  // per stress point with shear_tying_
+  std::vector<shell::CellHourglass> hourglass_;  // per stress point with shear_tying_ when director_hourglass, or empty
   std::array<approx::ShapeFunctions, 2> shape_;
   std::array<std::vector<TangentFrame>, 2> frames_;  // evaluation frames, kept for rebuilds
   std::array<std::size_t, 2> offset_{};

@@ -335,10 +335,17 @@ class InternalForceAssembler {
     }
     const shell::CellShearTie& tying = points.shear_tying(row);
     const std::size_t first = row * shell::max_cell_corners;
-    return shell::corner_shear_forces(
-        tying, points.shear_edges(row), [&](int k) -> const Vector3& { return position(tying.particle[std::size_t(k)]); },
-        [&](int k) -> const Vector3& { return director(tying.particle[std::size_t(k)]); }, nonlinear_,
-        &tied_force_[first], &tied_director_force_[first]);
+    const auto corner_position = [&](int k) -> const Vector3& { return position(tying.particle[std::size_t(k)]); };
+    const auto corner_director = [&](int k) -> const Vector3& { return director(tying.particle[std::size_t(k)]); };
+    double energy = shell::corner_shear_forces(tying, points.shear_edges(row), corner_position, corner_director,
+                                               nonlinear_, &tied_force_[first], &tied_director_force_[first]);
+    // The cell's director hourglass (PhysicsOptions::director_hourglass) adds
+    // to the same corner forces.
+    if (const shell::CellHourglass* hourglass = points.hourglass(row);
+        hourglass && tying.corners == shell::hourglass_corners)
+      energy += shell::add_hourglass_forces(*hourglass, corner_position, corner_director, nonlinear_,
+                                            &tied_force_[first], &tied_director_force_[first]);
+    return energy;
   }
 
   bool nonlinear_;

@@ -42,6 +42,12 @@ struct PhysicsOptions {
   double rotary_inertia_scale = 1.0;
   double shear_correction = 5.0 / 6.0;  // κs of the elastic transverse shear
   TransverseShear transverse_shear = TransverseShear::cell_edges;
+  // Adds to every quadrilateral cell the elastic bending energy of its
+  // directors' hourglass (the ξη part of their bilinear interpolation), which
+  // neither the stress points nor the particles see (shell/cell_hourglass.hpp;
+  // docs/method.md, "The director hourglass"). Needs the edge-tied shear and a
+  // model with cells.
+  bool director_hourglass = false;
 };
 
 // Particle integration (docs/method.md, "Quadrature and the particle share"):
