@@ -56,9 +56,9 @@ std::optional<Arguments> parse(int argc, char** argv) {
                       "which benchmarks to run: all is linear and nonlinear; paths follows the whole load paths of "
                       "Sze et al.'s hemisphere (at three resolutions), pull-out and pinched cylinder (one each) by "
                       "displacement control, about 17 min; hemisphere-path follows only the hemisphere's, at 33² and "
-                      "41² (finer than paths), about 20 min; pullout-stability follows the pull-out at 13×9 and 22×15 by "
-                      "displacement control with the tangent's stability after every step, then by arc length, "
-                      "about 2 min");
+                      "41² (finer than paths), about 20 min; pullout-stability follows the pull-out without the director "
+                      "hourglass at 13×9 and 22×15 and with it at 22×15 by displacement control with the tangent's "
+                      "stability after every step, then (without it) by arc length, about 3 min");
   command_line.output_folder(arguments.output);
   command_line.writes("benchmarks.csv", "every run: case, resolution, value, reference, error, seconds");
   command_line.writes("end_shear.csv", "cantilever under end shear: P/Pmax, tip w and -u, the elastica's");
@@ -79,14 +79,17 @@ std::optional<Arguments> parse(int argc, char** argv) {
   command_line.writes("pullout_path.svg", "its load-deflection chart with the paper's points");
   command_line.writes("pinched_cylinder_path.csv", "--cases paths: the pinched cylinder's path, control, P/Pmax, -W_A, U_B");
   command_line.writes("pinched_cylinder_path.svg", "its load-deflection chart with the paper's points");
-  command_line.writes("pullout_stability_NxM.csv",
+  command_line.writes("pullout_stability_NxM[_hourglass].csv",
                       "--cases pullout-stability: per step of the -U_B control, P/Pmax, W_A, -U_B, -U_C, the "
                       "tangent's negative eigenvalues, its eigenvalue nearest zero (and over the unloaded one's), "
-                      "its mode's share of the load; the last row is where the control stalled");
-  command_line.writes("pullout_arc_length_NxM.csv", "--cases pullout-stability: the arc-length path, length, P/Pmax, W_A, -U_B, -U_C");
+                      "its mode's share of the load; without the hourglass the last row is where the control stalled");
+  command_line.writes("pullout_arc_length_NxM.csv",
+                      "--cases pullout-stability, without the hourglass: the arc-length path, length, P/Pmax, W_A, "
+                      "-U_B, -U_C");
   command_line.writes("pullout_mode_NxM.csv",
-                      "--cases pullout-stability: that mode where the control stalled, per particle: x, y, z, "
-                      "its radial, circumferential and axial translation (largest 1)");
+                      "--cases pullout-stability, without the hourglass: that mode where the control stalled, per "
+                      "particle: x, y, z, its radial, circumferential and axial translation and its director "
+                      "rotations about the axis and about the circumference times the spacing (largest 1)");
   if (!command_line.parse(argc, argv)) return std::nullopt;
   return arguments;
 }
@@ -495,15 +498,16 @@ int run(const Arguments& arguments) {
     }
 
     if (!hemisphere_only) {  // the other two paths
-      // §3.5, the pull-out: B's inward motion (it grows through the paper's
-      // snap, where W_A barely moves and U_C turns back) in steps of 0.15.
+      // §3.5, the pull-out (with the director hourglass, as the case is
+      // defined): B's inward motion (it grows through the paper's snap, where
+      // W_A barely moves and U_C turns back) in steps of 0.1.
       const int pullout_nx = 22, pullout_ny = 15;
       const SzeCylinder pullout = sze_pullout_cylinder(pullout_nx, pullout_ny);
       const std::string pullout_grid = std::to_string(pullout_nx) + "×" + std::to_string(pullout_ny);
       const PathRun pullout_path =
           follow("Pull-out (Sze)", pullout_grid, pullout.model, pullout.E, pullout.nu, pullout.options, pullout.conditions,
                  {pullout.b, -Vector3::UnitY()},
-                 {{pullout.a, Vector3::UnitX()}, {pullout.b, -Vector3::UnitY()}, {pullout.c, -Vector3::UnitY()}}, 0.15, 60);
+                 {{pullout.a, Vector3::UnitX()}, {pullout.b, -Vector3::UnitY()}, {pullout.c, -Vector3::UnitY()}}, 0.1, 80);
       {
         PaperSeries a{"W_A", {}, {}}, b{"−U_B", {}, {}}, c{"−U_C", {}, {}};
         for (const TabulatedTriple& point : sze_pullout_table()) {
@@ -537,16 +541,26 @@ int run(const Arguments& arguments) {
   }
 
   if (pullout_stability) {
-    // Where the pull-out's path stops (README, "What limits them"): the
-    // tangent's stability after every step of the −U_B control, and the same
-    // path by arc length.
+    // Where the pull-out's path stops without the director hourglass and that
+    // it does not with it (README, "What limits them"): the tangent's
+    // stability after every step of the −U_B control, and without the
+    // hourglass the same path by arc length.
     NewtonOptions newton;
     newton.tolerance = 1e-5;
     newton.max_iterations = 12;
-    for (const Resolution& grid : {Resolution{13, 9}, Resolution{22, 15}}) {
+    struct StabilityRun {
+      Resolution grid;
+      bool director_hourglass;
+    };
+    for (const StabilityRun& case_run :
+         {StabilityRun{{13, 9}, false}, StabilityRun{{22, 15}, false}, StabilityRun{{22, 15}, true}}) {
+      const Resolution& grid = case_run.grid;
       const auto start = std::chrono::steady_clock::now();
-      const SzeCylinder cylinder = sze_pullout_cylinder(grid.nx, grid.ny);
-      const std::string tag = std::to_string(grid.nx) + "x" + std::to_string(grid.ny);
+      const SzeCylinder cylinder = sze_pullout_cylinder(grid.nx, grid.ny, pullout_options(case_run.director_hourglass));
+      const std::string tag = std::to_string(grid.nx) + "x" + std::to_string(grid.ny) +
+                              (case_run.director_hourglass ? "_hourglass" : "");
+      const std::string name = "Pull-out (Sze), " + grid.text() +
+                               (case_run.director_hourglass ? " with the director hourglass" : " without the director hourglass");
       const ControlDisplacement w_a{cylinder.a, Vector3::UnitX()}, u_b{cylinder.b, -Vector3::UnitY()},
           u_c{cylinder.c, -Vector3::UnitY()};
       {
@@ -570,33 +584,39 @@ int run(const Arguments& arguments) {
                     << " negative eigenvalues, nearest zero " << row[6] << " of the unloaded one ("
                     << seconds_since(start) << " s)\n";
         };
-        std::cerr << "Pull-out (Sze), " << grid.text() << ": -U_B in steps of 0.15, the tangent's stability\n";
+        std::cerr << name << ": -U_B in steps of 0.15, the tangent's stability\n";
         write(unloaded);
-        for (int k = 1; k <= 60; ++k) {
+        for (int k = 1; k <= 60 && statics.load_factor() < 1.0; ++k) {
           try {
             statics.solve_to_displacement(u_b, 0.15 * k, 0.15);
           } catch (const std::runtime_error& error) {
             std::cerr << "  stalled: " << error.what() << "\n";
             const auto stalled = statics.stability();
             write(stalled);
-            // The mode, in the cylinder's own directions, largest translation 1.
+            // The mode in the cylinder's own directions: translations, and
+            // the director rotations times the spacing (a length, comparable
+            // with them); the largest of all 1.
+            const double spacing = cylinder.model.maximum_spacing();
             io::CsvProbe mode_csv(arguments.output + "/pullout_mode_" + tag + ".csv",
-                                  {"x", "y", "z", "radial", "circumferential", "axial"});
+                                  {"x", "y", "z", "radial", "circumferential", "axial",
+                                   "rotation about the axis x spacing", "rotation about the circumference x spacing"});
             double largest = 0.0;
-            for (const Vector3& motion : stalled.mode) largest = std::max(largest, motion.norm());
+            for (std::size_t i = 0; i < stalled.mode.size(); ++i)
+              largest = std::max({largest, stalled.mode[i].norm(), spacing * stalled.mode_rotation[i].norm()});
             for (std::size_t i = 0; i < stalled.mode.size(); ++i) {
               const Vector3& x = cylinder.model.particle_position[i];
               const Vector3 radial = Vector3(x.x(), x.y(), 0.0).normalized();
               const Vector3 around = Vector3::UnitZ().cross(radial);
-              const Vector3 m = stalled.mode[i] / largest;
-              mode_csv.write_row({x.x(), x.y(), x.z(), m.dot(radial), m.dot(around), m.z()});
+              const Vector3 m = stalled.mode[i] / largest, r = spacing * stalled.mode_rotation[i] / largest;
+              mode_csv.write_row({x.x(), x.y(), x.z(), m.dot(radial), m.dot(around), m.z(), r.z(), r.dot(around)});
             }
             break;
           }
           write(statics.stability());
         }
       }
-      std::cerr << "Pull-out (Sze), " << grid.text() << ": arc length, RMS steps of 0.1\n";
+      if (case_run.director_hourglass) continue;  // its control does not stall
+      std::cerr << name << ": arc length, RMS steps of 0.1\n";
       const PathRun arc = follow_arc_length<NonlinearSolver>(
           cylinder.model, cylinder.E, cylinder.nu, cylinder.options, cylinder.conditions, {w_a, u_b, u_c}, 0.1, 1.0, 60, newton);
       io::CsvProbe arc_csv(arguments.output + "/pullout_arc_length_" + tag + ".csv",

@@ -292,6 +292,7 @@ class StaticShell {
     // not at a limit point of the load), and each particle's translation in it.
     double load_share = 0.0;
     std::vector<Vector3> mode;
+    std::vector<Vector3> mode_rotation;  // each director's rotation vector in it (rad per unit of the mode)
   };
   Stability stability() {
     constexpr int inverse_iterations = 60;
@@ -311,9 +312,10 @@ class StaticShell {
     const Eigen::VectorXd f = external_load(dofs);
     result.load_share = f.norm() > 0.0 ? std::abs(x.dot(f)) / f.norm() : 0.0;
     result.mode.assign(dofs.first.size() - 1, Vector3::Zero());
+    result.mode_rotation.assign(dofs.first.size() - 1, Vector3::Zero());
     for (std::size_t i = 0; i + 1 < dofs.first.size(); ++i)
       for (int k = dofs.first[i]; k < dofs.first[i + 1]; ++k)
-        if (!dofs.is_rotation[k]) result.mode[i] += x[k] * dofs.direction[k];
+        (dofs.is_rotation[k] ? result.mode_rotation[i] : result.mode[i]) += x[k] * dofs.direction[k];
     return result;
   }
 

@@ -63,7 +63,7 @@ inline constexpr std::array<double, hourglass_corners> corner_eta_quarter{-0.25,
 // What is fixed about one cell's hourglass term (reference configuration).
 struct CellHourglass {
   std::array<double, hourglass_corners> weight{};      // γ_k
-  Eigen::Matrix2d stiffness = Eigen::Matrix2d::Zero();  // S (N·m: bending stiffness × area / length²)
+  Eigen::Matrix2d stiffness = Eigen::Matrix2d::Zero();  // S (N/m: bending stiffness × area / length⁴)
   Vector2 reference = Vector2::Zero();                  // (X_,ξ·H, X_,η·H)
   // The reference tangents and hourglass director, which only the linear
   // form reads.
