@@ -55,8 +55,8 @@ std::optional<Arguments> parse(int argc, char** argv) {
                       {"all", "linear", "nonlinear", "paths", "hemisphere-path", "pullout-stability"},
                       "which benchmarks to run: all is linear and nonlinear; paths follows the whole load paths of "
                       "Sze et al.'s hemisphere (at three resolutions), pull-out and pinched cylinder (one each) by "
-                      "displacement control, about 17 min; hemisphere-path follows only the hemisphere's, at 33² and "
-                      "41² (finer than paths), about 20 min; pullout-stability follows the pull-out without the director "
+                      "displacement control, about 17 min; hemisphere-path follows only the hemisphere's, at 33², "
+                      "41² and 45² (finer than paths) with the director hourglass, about 20 min; pullout-stability follows the pull-out without the director "
                       "hourglass at 13×9 and 22×15 and with it at 22×15 by displacement control with the tangent's "
                       "stability after every step, then (without it) by arc length, about 3 min");
   command_line.output_folder(arguments.output);
@@ -75,6 +75,8 @@ std::optional<Arguments> parse(int argc, char** argv) {
   command_line.writes("pullout_cylinder.svg", "its load-deflection chart with the paper's points");
   command_line.writes("sze_hemisphere_path.csv", "--cases paths: the hemisphere's path, control, P/Pmax, pulled, pushed");
   command_line.writes("sze_hemisphere_path.svg", "its load-deflection chart with the paper's points");
+  command_line.writes("sze_hemisphere_path_fine.csv", "--cases hemisphere-path: the same at 33², 41² and 45² with the director hourglass");
+  command_line.writes("sze_hemisphere_path_fine.svg", "its chart (45²)");
   command_line.writes("pullout_path.csv", "--cases paths: the pull-out's path, control, P/Pmax, W_A, -U_B, -U_C");
   command_line.writes("pullout_path.svg", "its load-deflection chart with the paper's points");
   command_line.writes("pinched_cylinder_path.csv", "--cases paths: the pinched cylinder's path, control, P/Pmax, -W_A, U_B");
@@ -476,15 +478,19 @@ int run(const Arguments& arguments) {
     };
 
     // §3.4, the hemisphere: the pushed point's inward motion in steps of 0.5,
-    // at three resolutions.
+    // at three resolutions (hemisphere-path: finer, with the director
+    // hourglass, with which the 41² and 45² paths pass P_max).
     std::vector<GridRun> hemisphere_runs;
-    for (int n : hemisphere_only ? std::vector<int>{33, 41} : std::vector<int>{25, 29, 33}) {
+    SolverOptions hemisphere_options;
+    hemisphere_options.director_hourglass = hemisphere_only;
+    for (int n : hemisphere_only ? std::vector<int>{33, 41, 45} : std::vector<int>{25, 29, 33}) {
       const SzeHemisphere hemisphere = sze_hemisphere(n);
       const ControlDisplacement pushed{hemisphere.pushed, -Vector3::UnitY()};
       const ControlDisplacement pulled{hemisphere.pulled, Vector3::UnitX()};
       const std::string grid = std::to_string(n) + "²";
-      hemisphere_runs.push_back({grid, follow("Hemisphere (Sze)", grid, hemisphere.model, 6.825e7, 0.3, {},
-                                              hemisphere.conditions, pushed, {pulled, pushed}, 0.5, 40)});
+      hemisphere_runs.push_back({grid, follow("Hemisphere (Sze)", grid, hemisphere.model, 6.825e7, 0.3,
+                                              hemisphere_options, hemisphere.conditions, pushed, {pulled, pushed},
+                                              0.5, 40)});
     }
     {
       PaperSeries a{"pulled", {}, {}}, b{"pushed", {}, {}};
@@ -492,7 +498,9 @@ int run(const Arguments& arguments) {
         a.load_factor.push_back(point.load_factor), a.value.push_back(point.first);
         b.load_factor.push_back(point.load_factor), b.value.push_back(point.second);
       }
-      report("sze_hemisphere_path", "Hemisphere under alternating forces: the path (Sze 2004)",
+      report(hemisphere_only ? "sze_hemisphere_path_fine" : "sze_hemisphere_path",
+             hemisphere_only ? "Hemisphere, alternating forces, with the director hourglass (Sze 2004)"
+                             : "Hemisphere under alternating forces: the path (Sze 2004)",
              "Hemisphere, alternating forces", hemisphere_runs, {"pulled, outward", "pushed, inward"}, {a, b},
              {0.1, 0.5, 1.0});
     }
