@@ -499,7 +499,7 @@ int run(const Arguments& arguments) {
         b.load_factor.push_back(point.load_factor), b.value.push_back(point.second);
       }
       report(hemisphere_only ? "sze_hemisphere_path_fine" : "sze_hemisphere_path",
-             hemisphere_only ? "Hemisphere, alternating forces, with the director hourglass (Sze 2004)"
+             hemisphere_only ? "Hemisphere with the director hourglass (Sze 2004)"
                              : "Hemisphere under alternating forces: the path (Sze 2004)",
              "Hemisphere, alternating forces", hemisphere_runs, {"pulled, outward", "pushed, inward"}, {a, b},
              {0.1, 0.5, 1.0});
