@@ -143,7 +143,7 @@ TEST_CASE("Director hourglass: a linear director field strains nothing, on a ske
   }
 }
 
-TEST_CASE("Director hourglass: a rigid rotation strains nothing; forces are the energy's gradient and balance",
+TEST_CASE("Director hourglass: a rigid rotation strains nothing, the forces are the energy gradient and balance",
           "[solver][hourglass][objectivity]") {
   std::mt19937 random(5);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
