@@ -63,6 +63,9 @@ struct ParticleState {
 struct PackedKinematics {
   Vector3 position, director;
 };
+// The gather reads a particle's six numbers as one vector (IntegrationPoints::gather).
+static_assert(sizeof(PackedKinematics) == 6 * sizeof(double),
+              "PackedKinematics must hold position then director as six contiguous doubles");
 
 // Lumped translational mass m (kg) and rotary inertia I (kg·m²) per particle.
 struct Inertia {
