@@ -28,11 +28,18 @@ namespace sphshell::solver {
 
 class AssemblySchedule {
  public:
-  // Rows of one group integrated before the other group's turn. One row at a
-  // time (the groups strictly alternating) made the point updates slower than
-  // two separate passes; runs of 32 to 128 rows measured alike
-  // (README, "Performance").
-  static constexpr std::size_t rows_per_run = 64;
+  // Rows of one group integrated before the other group's turn, at most. One
+  // row at a time (the groups strictly alternating) made the point updates
+  // slower than two separate passes. Longer runs let the hardware prefetchers
+  // follow each group's arrays through memory: once the model outgrows the
+  // cache (a 401×401 plate), runs of 512 rows took 0.92-0.94 of the time per
+  // step of runs of 64; runs of 4096 were slower again, the particles' sums
+  // waiting too long for their points (README, "Performance").
+  static constexpr std::size_t max_rows_per_run = 512;
+  // Runs per segment, at least, when several threads share the pass, so that
+  // the segments can be cut to about equal sizes.
+  static constexpr std::size_t min_runs_per_segment = 8;
+  static constexpr std::size_t min_rows_per_run = 64;
   // Segments per thread when several threads share the pass. A particle
   // whose points lie in two segments is summed after the pass, away from the
   // cache that held its points: with eight per thread on the paper's plate
@@ -93,6 +100,10 @@ class AssemblySchedule {
     for (std::vector<std::size_t>& first_rows : group_run_first_row_) first_rows.clear();
     for (std::vector<std::uint32_t>& index : group_run_index_) index.clear();
     const std::size_t count[2] = {points.count(PointGroup::stress_points), points.count(PointGroup::particles)};
+    const std::size_t rows_per_run =
+        segment_count_ == 1
+            ? max_rows_per_run
+            : std::clamp(points.size() / (segment_count_ * min_runs_per_segment), min_rows_per_run, max_rows_per_run);
     std::size_t next[2] = {0, 0};
     while (next[0] < count[0] || next[1] < count[1]) {
       // The group less far through its rows goes next (next/count compared
