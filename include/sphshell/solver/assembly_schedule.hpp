@@ -32,7 +32,7 @@ class AssemblySchedule {
   // row at a time (the groups strictly alternating) made the point updates
   // slower than two separate passes. Longer runs let the hardware prefetchers
   // follow each group's arrays through memory: once the model outgrows the
-  // cache (a 401×401 plate), runs of 512 rows took 0.92-0.94 of the time per
+  // cache (a 401×401 plate), runs of 512 rows took about 0.92 of the time per
   // step of runs of 64; runs of 4096 were slower again, the particles' sums
   // waiting too long for their points (README, "Performance").
   static constexpr std::size_t max_rows_per_run = 512;
