@@ -37,7 +37,8 @@ class AssemblySchedule {
   // waiting too long for their points (README, "Performance").
   static constexpr std::size_t max_rows_per_run = 512;
   // Runs per segment, at least, when several threads share the pass, so that
-  // the segments can be cut to about equal sizes.
+  // the segments can be cut to about equal sizes; but never shorter than 64
+  // rows, the length all the thread measurements before the fourth round used.
   static constexpr std::size_t min_runs_per_segment = 8;
   static constexpr std::size_t min_rows_per_run = 64;
   // Segments per thread when several threads share the pass. A particle
