@@ -287,8 +287,8 @@ TEST_CASE("The assembly schedule sums each particle once, after every point that
           "[solver][parallel]") {
   // The interleaved pass (solver/assembly_schedule.hpp) may form a particle's
   // sum only once every point in its force entries has integrated in this
-  // step: inside one segment, after the run that completes them, or after all
-  // segments. A particle summed one run too early would take a point's forces
+  // step: inside one segment, after the run that completes them, or in a band
+  // that the last of the segments holding its points sums. A particle summed one run too early would take a point's forces
   // from the step before, an error too small for the mechanics tests to see.
   const SolverOptions options;
   const ShellModel plate = ShellModel::rectangular_plate(0.3, 0.2, 31, 21, 0.002);
@@ -296,7 +296,7 @@ TEST_CASE("The assembly schedule sums each particle once, after every point that
   for (const ShellModel* model : {&plate, &cap}) {
     const solver::IntegrationPoints<approx::MLS<kernel::CubicSpline>> points(*model, options.physics(),
                                                                               options.particle_integration(), 80e9);
-    for (std::size_t segments : {std::size_t{1}, std::size_t{2}, std::size_t{8}}) {
+    for (std::size_t segments : {std::size_t{1}, std::size_t{2}, std::size_t{8}, std::size_t{32}}) {
       INFO(model->particle_count() << " particles, " << segments << " segments");
       solver::AssemblySchedule schedule;
       schedule.update(points, model->particle_count(), segments);
@@ -331,7 +331,47 @@ TEST_CASE("The assembly schedule sums each particle once, after every point that
               after_its_points = after_its_points && point_run >= schedule.first_run(s) && point_run <= r;
             }
           }
-      for (const std::uint32_t i : schedule.straddling()) ++summed[i];
+      // A band's particles: each segment that holds any of their points
+      // reports once, after (or at) the last run there among those points.
+      std::vector<std::size_t> segment_of_run(schedule.end_run(segments - 1));
+      for (std::size_t s = 0; s < segments; ++s)
+        for (std::size_t r = schedule.first_run(s); r < schedule.end_run(s); ++r) segment_of_run[r] = s;
+      std::vector<std::vector<std::size_t>> report_run(schedule.band_count(),
+                                                       std::vector<std::size_t>(segments, points.size()));
+      bool one_report_per_segment = true;
+      for (std::size_t s = 0; s < segments; ++s)
+        for (std::size_t r = schedule.first_run(s); r < schedule.end_run(s); ++r)
+          for (const std::uint32_t b : schedule.bands_after(r)) {
+            one_report_per_segment = one_report_per_segment && report_run[b][s] == points.size();
+            report_run[b][s] = r;
+          }
+      bool reports_after_points = true, parts_counted = true, bands_straddle = true;
+      std::size_t in_bands = 0;
+      for (std::size_t b = 0; b < schedule.band_count(); ++b) {
+        std::vector<bool> holds(segments, false);
+        for (const std::uint32_t i : schedule.band(b)) {
+          ++summed[i];
+          ++in_bands;
+          std::vector<bool> own(segments, false);
+          for (std::size_t k = begin[i]; k < begin[i + 1]; ++k) {
+            const std::size_t point_run = run_of[points.force_entries()[k].point];
+            const std::size_t s = segment_of_run[point_run];
+            holds[s] = own[s] = true;
+            reports_after_points = reports_after_points && report_run[b][s] != points.size() &&
+                                   report_run[b][s] >= point_run;
+          }
+          bands_straddle = bands_straddle && std::count(own.begin(), own.end(), true) >= 2;
+        }
+        const auto reporting = std::count_if(report_run[b].begin(), report_run[b].end(),
+                                             [&](std::size_t r) { return r != points.size(); });
+        parts_counted = parts_counted && reporting == std::count(holds.begin(), holds.end(), true) &&
+                        schedule.band_parts(b) == std::size_t(reporting) && reporting >= 2;
+      }
+      CHECK(in_bands == schedule.straddling().size());
+      CHECK(one_report_per_segment);
+      CHECK(reports_after_points);
+      CHECK(parts_counted);
+      CHECK(bands_straddle);
       CHECK(after_its_points);
       CHECK(std::all_of(summed.begin(), summed.end(), [](int n) { return n == 1; }));
       // With one segment no particle waits for the end; with two, most of a

@@ -10,10 +10,13 @@
 // or a mesh's element order). A particle's sum needs every point that refers
 // to it; it is formed right after the run that completes them. The runs are
 // cut into segments of about equal size, one task each: a particle whose
-// points all lie in one segment is summed inside it ("completed by" a run),
-// one whose points lie in two or more ("straddling") after every segment is
-// done. Nothing here changes a result: each particle's sum keeps its order
-// (IntegrationPoints::force_entries).
+// points all lie in one segment is summed inside it ("completed by" a run).
+// One whose points lie in two or more segments ("straddling") belongs to a
+// band, the straddling particles of the same first and last segment; each
+// segment that holds points of a band reports after the run that completes
+// its share of them, and the segment that reports last sums the band there
+// and then (InternalForceAssembler keeps the count). Nothing here changes a
+// result: each particle's sum keeps its order (IntegrationPoints::force_entries).
 
 #include <sphshell/solver/integration_points.hpp>
 
@@ -22,6 +25,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <map>
+#include <utility>
 #include <vector>
 
 namespace sphshell::solver {
@@ -41,15 +46,15 @@ class AssemblySchedule {
   // rows, the length all the thread measurements before the fourth round used.
   static constexpr std::size_t min_runs_per_segment = 8;
   static constexpr std::size_t min_rows_per_run = 64;
-  // Segments per thread when several threads share the pass. A particle
-  // whose points lie in two segments is summed after the pass, away from the
-  // cache that held its points: with eight per thread on the paper's plate
-  // (segments of about three grid rows) that was 94 % of the particles, and
-  // two threads took 0.63-0.64 of one thread's time on an idle machine
-  // against 0.53 with one, two or four; under load all four measured alike
-  // (README, "Thread counts"). Two keeps a spare task for a thread the
-  // system holds back.
-  static constexpr std::size_t segments_per_thread = 2;
+  // Segments per thread when several threads share the pass. More segments
+  // let a thread that is ahead take over more of a held-back thread's share,
+  // but more particles straddle two of them. While the straddling particles
+  // were summed after the pass, away from the cache that held their points,
+  // two per thread measured best (eight: 94 % of the paper's plate straddled).
+  // Summed in bands (band()), mostly right after their points on the thread
+  // that integrated them, four per thread took about 0.95 of the time of two
+  // summed after the pass (README, "Thread counts").
+  static constexpr std::size_t segments_per_thread = 4;
 
   struct Run {
     PointGroup group;
@@ -90,8 +95,25 @@ class AssemblySchedule {
   Particles completed_by(std::size_t r) const {
     return {sum_order_.data() + run_sum_begin_[r], sum_order_.data() + run_sum_begin_[r + 1]};
   }
-  // The particles summed after the segments, by index.
-  const std::vector<std::uint32_t>& straddling() const { return straddling_; }
+  // The bands of straddling particles: band b's particles by index, and how
+  // many segments report for it (at least two).
+  std::size_t band_count() const { return band_parts_.size(); }
+  Particles band(std::size_t b) const {
+    return {band_particles_.data() + band_begin_[b], band_particles_.data() + band_begin_[b + 1]};
+  }
+  std::uint32_t band_parts(std::size_t b) const { return band_parts_[b]; }
+  // The bands for which run r's segment reports after run r.
+  struct Bands {
+    const std::uint32_t *first, *last;
+    const std::uint32_t* begin() const { return first; }
+    const std::uint32_t* end() const { return last; }
+    bool empty() const { return first == last; }
+  };
+  Bands bands_after(std::size_t r) const {
+    return {run_bands_.data() + run_band_begin_[r], run_bands_.data() + run_band_begin_[r + 1]};
+  }
+  // Every straddling particle, by index (the bands' particles, band by band).
+  const std::vector<std::uint32_t>& straddling() const { return band_particles_; }
 
  private:
   // Runs in the order they integrate, and each group's runs by first row.
@@ -147,8 +169,8 @@ class AssemblySchedule {
   }
 
   // Each particle after the last run among its points, if they all lie in
-  // one segment; with the straddling ones otherwise (and those that no point
-  // refers to: their sum is zero).
+  // one segment, and in a band otherwise; one that no point refers to (its sum
+  // is zero) after the first run.
   // (Two passes over the entries, counting and then placing, so that the
   // build keeps no array per particle besides the order itself.)
   template <class Approx>
@@ -158,7 +180,7 @@ class AssemblySchedule {
     const auto& entries = points.force_entries();
     // The run that completes particle i's points, or `straddles`.
     const auto completing_run = [&](std::size_t i) {
-      if (begin[i] == begin[i + 1]) return straddles;
+      if (begin[i] == begin[i + 1]) return std::uint32_t{0};
       std::uint32_t first = straddles, last = 0;
       for (std::size_t k = begin[i]; k < begin[i + 1]; ++k) {
         const std::uint32_t run = run_of(points, entries[k].point);
@@ -178,16 +200,62 @@ class AssemblySchedule {
     }
     for (std::size_t r = 0; r < runs_.size(); ++r) run_sum_begin_[r + 1] += run_sum_begin_[r];
     std::vector<std::uint32_t>(run_sum_begin_.back()).swap(sum_order_);
-    std::vector<std::uint32_t>().swap(straddling_);
-    straddling_.reserve(straddling);
+    std::vector<std::uint32_t> straddling_particles;
+    straddling_particles.reserve(straddling);
     std::vector<std::size_t> next(run_sum_begin_.begin(), run_sum_begin_.end() - 1);
     for (std::size_t i = 0; i < particle_count_; ++i) {
       const std::uint32_t run = completing_run(i);
       if (run == straddles)
-        straddling_.push_back(static_cast<std::uint32_t>(i));
+        straddling_particles.push_back(static_cast<std::uint32_t>(i));
       else
         sum_order_[next[run]++] = static_cast<std::uint32_t>(i);
     }
+    form_bands(points, straddling_particles);
+  }
+
+  // The bands of the straddling particles, and in each segment that holds
+  // points of a band the run after which it reports (the last run there
+  // among the band's points).
+  template <class Approx>
+  void form_bands(const IntegrationPoints<Approx>& points, const std::vector<std::uint32_t>& straddling) {
+    const std::vector<std::size_t>& begin = points.particle_slot_begin();
+    const auto& entries = points.force_entries();
+    std::map<std::pair<std::size_t, std::size_t>, std::uint32_t> band_of_range;  // (first, last segment) → band
+    std::map<std::pair<std::uint32_t, std::size_t>, std::uint32_t> report_run;  // (band, segment) → run
+    std::vector<std::uint32_t> band_of(straddling.size());
+    for (std::size_t k = 0; k < straddling.size(); ++k) {
+      const std::size_t i = straddling[k];
+      std::size_t first = segment_count_, last = 0;
+      for (std::size_t e = begin[i]; e < begin[i + 1]; ++e) {
+        const std::size_t segment = segment_of_run_[run_of(points, entries[e].point)];
+        first = std::min(first, segment);
+        last = std::max(last, segment);
+      }
+      const auto band = band_of_range.emplace(std::make_pair(first, last), std::uint32_t(band_of_range.size()));
+      band_of[k] = band.first->second;
+      for (std::size_t e = begin[i]; e < begin[i + 1]; ++e) {
+        const std::uint32_t run = run_of(points, entries[e].point);
+        std::uint32_t& report = report_run.emplace(std::make_pair(band_of[k], segment_of_run_[run]), run).first->second;
+        report = std::max(report, run);
+      }
+    }
+    const std::size_t bands = band_of_range.size();
+    band_begin_.assign(bands + 1, 0);
+    for (const std::uint32_t band : band_of) ++band_begin_[band + 1];
+    for (std::size_t b = 0; b < bands; ++b) band_begin_[b + 1] += band_begin_[b];
+    band_particles_.resize(straddling.size());
+    std::vector<std::size_t> next(band_begin_.begin(), band_begin_.end() - 1);
+    for (std::size_t k = 0; k < straddling.size(); ++k) band_particles_[next[band_of[k]]++] = straddling[k];
+    band_parts_.assign(bands, 0);
+    run_band_begin_.assign(runs_.size() + 1, 0);
+    for (const auto& [band_and_segment, run] : report_run) {
+      ++band_parts_[band_and_segment.first];
+      ++run_band_begin_[std::size_t(run) + 1];
+    }
+    for (std::size_t r = 0; r < runs_.size(); ++r) run_band_begin_[r + 1] += run_band_begin_[r];
+    run_bands_.resize(report_run.size());
+    std::vector<std::size_t> next_report(run_band_begin_.begin(), run_band_begin_.end() - 1);
+    for (const auto& [band_and_segment, run] : report_run) run_bands_[next_report[run]++] = band_and_segment.first;
   }
 
   std::uint64_t stamp_ = 0;  // IntegrationPoints::force_entries_stamp() of the last build (0: none)
@@ -199,7 +267,11 @@ class AssemblySchedule {
   std::vector<std::size_t> segment_of_run_;
   std::vector<std::size_t> run_sum_begin_;  // size runs + 1: completed_by(r) is sum_order_[r's range]
   std::vector<std::uint32_t> sum_order_;
-  std::vector<std::uint32_t> straddling_;
+  std::vector<std::size_t> band_begin_;        // size bands + 1: band(b) is band_particles_[b's range]
+  std::vector<std::uint32_t> band_particles_;  // the straddling particles, band by band
+  std::vector<std::uint32_t> band_parts_;      // per band: the segments that report
+  std::vector<std::size_t> run_band_begin_;    // size runs + 1: bands_after(r) is run_bands_[r's range]
+  std::vector<std::uint32_t> run_bands_;
 };
 
 }  // namespace sphshell::solver

@@ -31,9 +31,11 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <exception>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -61,9 +63,11 @@ class InternalForceAssembler {
       packed_[i] = PackedKinematics{particles.position[i], particles.director[i]};
     });
     // Each segment integrates its runs and sums the particles that each run
-    // completes; the particles whose points lie in two segments follow.
+    // completes; a band of particles whose points lie in several segments is
+    // summed by the segment that finishes its share of them last.
     const ForceSum<Approx> sum(points, *this);
     failures_.assign(schedule_.segments(), PointFailure{});
+    band_countdown_.start(schedule_);
     parallel::for_each_task(schedule_.segments(), [&](std::size_t segment) noexcept {
       PointFailure& failure = failures_[segment];
       for (std::size_t run = schedule_.first_run(segment); run < schedule_.end_run(segment); ++run) {
@@ -76,11 +80,11 @@ class InternalForceAssembler {
           }
         }
         for (const std::uint32_t i : schedule_.completed_by(run)) sum(i, forces);
+        for (const std::uint32_t band : schedule_.bands_after(run))
+          if (band_countdown_.report(band))
+            for (const std::uint32_t i : schedule_.band(band)) sum(i, forces);
       }
     });
-    const std::vector<std::uint32_t>& straddling = schedule_.straddling();
-    parallel::for_each(std::size_t{0}, straddling.size(),
-                       [&](std::size_t k) noexcept { sum(straddling[k], forces); });
     report_failure(at, points);
   }
 
@@ -348,6 +352,30 @@ class InternalForceAssembler {
     return energy;
   }
 
+  // Per band of the schedule: the segments still to report in this
+  // compute(). A segment's report releases the forces it wrote and the last
+  // one's acquires the others', so the band's sums read every point's forces
+  // of this step. (A copy starts without counts: compute() sets them.)
+  class BandCountdown {
+   public:
+    BandCountdown() = default;
+    BandCountdown(const BandCountdown&) {}
+    BandCountdown& operator=(const BandCountdown&) { return *this; }
+    void start(const AssemblySchedule& schedule) {
+      if (size_ != schedule.band_count()) {
+        size_ = schedule.band_count();
+        remaining_ = std::make_unique<std::atomic<std::uint32_t>[]>(size_);
+      }
+      for (std::size_t b = 0; b < size_; ++b) remaining_[b].store(schedule.band_parts(b), std::memory_order_relaxed);
+    }
+    // True for the segment that reports last.
+    bool report(std::size_t band) { return remaining_[band].fetch_sub(1, std::memory_order_acq_rel) == 1; }
+
+   private:
+    std::size_t size_ = 0;
+    std::unique_ptr<std::atomic<std::uint32_t>[]> remaining_;
+  };
+
   bool nonlinear_;
   std::size_t failed_point_ = 0;
   // Per point: its conjugate forces (zero for a removed point). Per stress
@@ -359,6 +387,7 @@ class InternalForceAssembler {
   std::vector<PackedKinematics> packed_;  // this step's positions and directors
   AssemblySchedule schedule_;
   std::vector<PointFailure> failures_;  // per segment of the last compute()
+  BandCountdown band_countdown_;
 };
 
 }  // namespace sphshell::solver
