@@ -9,8 +9,12 @@
 // machine's load hits both alike. The counter `ratio` is the median over the
 // rounds of (2-thread chunk time) / (1-thread chunk time): below 1 the second
 // thread helps, 1.1 is the limit under load. `load1` is the 1-minute
-// load average when the benchmark started. The argument is the team's spin
-// time in µs (parallel::set_spin_time; 50 is the library's default).
+// load average when the benchmark started. `steal` is the share of the
+// machine's CPU time that its hypervisor gave to other guests while the
+// rounds ran (Linux /proc/stat; −1 where it cannot be read): a virtual
+// machine can show no load of its own and still lose its cores for a while,
+// and then "idle" is not idle. The argument is the team's spin time in µs
+// (parallel::set_spin_time; 50 is the library's default).
 #include <sphshell/sphshell.hpp>
 
 #include <benchmark/benchmark.h>
@@ -18,6 +22,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -80,6 +87,33 @@ double seconds_for_steps(PlateSolver& solver, int steps) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+// The machine's CPU time so far, in clock ticks: all of it and the part
+// stolen by the hypervisor (the first line of /proc/stat: user nice system
+// idle iowait irq softirq steal ...). {-1, -1} where it cannot be read.
+struct CpuTicks {
+  double total = -1.0, steal = -1.0;
+};
+CpuTicks cpu_ticks() {
+  std::ifstream stat("/proc/stat");
+  std::string line, label;
+  if (!std::getline(stat, line)) return {};
+  std::istringstream fields(line);
+  fields >> label;
+  if (label != "cpu") return {};
+  CpuTicks ticks{0.0, 0.0};
+  double value = 0.0;
+  constexpr int steal_field = 7;  // zero-based among the numbers
+  for (int k = 0; k < 8 && fields >> value; ++k) {
+    ticks.total += value;
+    if (k == steal_field) ticks.steal = value;
+  }
+  return ticks;
+}
+double steal_share(const CpuTicks& before, const CpuTicks& after) {
+  if (before.total < 0.0 || after.total <= before.total) return -1.0;
+  return (after.steal - before.steal) / (after.total - before.total);
+}
+
 double median(std::vector<double> values) {
   std::sort(values.begin(), values.end());
   const std::size_t n = values.size();
@@ -102,6 +136,7 @@ void two_against_one_thread(benchmark::State& state, bool with_busy_process) {
     if (busy && !busy->running()) state.SkipWithError("could not start the busy process");
     std::vector<double> ratios;
     double one_seconds = 0.0, two_seconds = 0.0;
+    const CpuTicks ticks_before = cpu_ticks();
     for (int round = 0; round < rounds; ++round) {
       double t1 = 0.0, t2 = 0.0;
       for (int turn = 0; turn < 2; ++turn) {
@@ -117,6 +152,7 @@ void two_against_one_thread(benchmark::State& state, bool with_busy_process) {
       one_seconds += t1;
       two_seconds += t2;
     }
+    const CpuTicks ticks_after = cpu_ticks();
     delete busy;
     use_threads(1);
     state.SetIterationTime(two_seconds / (rounds * chunk));
@@ -124,6 +160,7 @@ void two_against_one_thread(benchmark::State& state, bool with_busy_process) {
     state.counters["one_thread_us_per_step"] = 1e6 * one_seconds / (rounds * chunk);
     state.counters["two_threads_us_per_step"] = 1e6 * two_seconds / (rounds * chunk);
     state.counters["load1"] = load1;
+    state.counters["steal"] = steal_share(ticks_before, ticks_after);
   }
   parallel::set_spin_time(previous_spin);
 }
