@@ -112,6 +112,41 @@ TEST_CASE("Gravity acts on each particle's mass: a free plate falls as x = g t²
   CHECK(std::abs(energy.balance()) < 1e-9 * energy.external_work);
 }
 
+TEST_CASE("add_uniform_pressure gives the same bits as add_pressure with the same function on any thread count", "[solver][loads]") {
+  // add_uniform_pressure evaluates its time function once per step and shares
+  // its loop among the threads; add_pressure calls p(X, t) for every particle
+  // on one thread. The forces, and so every position, must be the same bits.
+  using PlateSolver = Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<3>, material::Elastic>;
+  const ShellModel plate = ShellModel::rectangular_plate(0.3, 0.2, 31, 21, 0.004);
+  const time_function::Ramp ramp{2e-5, 1e-6};
+  for (const PressureDirection direction : {PressureDirection::follower, PressureDirection::fixed}) {
+    PlateSolver uniform(plate, {70e9, 0.3}), general(plate, {70e9, 0.3});
+    for (PlateSolver* solver : {&uniform, &general}) solver->clamp(solver->model().set("boundary"));
+    uniform.add_uniform_pressure(uniform.model().all_particles(), 4e5, ramp, direction);
+    general.add_pressure(
+        general.model().all_particles(), [ramp](const Vector3&, double t) { return 4e5 * ramp(t); }, direction);
+    for (const int threads : {2, 1, 3}) {
+#ifdef _OPENMP
+      omp_set_num_threads(threads);
+#endif
+      for (int k = 0; k < 15; ++k) {
+        uniform.step();
+        general.step();
+      }
+    }
+#ifdef _OPENMP
+    omp_set_num_threads(1);
+#endif
+    std::size_t differing = 0;
+    for (std::size_t i = 0; i < uniform.particle_count(); ++i)
+      differing += uniform.positions()[i] == general.positions()[i] ? 0 : 1;
+    CHECK(differing == 0);
+    // The load has acted: the plate's centre moved against the normal.
+    const int centre = 15 * 21 + 10;
+    CHECK(uniform.displacement(centre).z() < -1e-9);
+  }
+}
+
 TEST_CASE("An end moment bends a cantilever strip uniformly: tip rotation ML/EI", "[solver][loads]") {
   // Linear, ν = 0 (the strip bends like a beam), static by dynamic relaxation.
   const double L = 0.5, width = 0.1, d = 0.02, E = 210e9, rho = 7850;

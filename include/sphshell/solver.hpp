@@ -184,8 +184,8 @@ class Solver {
   void add_uniform_pressure(const ParticleSet& set, double pressure, TimeFunction time = {},
                             PressureDirection direction = PressureDirection::follower) {
     detail::require_finite("pressure", pressure);
-    detail::check_time_function(time);
-    add_pressure(set, [pressure, time](const Vector3&, double t) { return pressure * time(t); }, direction);
+    loads_.add(std::make_unique<detail::UniformPressureLoad<TimeFunction>>(checked(set), pressure, std::move(time),
+                                                                           direction));
   }
   // A force (N) on every particle of the set.
   template <class TimeFunction = time_function::Step>

@@ -210,7 +210,9 @@ class DistributedSolver {
       sphshell::detail::require_finite("pressure", pressure);
       sphshell::detail::check_time_function(time);
     });
-    add_pressure(set, [pressure, time](const Vector3&, double t) { return pressure * time(t); }, direction);
+    on_set(set, [&](const ParticleSet&, const ParticleSet& local) {
+      loads_.add(std::make_unique<sphshell::detail::UniformPressureLoad<TimeFunction>>(local, pressure, time, direction));
+    });
   }
   template <class TimeFunction = time_function::Step>
   void add_uniform_pressure(const std::string& set_name, double pressure, TimeFunction time = {},

@@ -3,7 +3,11 @@
 // direction), point forces and moments, gravity, and ready-made time functions.
 //
 // Each load is type-erased once (one virtual call per load per step); its loop
-// over particles calls the user's callable inline.
+// over particles calls the user's callable inline. A loop that calls no user
+// code per particle (a uniform pressure, point forces and moments, gravity:
+// their time function is evaluated once per step) is shared by the threads,
+// each particle of the set being listed once (solver::checked_set); a
+// pressure function p(X, t) is called serially, as it need not be thread-safe.
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/parallel.hpp>
@@ -112,6 +116,35 @@ class PressureLoad final : public Load {
   PressureDirection direction_;
 };
 
+// p·f(t) on every particle of the set, the same as PressureLoad with
+// p(X, t) = p·f(t).
+template <class TimeFunction>
+class UniformPressureLoad final : public Load {
+ public:
+  UniformPressureLoad(std::vector<int> particles, double pressure, TimeFunction time_function,
+                      PressureDirection direction)
+      : particles_(std::move(particles)),
+        pressure_(pressure),
+        time_function_(std::move(time_function)),
+        direction_(direction) {
+    check_time_function(time_function_);
+  }
+  void apply(LoadContext& c) const override {
+    const double p = pressure_ * time_function_(c.time);
+    parallel::for_each(std::size_t{0}, particles_.size(), [&](std::size_t k) noexcept {
+      const std::size_t i = std::size_t(particles_[k]);
+      const Vector3& n = direction_ == PressureDirection::follower ? c.director[i] : c.reference_normal[i];
+      c.force[i] -= p * c.area[i] * n;
+    });
+  }
+
+ private:
+  std::vector<int> particles_;
+  double pressure_;
+  TimeFunction time_function_;
+  PressureDirection direction_;
+};
+
 template <class TimeFunction>
 class PointForceLoad final : public Load {
  public:
@@ -121,7 +154,8 @@ class PointForceLoad final : public Load {
   }
   void apply(LoadContext& c) const override {
     const Vector3 f = time_function_(c.time) * force_;
-    for (int i : particles_) c.force[i] += f;
+    parallel::for_each(std::size_t{0}, particles_.size(),
+                       [&](std::size_t k) noexcept { c.force[std::size_t(particles_[k])] += f; });
   }
 
  private:
@@ -139,7 +173,8 @@ class PointMomentLoad final : public Load {
   }
   void apply(LoadContext& c) const override {
     const Vector3 m = time_function_(c.time) * moment_;
-    for (int i : particles_) c.moment[i] += m;
+    parallel::for_each(std::size_t{0}, particles_.size(),
+                       [&](std::size_t k) noexcept { c.moment[std::size_t(particles_[k])] += m; });
   }
 
  private:
@@ -158,7 +193,10 @@ class GravityLoad final : public Load {
   }
   void apply(LoadContext& c) const override {
     const Vector3 g = time_function_(c.time) * acceleration_;
-    for (int i : particles_) c.force[i] += c.mass[i] * g;
+    parallel::for_each(std::size_t{0}, particles_.size(), [&](std::size_t k) noexcept {
+      const std::size_t i = std::size_t(particles_[k]);
+      c.force[i] += c.mass[i] * g;
+    });
   }
 
  private:
