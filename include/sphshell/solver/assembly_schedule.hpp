@@ -52,9 +52,9 @@ class AssemblySchedule {
   // were summed after the pass, away from the cache that held their points,
   // two per thread measured best (eight: 94 % of the paper's plate straddled).
   // Summed in bands (band()), mostly right after their points on the thread
-  // that integrated them, four per thread took about 0.95 of the time of two
-  // summed after the pass (README, "Thread counts").
-  static constexpr std::size_t segments_per_thread = 4;
+  // that integrated them, eight per thread took about 0.93 of the time of two
+  // summed after the pass, four about 0.95 (README, "Thread counts").
+  static constexpr std::size_t segments_per_thread = 8;
 
   struct Run {
     PointGroup group;
