@@ -318,6 +318,41 @@ TEST_CASE("A plate's step is bitwise the same on 1, 2 and 3 threads", "[core][pa
   }
 }
 
+TEST_CASE("The energy books are the same on 1, 2 and 3 threads and add up every particle", "[core][parallel]") {
+  // EnergyLedger::book_step adds the particles' terms in chunks of
+  // ParticleEnergyTerms::sum_chunk on the threads; 31 × 21 particles make
+  // three chunks, the last one short.
+  const ShellModel plate = ShellModel::rectangular_plate(0.3, 0.2, 31, 21, 0.004);
+  REQUIRE(plate.particle_count() > 2 * solver::ParticleEnergyTerms::sum_chunk);
+  std::vector<EnergyReport> reports;
+  for (const int threads : {1, 2, 3}) {
+#ifdef _OPENMP
+    omp_set_num_threads(threads);
+#endif
+    Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<3>, material::Elastic> solver(plate, {70e9, 0.3});
+    solver.clamp(solver.model().set("boundary"));
+    solver.add_uniform_pressure(solver.model().all_particles(), 3e5);
+    solver.run_until(30 * solver.time_step());
+    reports.push_back(solver.energy());
+    // The kinetic energy at the last half step, summed here particle by particle.
+    double kinetic = 0.0;
+    for (std::size_t i = 0; i < solver.particle_count(); ++i)
+      kinetic += 0.5 * solver.masses()[i] * solver.velocities()[i].squaredNorm() +
+                 0.5 * solver.rotary_inertias()[i] * solver.angular_velocities()[i].squaredNorm();
+    CHECK(kinetic > 0.0);
+    CHECK(std::abs(reports.back().kinetic - kinetic) <= 1e-13 * kinetic);
+  }
+#ifdef _OPENMP
+  omp_set_num_threads(1);
+#endif
+  for (std::size_t run = 1; run < reports.size(); ++run) {
+    CHECK(reports[run].kinetic == reports[0].kinetic);
+    CHECK(reports[run].external_work == reports[0].external_work);
+    CHECK(reports[run].damping_work == reports[0].damping_work);
+    CHECK(reports[run].internal == reports[0].internal);
+  }
+}
+
 TEST_CASE("The assembly schedule sums each particle once, after every point that refers to it",
           "[solver][parallel]") {
   // The interleaved pass (solver/assembly_schedule.hpp) may form a particle's

@@ -48,38 +48,75 @@ namespace solver {
 // work over the step of the external forces and moments with the reactions of
 // the kinematic conditions, f · Δt · (v^{n−½} + v^{n+½})/2 with the reactions
 // m (v − v_free)/Δt; the damping work c m |v̄|²Δt; the kinetic energy at n+½.
-// Each term is written to an array by a parallel loop, so the ledger adds
-// them in index order (identical books for any thread count).
+// Each term is written to an array by a parallel loop. The serial ledger adds
+// them in fixed chunks of particles (sum()), the MPI one in index order, so
+// the books are identical for any thread count.
+//
+// The copies of the velocities and the chunks run on the threads like the
+// stepper's loops: each thread then reads and writes the particles whose
+// velocities it updated. Done serially, they pulled half of the particles'
+// velocities to the calling thread's core every step, and the stepper's next
+// writes had to take them back (README, "Performance", fifth round).
 class ParticleEnergyTerms {
  public:
+  // Particles per partial sum in sum(): fixed, not per thread, so that the
+  // sums are the same whatever the thread count.
+  static constexpr std::size_t sum_chunk = 256;
+
   // v^{n−½} and ω^{n−½}, before the stepper updates them.
   void remember_velocities(const ParticleState& state) {
-    old_velocity_ = state.velocity;
-    old_angular_velocity_ = state.angular_velocity;
+    old_velocity_.resize(state.velocity.size());
+    old_angular_velocity_.resize(state.angular_velocity.size());
+    parallel::for_each(std::size_t{0}, state.velocity.size(), [&](std::size_t i) noexcept {
+      old_velocity_[i] = state.velocity[i];
+      old_angular_velocity_[i] = state.angular_velocity[i];
+    });
   }
   // The velocities the unconstrained update produced, before the kinematic
   // conditions: their difference is the reactions' impulse.
-  void remember_free_velocities(const ParticleState& state) { free_velocity_ = state.velocity; }
+  void remember_free_velocities(const ParticleState& state) {
+    free_velocity_.resize(state.velocity.size());
+    parallel::for_each(std::size_t{0}, state.velocity.size(),
+                       [&](std::size_t i) noexcept { free_velocity_[i] = state.velocity[i]; });
+  }
 
   // The terms of particles [begin, end) (the arrays are sized to end).
   void compute(const stepper::StepContext& context, const ParticleState& state, const Inertia& inertia,
                const ParticleForces& forces, std::size_t begin, std::size_t end) {
-    const double dt = context.velocity_step;
-    const double c = context.damping;
-    external_.resize(end);
-    damping_.resize(end);
-    kinetic_.resize(end);
-    parallel::for_each(begin, end, [&](std::size_t i) noexcept {
-      const Vector3 average = 0.5 * (old_velocity_[i] + state.velocity[i]);
-      const Vector3 average_angular = 0.5 * (old_angular_velocity_[i] + state.angular_velocity[i]);
-      const Vector3 reaction = inertia.mass[i] * (state.velocity[i] - free_velocity_[i]) / dt;
-      external_[i] = dt * (forces.external[i] + reaction).dot(average) +
-                     dt * forces.external_moment[i].dot(average_angular);
-      damping_[i] = dt * c * inertia.mass[i] * average.squaredNorm() +
-                    dt * c * inertia.rotary_inertia[i] * average_angular.squaredNorm();
-      kinetic_[i] = 0.5 * inertia.mass[i] * state.velocity[i].squaredNorm() +
-                    0.5 * inertia.rotary_inertia[i] * state.angular_velocity[i].squaredNorm();
+    size_to(end);
+    parallel::for_each(begin, end,
+                       [&](std::size_t i) noexcept { compute_particle(i, context, state, inertia, forces); });
+  }
+
+  // The sums over particles [begin, end) of the three terms.
+  struct Sums {
+    double external = 0.0, damping = 0.0, kinetic = 0.0;
+  };
+  // compute() and the sums in one parallel pass: each chunk of sum_chunk
+  // particles is added in index order, then the chunks' sums in chunk order.
+  Sums compute_and_sum(const stepper::StepContext& context, const ParticleState& state, const Inertia& inertia,
+                       const ParticleForces& forces, std::size_t begin, std::size_t end) {
+    size_to(end);
+    const std::size_t chunks = (end - begin + sum_chunk - 1) / sum_chunk;
+    chunk_sums_.resize(chunks);
+    parallel::for_each_task(chunks, [&](std::size_t chunk) noexcept {
+      Sums sums;
+      const std::size_t last = std::min(end, begin + (chunk + 1) * sum_chunk);
+      for (std::size_t i = begin + chunk * sum_chunk; i < last; ++i) {
+        compute_particle(i, context, state, inertia, forces);
+        sums.external += external_[i];
+        sums.damping += damping_[i];
+        sums.kinetic += kinetic_[i];
+      }
+      chunk_sums_[chunk] = sums;
     });
+    Sums total;
+    for (const Sums& sums : chunk_sums_) {
+      total.external += sums.external;
+      total.damping += sums.damping;
+      total.kinetic += sums.kinetic;
+    }
+    return total;
   }
 
   const std::vector<double>& external() const { return external_; }
@@ -87,8 +124,29 @@ class ParticleEnergyTerms {
   const std::vector<double>& kinetic() const { return kinetic_; }
 
  private:
+  void size_to(std::size_t end) {
+    external_.resize(end);
+    damping_.resize(end);
+    kinetic_.resize(end);
+  }
+  void compute_particle(std::size_t i, const stepper::StepContext& context, const ParticleState& state,
+                        const Inertia& inertia, const ParticleForces& forces) {
+    const double dt = context.velocity_step;
+    const double c = context.damping;
+    const Vector3 average = 0.5 * (old_velocity_[i] + state.velocity[i]);
+    const Vector3 average_angular = 0.5 * (old_angular_velocity_[i] + state.angular_velocity[i]);
+    const Vector3 reaction = inertia.mass[i] * (state.velocity[i] - free_velocity_[i]) / dt;
+    external_[i] =
+        dt * (forces.external[i] + reaction).dot(average) + dt * forces.external_moment[i].dot(average_angular);
+    damping_[i] = dt * c * inertia.mass[i] * average.squaredNorm() +
+                  dt * c * inertia.rotary_inertia[i] * average_angular.squaredNorm();
+    kinetic_[i] = 0.5 * inertia.mass[i] * state.velocity[i].squaredNorm() +
+                  0.5 * inertia.rotary_inertia[i] * state.angular_velocity[i].squaredNorm();
+  }
+
   std::vector<Vector3> old_velocity_, old_angular_velocity_, free_velocity_;
   std::vector<double> external_, damping_, kinetic_;
+  std::vector<Sums> chunk_sums_;
 };
 
 class EnergyLedger {
@@ -122,16 +180,11 @@ class EnergyLedger {
   // damping, and the kinetic energy at n+½ (ParticleEnergyTerms).
   void book_step(const stepper::StepContext& context, const ParticleState& state, const Inertia& inertia,
                  const ParticleForces& forces) {
-    terms_.compute(context, state, inertia, forces, state.ranges.owned_begin, state.ranges.owned_end);
-    double external = 0.0, damping = 0.0, kinetic = 0.0;
-    for (std::size_t i = state.ranges.owned_begin; i < state.ranges.owned_end; ++i) {
-      external += terms_.external()[i];
-      damping += terms_.damping()[i];
-      kinetic += terms_.kinetic()[i];
-    }
-    external_work_ += external;
-    damping_work_ += damping;
-    kinetic_energy_ = kinetic;
+    const ParticleEnergyTerms::Sums sums =
+        terms_.compute_and_sum(context, state, inertia, forces, state.ranges.owned_begin, state.ranges.owned_end);
+    external_work_ += sums.external;
+    damping_work_ += sums.damping;
+    kinetic_energy_ = sums.kinetic;
   }
 
   // The internal work of one force evaluation, per point in index order.
