@@ -53,7 +53,7 @@ class AssemblySchedule {
   // two per thread measured best (eight: 94 % of the paper's plate straddled).
   // Summed in bands (band()), mostly right after their points on the thread
   // that integrated them, eight per thread took about 0.93 of the time of two
-  // summed after the pass, four about 0.95 (README, "Thread counts").
+  // summed after the pass, four about 0.95 (README, "Performance", fifth round).
   static constexpr std::size_t segments_per_thread = 8;
 
   struct Run {

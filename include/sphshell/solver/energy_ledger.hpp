@@ -49,7 +49,7 @@ namespace solver {
 // the kinematic conditions, f · Δt · (v^{n−½} + v^{n+½})/2 with the reactions
 // m (v − v_free)/Δt; the damping work c m |v̄|²Δt; the kinetic energy at n+½.
 // Each term is written to an array by a parallel loop. The serial ledger adds
-// them in fixed chunks of particles (sum()), the MPI one in index order, so
+// them in fixed chunks of particles (compute_and_sum()), the MPI one in index order, so
 // the books are identical for any thread count.
 //
 // The copies of the velocities and the chunks run on the threads like the
@@ -59,7 +59,7 @@ namespace solver {
 // writes had to take them back (README, "Performance", fifth round).
 class ParticleEnergyTerms {
  public:
-  // Particles per partial sum in sum(): fixed, not per thread, so that the
+  // Particles per partial sum in compute_and_sum(): fixed, not per thread, so that the
   // sums are the same whatever the thread count.
   static constexpr std::size_t sum_chunk = 256;
 
