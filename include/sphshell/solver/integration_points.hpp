@@ -434,7 +434,7 @@ class IntegrationPoints {
   std::size_t untied_corner() const { return count(PointGroup::stress_points) * shell::max_cell_corners; }
 
   // Maps every particle to the shape-function slots that reference it, so the
-  // force gather is a deterministic per-particle sum (no atomics, identical
+  // force gather is a deterministic per-particle sum (no atomic additions, identical
   // results for any thread count). Rows keep their capacity when cracks shrink
   // them, so the slot numbering stays; only the map is rebuilt.
   void build_slot_transpose(std::size_t particle_count) {

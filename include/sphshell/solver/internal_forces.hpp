@@ -6,7 +6,7 @@
 // the corner forces of its edge-tied shear) kept per point; then each particle
 // sums, over the shape-function slots that refer to it and in a fixed order
 // (IntegrationPoints::force_entries), the slot's share of its point's forces
-// (the deterministic sum: no atomics, identical results for any thread
+// (the deterministic sum: no atomic additions, identical results for any thread
 // count). The per-slot forces are formed where they are added, so no array of
 // them is written and read back. The work of each point over the step is kept
 // for the energy ledger.
