@@ -96,18 +96,21 @@ class Load {
   virtual void apply(LoadContext& context) const = 0;
 };
 
+// Adds a pressure p on particle i: f = −p A n, n the current director
+// (follower) or the reference normal (fixed).
+inline void add_pressure_force(LoadContext& c, std::size_t i, double p, PressureDirection direction) {
+  const Vector3& n = direction == PressureDirection::follower ? c.director[i] : c.reference_normal[i];
+  c.force[i] -= p * c.area[i] * n;
+}
+
 template <class PressureFunction>
 class PressureLoad final : public Load {
  public:
   PressureLoad(std::vector<int> particles, PressureFunction pressure, PressureDirection direction)
       : particles_(std::move(particles)), pressure_(std::move(pressure)), direction_(direction) {}
   void apply(LoadContext& c) const override {
-    for (int i : particles_) {
-      const double p = pressure_(c.reference_position[i], c.time);
-      const Vector3& n =
-          direction_ == PressureDirection::follower ? c.director[i] : c.reference_normal[i];
-      c.force[i] -= p * c.area[i] * n;
-    }
+    for (int i : particles_)
+      add_pressure_force(c, std::size_t(i), pressure_(c.reference_position[i], c.time), direction_);
   }
 
  private:
@@ -132,9 +135,7 @@ class UniformPressureLoad final : public Load {
   void apply(LoadContext& c) const override {
     const double p = pressure_ * time_function_(c.time);
     parallel::for_each(std::size_t{0}, particles_.size(), [&](std::size_t k) noexcept {
-      const std::size_t i = std::size_t(particles_[k]);
-      const Vector3& n = direction_ == PressureDirection::follower ? c.director[i] : c.reference_normal[i];
-      c.force[i] -= p * c.area[i] * n;
+      add_pressure_force(c, std::size_t(particles_[k]), p, direction_);
     });
   }
 

@@ -86,30 +86,25 @@ class AssemblySchedule {
   std::size_t end_run(std::size_t segment) const { return segment_first_run_[segment + 1]; }
   const Run& run(std::size_t r) const { return runs_[r]; }
 
-  // The particles whose sums the run completes (within its segment), by index.
-  struct Particles {
+  // A stretch of one of the schedule's index arrays (particles or bands).
+  struct Indices {
     const std::uint32_t *first, *last;
     const std::uint32_t* begin() const { return first; }
     const std::uint32_t* end() const { return last; }
   };
-  Particles completed_by(std::size_t r) const {
+  // The particles whose sums the run completes (within its segment), by index.
+  Indices completed_by(std::size_t r) const {
     return {sum_order_.data() + run_sum_begin_[r], sum_order_.data() + run_sum_begin_[r + 1]};
   }
   // The bands of straddling particles: band b's particles by index, and how
   // many segments report for it (at least two).
   std::size_t band_count() const { return band_parts_.size(); }
-  Particles band(std::size_t b) const {
+  Indices band(std::size_t b) const {
     return {band_particles_.data() + band_begin_[b], band_particles_.data() + band_begin_[b + 1]};
   }
   std::uint32_t band_parts(std::size_t b) const { return band_parts_[b]; }
   // The bands for which run r's segment reports after run r.
-  struct Bands {
-    const std::uint32_t *first, *last;
-    const std::uint32_t* begin() const { return first; }
-    const std::uint32_t* end() const { return last; }
-    bool empty() const { return first == last; }
-  };
-  Bands bands_after(std::size_t r) const {
+  Indices bands_after(std::size_t r) const {
     return {run_bands_.data() + run_band_begin_[r], run_bands_.data() + run_band_begin_[r + 1]};
   }
   // Every straddling particle, by index (the bands' particles, band by band).
