@@ -147,6 +147,90 @@ TEST_CASE("add_uniform_pressure gives the same bits as add_pressure with the sam
   }
 }
 
+TEST_CASE("The loads' single pass adds each load in turn on any thread count and reports the lowest bad particle", "[solver][loads]") {
+  // ExternalLoads zeroes, adds every load and checks one range of particles
+  // at a time. Against the sums written here, particle by particle in the
+  // order the loads were added (the same additions, so the same bits): sets
+  // unsorted and partial, a serial p(X, t) between parallel loads or none.
+  constexpr std::size_t n = 3001;
+  std::vector<Vector3> position(n), normal(n), director(n), force(n), moment(n);
+  std::vector<double> area(n), mass(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double x = 0.001 * static_cast<double>(i);
+    position[i] = Vector3(x, std::sin(x), 0.0);
+    normal[i] = Vector3(0.0, 0.0, 1.0);
+    director[i] = Vector3(0.1 * std::sin(3 * x), 0.2 * std::cos(5 * x), 1.0).normalized();
+    area[i] = 1e-4 * (1.0 + 0.3 * std::cos(7 * x));
+    mass[i] = 0.02 * (1.0 + 0.2 * std::sin(11 * x));
+  }
+  std::vector<int> all(n), even_backwards, tail;
+  for (std::size_t i = 0; i < n; ++i) all[i] = static_cast<int>(n - 1 - i);
+  for (int i = static_cast<int>(n) - 1; i >= 0; i -= 2) even_backwards.push_back(i);
+  for (int i = 2000; i < static_cast<int>(n); ++i) tail.push_back(i);
+  const time_function::Ramp ramp{2e-5, 1e-6};
+  const double t = 7.3e-6, pressure = 3.1e5;
+  const Vector3 point_force(1.5, -2.25, 0.75), point_moment(0.0, 0.3, -0.1), gravity(0.0, 0.0, -9.81);
+  const auto pressure_at = [](const Vector3& X, double time) { return 2e5 * (1.0 + X.x()) * time * 1e5; };
+  const StepTime at{12, t};
+
+  for (const bool with_serial : {false, true}) {
+    ExternalLoads loads;
+    loads.add(std::make_unique<detail::UniformPressureLoad<time_function::Ramp>>(all, pressure, ramp,
+                                                                                  PressureDirection::follower));
+    loads.add(std::make_unique<detail::PointForceLoad<time_function::Ramp>>(even_backwards, point_force, ramp));
+    if (with_serial)
+      loads.add(std::make_unique<detail::PressureLoad<decltype(pressure_at)>>(tail, pressure_at,
+                                                                              PressureDirection::fixed));
+    loads.add(std::make_unique<detail::GravityLoad<time_function::Ramp>>(tail, gravity, ramp));
+    loads.add(std::make_unique<detail::PointMomentLoad<time_function::Ramp>>(even_backwards, point_moment, ramp));
+
+    // The expected sums, one particle at a time.
+    const double f = ramp(t);
+    std::vector<Vector3> expected_force(n, Vector3::Zero()), expected_moment(n, Vector3::Zero());
+    for (std::size_t i = 0; i < n; ++i) {
+      const bool even = i % 2 == 0, in_tail = i >= 2000;  // n − 1 = 3000: even_backwards holds the even indices
+      expected_force[i] -= (pressure * f) * area[i] * director[i];
+      if (even) expected_force[i] += f * point_force;
+      if (with_serial && in_tail) expected_force[i] -= pressure_at(position[i], t) * area[i] * normal[i];
+      if (in_tail) expected_force[i] += mass[i] * (f * gravity);
+      if (even) expected_moment[i] += f * point_moment;
+    }
+    for (const int threads : {1, 2, 3}) {
+#ifdef _OPENMP
+      omp_set_num_threads(threads);
+#endif
+      std::fill(force.begin(), force.end(), Vector3::Constant(7.0));  // stale values must be zeroed
+      std::fill(moment.begin(), moment.end(), Vector3::Constant(7.0));
+      detail::LoadContext context{t, position, normal, director, area, mass, force, moment};
+      loads.apply(at, context);
+      std::size_t differing = 0;
+      for (std::size_t i = 0; i < n; ++i)
+        differing += force[i] == expected_force[i] && moment[i] == expected_moment[i] ? 0 : 1;
+      INFO("threads " << threads << ", serial load " << with_serial);
+      CHECK(differing == 0);
+    }
+  }
+
+  // A non-finite load stops the step, naming the lowest particle it reached.
+  const auto nan_after = [](double time) { return time > 5e-6 ? std::nan("") : 1.0; };
+  for (const int threads : {1, 2, 3}) {
+#ifdef _OPENMP
+    omp_set_num_threads(threads);
+#endif
+    ExternalLoads loads;
+    loads.add(std::make_unique<detail::GravityLoad<time_function::Ramp>>(all, gravity, ramp));
+    loads.add(std::make_unique<detail::PointForceLoad<decltype(nan_after)>>(std::vector<int>{2900, 1777, 601, 2400},
+                                                                            point_force, nan_after));
+    detail::LoadContext context{t, position, normal, director, area, mass, force, moment};
+    INFO("threads " << threads);
+    CHECK_THROWS_WITH(loads.apply(at, context),
+                      Catch::Contains("step 12") && Catch::Contains("non-finite external load at particle 601 "));
+  }
+#ifdef _OPENMP
+  omp_set_num_threads(1);
+#endif
+}
+
 TEST_CASE("An end moment bends a cantilever strip uniformly: tip rotation ML/EI", "[solver][loads]") {
   // Linear, ν = 0 (the strip bends like a beam), static by dynamic relaxation.
   const double L = 0.5, width = 0.1, d = 0.02, E = 210e9, rho = 7850;

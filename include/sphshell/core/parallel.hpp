@@ -301,6 +301,19 @@ constexpr std::size_t tasks_per_thread = 16;
 // Below this many indices per task a loop is not worth waking threads for.
 constexpr std::size_t min_task_size = 8;
 
+// The team for a loop of `count` indices on `threads` threads, or nullptr when
+// the loop runs serially (one thread, too few indices, or the team is busy).
+inline Team* team_for(std::size_t count, int threads) {
+  if (threads <= 1 || count < 2 * min_task_size) return nullptr;
+  Team* team = &Team::instance();
+  return team->try_acquire() ? team : nullptr;
+}
+// The indices per task of a loop of `count` indices on `threads` threads.
+inline std::size_t task_size_for(std::size_t count, int threads) {
+  const std::size_t wanted = static_cast<std::size_t>(threads) * tasks_per_thread;
+  return std::max(min_task_size, (count + wanted - 1) / wanted);
+}
+
 }  // namespace detail
 
 // How long a waiting thread of the team spins before it sleeps (50 µs unless
@@ -361,14 +374,8 @@ void for_each(Index begin, Index end, Body&& body, OnFailure&& on_failure) {
   Job job{body, begin, count, count, {}, count, nullptr};
 
   const int threads = thread_count();
-  detail::Team* team = nullptr;
-  if (threads > 1 && count >= 2 * detail::min_task_size) {
-    team = &detail::Team::instance();
-    if (!team->try_acquire()) team = nullptr;
-  }
-  if (team) {
-    const std::size_t wanted = static_cast<std::size_t>(threads) * detail::tasks_per_thread;
-    job.task_size = std::max(detail::min_task_size, (count + wanted - 1) / wanted);
+  if (detail::Team* team = detail::team_for(count, threads)) {
+    job.task_size = detail::task_size_for(count, threads);
     const std::size_t tasks = (count + job.task_size - 1) / job.task_size;
     team->run(tasks, threads, &Job::run_task, &job);
     team->release();
@@ -380,6 +387,40 @@ void for_each(Index begin, Index end, Body&& body, OnFailure&& on_failure) {
       on_failure(static_cast<Index>(begin + static_cast<Index>(job.failed)), job.failure);
       std::rethrow_exception(job.failure);
     }
+  }
+}
+
+// Calls body(first, last) on ranges that cover [begin, end) once: the tasks
+// for_each makes of the same range, so each thread gets the same block of
+// indices as in a for_each over it. For loops that make several passes over
+// each index (a pass per load, then a check) while its data is in cache.
+// body must not throw (note a failure and report it after the loop).
+template <class Index, class Body>
+void for_each_range(Index begin, Index end, Body&& body) {
+  static_assert(std::is_integral_v<Index>, "parallel::for_each_range: the index must be an integer type");
+  static_assert(std::is_nothrow_invocable_v<Body&, Index, Index>,
+                "parallel::for_each_range: declare the body noexcept (note a failure and report it after the loop)");
+  if (!(begin < end)) return;
+  const std::size_t count = static_cast<std::size_t>(end - begin);
+  struct Job {
+    Body& body;
+    Index begin;
+    std::size_t count, task_size;
+    static void run_task(void* context, std::size_t task) {
+      const Job& job = *static_cast<const Job*>(context);
+      const std::size_t from = task * job.task_size;
+      const std::size_t to = std::min(job.count, from + job.task_size);
+      job.body(static_cast<Index>(job.begin + static_cast<Index>(from)),
+               static_cast<Index>(job.begin + static_cast<Index>(to)));
+    }
+  };
+  const int threads = thread_count();
+  if (detail::Team* team = detail::team_for(count, threads)) {
+    Job job{body, begin, count, detail::task_size_for(count, threads)};
+    team->run((count + job.task_size - 1) / job.task_size, threads, &Job::run_task, &job);
+    team->release();
+  } else {
+    body(begin, end);
   }
 }
 

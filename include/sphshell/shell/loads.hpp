@@ -2,17 +2,20 @@
 // External loads on particles: pressure (uniform or p(X, t), follower or fixed
 // direction), point forces and moments, gravity, and ready-made time functions.
 //
-// Each load is type-erased once (one virtual call per load per step); its loop
-// over particles calls the user's callable inline. A loop that calls no user
-// code per particle (a uniform pressure, point forces and moments, gravity:
-// their time function is evaluated once per step) is shared by the threads,
-// each particle of the set being listed once (solver::checked_set); a
-// pressure function p(X, t) is called serially, as it need not be thread-safe.
+// Each load is type-erased once (a virtual call per load and range of
+// particles); its loop over particles calls the user's callable inline. A
+// load that calls no user code per particle (a uniform pressure, point forces
+// and moments, gravity: their time function is evaluated once per step) is
+// shared by the threads, each particle of the set being listed once
+// (solver::checked_set); a pressure function p(X, t) is called serially, as
+// it need not be thread-safe.
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/parallel.hpp>
 #include <sphshell/core/types.hpp>
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <memory>
@@ -90,10 +93,42 @@ struct LoadContext {
   std::vector<Vector3>& moment;
 };
 
+// A load adds its contribution in two parts: its time function, evaluated once
+// per step on the calling thread (it is user code: it may throw and need not
+// be thread-safe), and the additions to the particles of its set, made for one
+// range of particle indices at a time and for disjoint ranges on several
+// threads at once, unless the load calls user code per particle (serial()).
 class Load {
  public:
   virtual ~Load() = default;
-  virtual void apply(LoadContext& context) const = 0;
+  // The load's time factor at `time` (1 for a load without a time function).
+  virtual double factor(double time) const = 0;
+  // Adds the load, scaled by `factor`, to the particles of its set whose
+  // index is in [first, last).
+  virtual void apply(LoadContext& context, double factor, std::size_t first, std::size_t last) const = 0;
+  // True when apply() calls user code per particle: it is then called once,
+  // on the whole range, by the calling thread.
+  virtual bool serial() const { return false; }
+};
+
+// A load's particles in index order, so that those in a range of indices are
+// found by two binary searches (a set lists each particle once, so the order
+// does not change what a particle receives).
+class SortedParticles {
+ public:
+  explicit SortedParticles(std::vector<int> particles) : particles_(std::move(particles)) {
+    std::sort(particles_.begin(), particles_.end());
+  }
+  template <class Visit>
+  void visit(std::size_t first, std::size_t last, Visit&& visit) const {
+    const auto below = [](int particle, std::size_t index) { return static_cast<std::size_t>(particle) < index; };
+    const auto from = std::lower_bound(particles_.begin(), particles_.end(), first, below);
+    const auto to = std::lower_bound(from, particles_.end(), last, below);
+    for (auto it = from; it != to; ++it) visit(static_cast<std::size_t>(*it));
+  }
+
+ private:
+  std::vector<int> particles_;
 };
 
 // Adds a pressure p on particle i: f = −p A n, n the current director
@@ -103,15 +138,20 @@ inline void add_pressure_force(LoadContext& c, std::size_t i, double p, Pressure
   c.force[i] -= p * c.area[i] * n;
 }
 
+// p(X, t) on the particles of the set, in the set's order, on one thread.
 template <class PressureFunction>
 class PressureLoad final : public Load {
  public:
   PressureLoad(std::vector<int> particles, PressureFunction pressure, PressureDirection direction)
       : particles_(std::move(particles)), pressure_(std::move(pressure)), direction_(direction) {}
-  void apply(LoadContext& c) const override {
-    for (int i : particles_)
-      add_pressure_force(c, std::size_t(i), pressure_(c.reference_position[i], c.time), direction_);
+  double factor(double) const override { return 1.0; }
+  void apply(LoadContext& c, double, std::size_t first, std::size_t last) const override {
+    for (int particle : particles_) {
+      const std::size_t i = static_cast<std::size_t>(particle);
+      if (i >= first && i < last) add_pressure_force(c, i, pressure_(c.reference_position[i], c.time), direction_);
+    }
   }
+  bool serial() const override { return true; }
 
  private:
   std::vector<int> particles_;
@@ -132,15 +172,14 @@ class UniformPressureLoad final : public Load {
         direction_(direction) {
     check_time_function(time_function_);
   }
-  void apply(LoadContext& c) const override {
-    const double p = pressure_ * time_function_(c.time);
-    parallel::for_each(std::size_t{0}, particles_.size(), [&](std::size_t k) noexcept {
-      add_pressure_force(c, std::size_t(particles_[k]), p, direction_);
-    });
+  double factor(double time) const override { return time_function_(time); }
+  void apply(LoadContext& c, double factor, std::size_t first, std::size_t last) const override {
+    const double p = pressure_ * factor;
+    particles_.visit(first, last, [&](std::size_t i) { add_pressure_force(c, i, p, direction_); });
   }
 
  private:
-  std::vector<int> particles_;
+  SortedParticles particles_;
   double pressure_;
   TimeFunction time_function_;
   PressureDirection direction_;
@@ -153,14 +192,14 @@ class PointForceLoad final : public Load {
       : particles_(std::move(particles)), force_(force), time_function_(std::move(time_function)) {
     check_time_function(time_function_);
   }
-  void apply(LoadContext& c) const override {
-    const Vector3 f = time_function_(c.time) * force_;
-    parallel::for_each(std::size_t{0}, particles_.size(),
-                       [&](std::size_t k) noexcept { c.force[std::size_t(particles_[k])] += f; });
+  double factor(double time) const override { return time_function_(time); }
+  void apply(LoadContext& c, double factor, std::size_t first, std::size_t last) const override {
+    const Vector3 f = factor * force_;
+    particles_.visit(first, last, [&](std::size_t i) { c.force[i] += f; });
   }
 
  private:
-  std::vector<int> particles_;
+  SortedParticles particles_;
   Vector3 force_;
   TimeFunction time_function_;
 };
@@ -172,14 +211,14 @@ class PointMomentLoad final : public Load {
       : particles_(std::move(particles)), moment_(moment), time_function_(std::move(time_function)) {
     check_time_function(time_function_);
   }
-  void apply(LoadContext& c) const override {
-    const Vector3 m = time_function_(c.time) * moment_;
-    parallel::for_each(std::size_t{0}, particles_.size(),
-                       [&](std::size_t k) noexcept { c.moment[std::size_t(particles_[k])] += m; });
+  double factor(double time) const override { return time_function_(time); }
+  void apply(LoadContext& c, double factor, std::size_t first, std::size_t last) const override {
+    const Vector3 m = factor * moment_;
+    particles_.visit(first, last, [&](std::size_t i) { c.moment[i] += m; });
   }
 
  private:
-  std::vector<int> particles_;
+  SortedParticles particles_;
   Vector3 moment_;
   TimeFunction time_function_;
 };
@@ -192,16 +231,14 @@ class GravityLoad final : public Load {
       : particles_(std::move(particles)), acceleration_(acceleration), time_function_(std::move(time_function)) {
     check_time_function(time_function_);
   }
-  void apply(LoadContext& c) const override {
-    const Vector3 g = time_function_(c.time) * acceleration_;
-    parallel::for_each(std::size_t{0}, particles_.size(), [&](std::size_t k) noexcept {
-      const std::size_t i = std::size_t(particles_[k]);
-      c.force[i] += c.mass[i] * g;
-    });
+  double factor(double time) const override { return time_function_(time); }
+  void apply(LoadContext& c, double factor, std::size_t first, std::size_t last) const override {
+    const Vector3 g = factor * acceleration_;
+    particles_.visit(first, last, [&](std::size_t i) { c.force[i] += c.mass[i] * g; });
   }
 
  private:
-  std::vector<int> particles_;
+  SortedParticles particles_;
   Vector3 acceleration_;
   TimeFunction time_function_;
 };
@@ -210,26 +247,75 @@ class GravityLoad final : public Load {
 
 // The loads of a run: each applied in turn into zeroed force and moment
 // arrays; a load that produces a non-finite value stops the run.
+// Without a serial load (a pressure function p(X, t)) this is one pass over
+// the particles, shared by the threads: each thread zeroes a range, adds
+// every load to it and checks it while its particles are in cache. The sums
+// are those of one load after the other (each particle receives its loads in
+// the order they were added), so they are the same for any thread count.
 class ExternalLoads {
  public:
-  void add(std::unique_ptr<detail::Load> load) { loads_.push_back(std::move(load)); }
+  void add(std::unique_ptr<detail::Load> load) {
+    any_serial_ = any_serial_ || load->serial();
+    loads_.push_back(std::move(load));
+    factors_.push_back(0.0);
+  }
   bool empty() const { return loads_.empty(); }
 
-  void apply(const StepTime& at, detail::LoadContext& context) const {
-    parallel::for_each(std::size_t{0}, context.force.size(), [&](std::size_t i) noexcept {
-      context.force[i].setZero();
-      context.moment[i].setZero();
-    });
-    for (const auto& load : loads_) load->apply(context);
-    parallel::for_each(std::size_t{0}, context.force.size(), [&](std::size_t i) {
-      if (!all_finite(context.force[i], context.moment[i]))
-        detail::fail_unstable(at, "non-finite external load at particle " + std::to_string(i) +
-                                      " (a pressure, force or moment function returned NaN or infinity)");
-    });
+  void apply(const StepTime& at, detail::LoadContext& context) {
+    for (std::size_t l = 0; l < loads_.size(); ++l) factors_[l] = loads_[l]->factor(context.time);
+    const std::size_t count = context.force.size();
+    std::atomic<std::size_t> first_non_finite{count};
+    const auto check = [&](std::size_t first, std::size_t last) noexcept {
+      for (std::size_t i = first; i < last; ++i)
+        if (!all_finite(context.force[i], context.moment[i])) {
+          note_lowest(first_non_finite, i);
+          return;
+        }
+    };
+    if (!any_serial_) {
+      parallel::for_each_range(std::size_t{0}, count, [&](std::size_t first, std::size_t last) noexcept {
+        zero(context, first, last);
+        for (std::size_t l = 0; l < loads_.size(); ++l) loads_[l]->apply(context, factors_[l], first, last);
+        check(first, last);
+      });
+    } else {
+      parallel::for_each_range(std::size_t{0}, count,
+                               [&](std::size_t first, std::size_t last) noexcept { zero(context, first, last); });
+      for (std::size_t l = 0; l < loads_.size(); ++l) {
+        const detail::Load& load = *loads_[l];
+        const double factor = factors_[l];
+        if (load.serial())
+          load.apply(context, factor, 0, count);
+        else
+          parallel::for_each_range(std::size_t{0}, count, [&](std::size_t first, std::size_t last) noexcept {
+            load.apply(context, factor, first, last);
+          });
+      }
+      parallel::for_each_range(std::size_t{0}, count, check);
+    }
+    const std::size_t i = first_non_finite.load();
+    if (i < count)
+      detail::fail_unstable(at, "non-finite external load at particle " + std::to_string(i) +
+                                    " (a pressure, force or moment function returned NaN or infinity)");
   }
 
  private:
+  static void zero(detail::LoadContext& context, std::size_t first, std::size_t last) noexcept {
+    for (std::size_t i = first; i < last; ++i) {
+      context.force[i].setZero();
+      context.moment[i].setZero();
+    }
+  }
+  // Keeps the lowest non-finite particle whatever thread finds it first.
+  static void note_lowest(std::atomic<std::size_t>& lowest, std::size_t i) noexcept {
+    std::size_t current = lowest.load(std::memory_order_relaxed);
+    while (i < current && !lowest.compare_exchange_weak(current, i, std::memory_order_relaxed)) {
+    }
+  }
+
   std::vector<std::unique_ptr<detail::Load>> loads_;
+  std::vector<double> factors_;  // each load's time factor this step
+  bool any_serial_ = false;
 };
 
 }  // namespace sphshell
