@@ -16,6 +16,7 @@
 #include <sphshell/stepper/stepper.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <ostream>
@@ -190,7 +191,19 @@ class EnergyLedger {
   // The internal work of one force evaluation, per point in index order.
   void book_internal_work(const std::vector<double>& work_increments) {
     previous_internal_energy_ = internal_energy_;
-    for (double work : work_increments) internal_energy_ += work;
+    // Partial sums over every partial_sums-th point, added up in a fixed
+    // order: a single running sum waits for each addition before the next
+    // (this serial part of the step took ~4 cycles per point), these overlap.
+    // The order does not depend on the thread count.
+    constexpr std::size_t partial_sums = 8;
+    std::array<double, partial_sums> sums{};
+    const std::size_t count = work_increments.size(), whole = count - count % partial_sums;
+    for (std::size_t p = 0; p < whole; p += partial_sums)
+      for (std::size_t k = 0; k < partial_sums; ++k) sums[k] += work_increments[p + k];
+    for (std::size_t p = whole; p < count; ++p) sums[p - whole] += work_increments[p];
+    double work = 0.0;
+    for (double sum : sums) work += sum;
+    internal_energy_ += work;
   }
 
   // After a static solve (solver/static_solution.hpp): the shell at rest
