@@ -1,5 +1,6 @@
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/frame.hpp>
+#include <sphshell/core/statistics.hpp>
 #include <sphshell/core/types.hpp>
 
 #include <catch2/catch.hpp>
@@ -7,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 using namespace sphshell;
 
@@ -34,6 +36,26 @@ TEST_CASE("all_finite is false for any NaN or infinite component, true for the l
         CHECK_FALSE(all_finite(v[0], v[1], v[2], v[3]));
         CHECK_FALSE(all_finite(v[std::size_t(vector)]));
       }
+}
+
+TEST_CASE("interleaved_sum adds every value, whatever the count", "[core]") {
+  // Integers are exact in any order: 1 + 2 + ... + n = n(n + 1)/2, for counts
+  // below, at and above multiples of the eight partial sums.
+  for (std::size_t n = 0; n <= 41; ++n) {
+    std::vector<double> values(n);
+    for (std::size_t i = 0; i < n; ++i) values[i] = static_cast<double>(i + 1);
+    INFO("count " << n);
+    CHECK(sphshell::detail::interleaved_sum(values) == static_cast<double>(n * (n + 1) / 2));
+  }
+  // Fractions: within a few ulps of the sum in long double.
+  std::vector<double> values;
+  long double reference = 0.0L;
+  for (int i = 1; i <= 5101; ++i) {
+    values.push_back(1.0 / (i + 0.37));
+    reference += 1.0L / (i + 0.37L);
+  }
+  CHECK(std::abs(sphshell::detail::interleaved_sum(values) - static_cast<double>(reference)) <
+        8 * std::numeric_limits<double>::epsilon() * static_cast<double>(reference));
 }
 
 TEST_CASE("Tangent frames are right-handed and orthonormal", "[core]") {

@@ -10,13 +10,13 @@
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/parallel.hpp>
+#include <sphshell/core/statistics.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/solver/options.hpp>
 #include <sphshell/solver/particles.hpp>
 #include <sphshell/stepper/stepper.hpp>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstddef>
 #include <ostream>
@@ -191,19 +191,7 @@ class EnergyLedger {
   // The internal work of one force evaluation, per point in index order.
   void book_internal_work(const std::vector<double>& work_increments) {
     previous_internal_energy_ = internal_energy_;
-    // Partial sums over every partial_sums-th point, added up in a fixed
-    // order: a single running sum waits for each addition before the next
-    // (this serial part of the step took ~4 cycles per point), these overlap.
-    // The order does not depend on the thread count.
-    constexpr std::size_t partial_sums = 8;
-    std::array<double, partial_sums> sums{};
-    const std::size_t count = work_increments.size(), whole = count - count % partial_sums;
-    for (std::size_t p = 0; p < whole; p += partial_sums)
-      for (std::size_t k = 0; k < partial_sums; ++k) sums[k] += work_increments[p + k];
-    for (std::size_t p = whole; p < count; ++p) sums[p - whole] += work_increments[p];
-    double work = 0.0;
-    for (double sum : sums) work += sum;
-    internal_energy_ += work;
+    internal_energy_ += detail::interleaved_sum(work_increments);
   }
 
   // After a static solve (solver/static_solution.hpp): the shell at rest
