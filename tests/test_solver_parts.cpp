@@ -7,9 +7,11 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <cmath>
+#include <memory>
 #include <new>
 #include <sstream>
 #include <stdexcept>
@@ -151,7 +153,10 @@ TEST_CASE("The loads' single pass adds each load in turn on any thread count and
   // ExternalLoads zeroes, adds every load and checks one range of particles
   // at a time. Against the sums written here, particle by particle in the
   // order the loads were added (the same additions, so the same bits): sets
-  // unsorted and partial, a serial p(X, t) between parallel loads or none.
+  // unsorted and partial, a serial p(X, t) between parallel loads or none;
+  // on 1, 2 and 3 threads, and each load applied to two ranges split at
+  // chosen places (without threads too). User code (p(X, t), time
+  // functions) runs on the calling thread only.
   constexpr std::size_t n = 3001;
   std::vector<Vector3> position(n), normal(n), director(n), force(n), moment(n);
   std::vector<double> area(n), mass(n);
@@ -170,19 +175,35 @@ TEST_CASE("The loads' single pass adds each load in turn on any thread count and
   const time_function::Ramp ramp{2e-5, 1e-6};
   const double t = 7.3e-6, pressure = 3.1e5;
   const Vector3 point_force(1.5, -2.25, 0.75), point_moment(0.0, 0.3, -0.1), gravity(0.0, 0.0, -9.81);
-  const auto pressure_at = [](const Vector3& X, double time) { return 2e5 * (1.0 + X.x()) * time * 1e5; };
+  const std::thread::id caller = std::this_thread::get_id();
+  std::atomic<int> calls_elsewhere{0};
+  const auto pressure_at = [caller, &calls_elsewhere](const Vector3& X, double time) {
+    if (std::this_thread::get_id() != caller) ++calls_elsewhere;
+    return 2e5 * (1.0 + X.x()) * time * 1e5;
+  };
+  const auto watched_ramp = [caller, &calls_elsewhere, ramp](double time) {
+    if (std::this_thread::get_id() != caller) ++calls_elsewhere;
+    return ramp(time);
+  };
   const StepTime at{12, t};
 
   for (const bool with_serial : {false, true}) {
+    const auto make_loads = [&] {
+      std::vector<std::unique_ptr<detail::Load>> made;
+      made.push_back(std::make_unique<detail::UniformPressureLoad<time_function::Ramp>>(all, pressure, ramp,
+                                                                                         PressureDirection::follower));
+      made.push_back(
+          std::make_unique<detail::PointForceLoad<decltype(watched_ramp)>>(even_backwards, point_force, watched_ramp));
+      if (with_serial)
+        made.push_back(std::make_unique<detail::PressureLoad<decltype(pressure_at)>>(tail, pressure_at,
+                                                                                     PressureDirection::fixed));
+      made.push_back(std::make_unique<detail::GravityLoad<time_function::Ramp>>(tail, gravity, ramp));
+      made.push_back(
+          std::make_unique<detail::PointMomentLoad<time_function::Ramp>>(even_backwards, point_moment, ramp));
+      return made;
+    };
     ExternalLoads loads;
-    loads.add(std::make_unique<detail::UniformPressureLoad<time_function::Ramp>>(all, pressure, ramp,
-                                                                                  PressureDirection::follower));
-    loads.add(std::make_unique<detail::PointForceLoad<time_function::Ramp>>(even_backwards, point_force, ramp));
-    if (with_serial)
-      loads.add(std::make_unique<detail::PressureLoad<decltype(pressure_at)>>(tail, pressure_at,
-                                                                              PressureDirection::fixed));
-    loads.add(std::make_unique<detail::GravityLoad<time_function::Ramp>>(tail, gravity, ramp));
-    loads.add(std::make_unique<detail::PointMomentLoad<time_function::Ramp>>(even_backwards, point_moment, ramp));
+    for (auto& load : make_loads()) loads.add(std::move(load));
 
     // The expected sums, one particle at a time.
     const double f = ramp(t);
@@ -209,7 +230,30 @@ TEST_CASE("The loads' single pass adds each load in turn on any thread count and
       INFO("threads " << threads << ", serial load " << with_serial);
       CHECK(differing == 0);
     }
+#ifdef _OPENMP
+    omp_set_num_threads(1);
+#endif
+    // Each load on [0, k) and then [k, n): the sets' ends, range ends on and
+    // beside a member, and the empty ranges.
+    const std::vector<std::unique_ptr<detail::Load>> parts = make_loads();
+    for (const std::size_t k : {std::size_t{0}, std::size_t{1}, std::size_t{1000}, std::size_t{1001},
+                                std::size_t{2000}, std::size_t{2001}, n - 1, n}) {
+      std::fill(force.begin(), force.end(), Vector3::Zero());
+      std::fill(moment.begin(), moment.end(), Vector3::Zero());
+      detail::LoadContext context{t, position, normal, director, area, mass, force, moment};
+      for (const auto& load : parts) {
+        const double factor = load->factor(t);
+        load->apply(context, factor, 0, k);
+        load->apply(context, factor, k, n);
+      }
+      std::size_t differing = 0;
+      for (std::size_t i = 0; i < n; ++i)
+        differing += force[i] == expected_force[i] && moment[i] == expected_moment[i] ? 0 : 1;
+      INFO("split at " << k << ", serial load " << with_serial);
+      CHECK(differing == 0);
+    }
   }
+  CHECK(calls_elsewhere == 0);
 
   // A non-finite load stops the step, naming the lowest particle it reached.
   const auto nan_after = [](double time) { return time > 5e-6 ? std::nan("") : 1.0; };

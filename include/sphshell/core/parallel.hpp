@@ -1,15 +1,19 @@
 #pragma once
 // The library's one parallel seam. Every per-particle and per-point loop of a
-// step runs through parallel::for_each, so the threading rule lives here once:
+// step runs through parallel::for_each (or for_each_range, for_each_task), so
+// the threading rule lives here once:
 //  - each index of the range is visited once, by one thread; a body writes
 //    only what belongs to its own index, so what it writes is the same
 //    whichever thread runs it and however many threads there are;
 //  - sums over indices are never formed inside the loop: a body writes its
-//    term to an array and the caller adds the array up in index order, so
-//    reductions are identical for any thread count too;
+//    term to an array and the caller adds the array up in an order that
+//    depends only on the count (index order, fixed chunks, or
+//    detail::interleaved_sum), so reductions are identical for any thread
+//    count too;
 //  - an exception must not leave a worker thread (that would call
-//    std::terminate): the error of the lowest failing index is kept and
-//    rethrown after the loop, the same one whatever the thread count.
+//    std::terminate): for_each keeps the error of the lowest failing index
+//    and rethrows it after the loop, the same one whatever the thread count;
+//    for_each_range and for_each_task bodies must not throw.
 //
 // Threads. The loops run on the library's own team of threads (the calling
 // thread plus workers started on first use and kept for the process), not on

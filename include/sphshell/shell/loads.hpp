@@ -104,7 +104,8 @@ class Load {
   // The load's time factor at `time` (1 for a load without a time function).
   virtual double factor(double time) const = 0;
   // Adds the load, scaled by `factor`, to the particles of its set whose
-  // index is in [first, last).
+  // index is in [first, last). Unless serial(), it runs inside a parallel
+  // loop and must not throw (the library's loads are declared noexcept).
   virtual void apply(LoadContext& context, double factor, std::size_t first, std::size_t last) const = 0;
   // True when apply() calls user code per particle: it is then called once,
   // on the whole range, by the calling thread.
@@ -173,7 +174,7 @@ class UniformPressureLoad final : public Load {
     check_time_function(time_function_);
   }
   double factor(double time) const override { return time_function_(time); }
-  void apply(LoadContext& c, double factor, std::size_t first, std::size_t last) const override {
+  void apply(LoadContext& c, double factor, std::size_t first, std::size_t last) const noexcept override {
     const double p = pressure_ * factor;
     particles_.visit(first, last, [&](std::size_t i) { add_pressure_force(c, i, p, direction_); });
   }
@@ -193,7 +194,7 @@ class PointForceLoad final : public Load {
     check_time_function(time_function_);
   }
   double factor(double time) const override { return time_function_(time); }
-  void apply(LoadContext& c, double factor, std::size_t first, std::size_t last) const override {
+  void apply(LoadContext& c, double factor, std::size_t first, std::size_t last) const noexcept override {
     const Vector3 f = factor * force_;
     particles_.visit(first, last, [&](std::size_t i) { c.force[i] += f; });
   }
@@ -212,7 +213,7 @@ class PointMomentLoad final : public Load {
     check_time_function(time_function_);
   }
   double factor(double time) const override { return time_function_(time); }
-  void apply(LoadContext& c, double factor, std::size_t first, std::size_t last) const override {
+  void apply(LoadContext& c, double factor, std::size_t first, std::size_t last) const noexcept override {
     const Vector3 m = factor * moment_;
     particles_.visit(first, last, [&](std::size_t i) { c.moment[i] += m; });
   }
@@ -232,7 +233,7 @@ class GravityLoad final : public Load {
     check_time_function(time_function_);
   }
   double factor(double time) const override { return time_function_(time); }
-  void apply(LoadContext& c, double factor, std::size_t first, std::size_t last) const override {
+  void apply(LoadContext& c, double factor, std::size_t first, std::size_t last) const noexcept override {
     const Vector3 g = factor * acceleration_;
     particles_.visit(first, last, [&](std::size_t i) { c.force[i] += c.mass[i] * g; });
   }
@@ -255,13 +256,14 @@ class GravityLoad final : public Load {
 class ExternalLoads {
  public:
   void add(std::unique_ptr<detail::Load> load) {
-    any_serial_ = any_serial_ || load->serial();
+    const bool serial = load->serial();
     loads_.push_back(std::move(load));
-    factors_.push_back(0.0);
+    any_serial_ = any_serial_ || serial;
   }
   bool empty() const { return loads_.empty(); }
 
   void apply(const StepTime& at, detail::LoadContext& context) {
+    factors_.resize(loads_.size());
     for (std::size_t l = 0; l < loads_.size(); ++l) factors_[l] = loads_[l]->factor(context.time);
     const std::size_t count = context.force.size();
     std::atomic<std::size_t> first_non_finite{count};

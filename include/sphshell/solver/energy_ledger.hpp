@@ -4,9 +4,10 @@
 // kinetic energy, the internal work done on the material, and their balance,
 // checked while the run goes.
 //
-// Every sum over particles or points is formed in index order from terms a
-// parallel loop wrote to an array, so the books are identical for any thread
-// count.
+// Every sum over particles or points adds terms a parallel loop wrote to an
+// array in an order that depends only on their count (fixed chunks of
+// particles, interleaved partial sums over points), so the books are
+// identical for any thread count.
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/parallel.hpp>
