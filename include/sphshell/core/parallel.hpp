@@ -333,70 +333,10 @@ inline void set_spin_time(std::chrono::nanoseconds time) {
   detail::spin_nanoseconds().store(static_cast<std::int64_t>(time.count()), std::memory_order_relaxed);
 }
 
-// Calls body(i) for i in [begin, end) on the team (a body declared noexcept
-// runs without the exception bookkeeping); on failure, on_failure(i, error) is
-// called once, after the loop, with the lowest failing index and its exception
-// (it is expected to throw; if it returns, the error is rethrown).
-template <class Index, class Body, class OnFailure>
-void for_each(Index begin, Index end, Body&& body, OnFailure&& on_failure) {
-  static_assert(std::is_integral_v<Index>, "parallel::for_each: the index must be an integer type");
-  if (!(begin < end)) return;
-  constexpr bool catches = !std::is_nothrow_invocable_v<Body&, Index>;
-  const std::size_t count = static_cast<std::size_t>(end - begin);
-
-  struct Job {
-    Body& body;
-    Index begin;
-    std::size_t count, task_size;
-    std::mutex failure_mutex;
-    std::size_t failed;
-    std::exception_ptr failure;
-
-    void run_range(std::size_t from, std::size_t to) {
-      for (std::size_t k = from; k < to; ++k) {
-        if constexpr (catches) {
-          try {
-            body(static_cast<Index>(begin + static_cast<Index>(k)));
-          } catch (...) {
-            std::lock_guard<std::mutex> lock(failure_mutex);
-            if (k < failed) {
-              failed = k;
-              failure = std::current_exception();
-            }
-          }
-        } else {
-          body(static_cast<Index>(begin + static_cast<Index>(k)));
-        }
-      }
-    }
-    static void run_task(void* context, std::size_t task) {
-      Job& job = *static_cast<Job*>(context);
-      const std::size_t from = task * job.task_size;
-      job.run_range(from, std::min(job.count, from + job.task_size));
-    }
-  };
-  Job job{body, begin, count, count, {}, count, nullptr};
-
-  const int threads = thread_count();
-  if (detail::Team* team = detail::team_for(count, threads)) {
-    job.task_size = detail::task_size_for(count, threads);
-    const std::size_t tasks = (count + job.task_size - 1) / job.task_size;
-    team->run(tasks, threads, &Job::run_task, &job);
-    team->release();
-  } else {
-    job.run_range(0, count);
-  }
-  if constexpr (catches) {
-    if (job.failure) {
-      on_failure(static_cast<Index>(begin + static_cast<Index>(job.failed)), job.failure);
-      std::rethrow_exception(job.failure);
-    }
-  }
-}
-
-// Calls body(first, last) on ranges that cover [begin, end) once: the tasks
-// for_each makes of the same range, so each thread gets the same block of
-// indices as in a for_each over it. For loops that make several passes over
+// Calls body(first, last) on ranges that cover [begin, end) once: each
+// thread's block of the range, cut into tasks of task_size_for() indices.
+// for_each runs its indices through the same ranges, so a thread gets the
+// same block of indices in both. For loops that make several passes over
 // each index (a pass per load, then a check) while its data is in cache.
 // body must not throw (note a failure and report it after the loop).
 template <class Index, class Body>
@@ -425,6 +365,43 @@ void for_each_range(Index begin, Index end, Body&& body) {
     team->release();
   } else {
     body(begin, end);
+  }
+}
+
+// Calls body(i) for i in [begin, end) on the team, in the ranges of
+// for_each_range (a body declared noexcept runs without the exception
+// bookkeeping); on failure, on_failure(i, error) is called once, after the
+// loop, with the lowest failing index and its exception (it is expected to
+// throw; if it returns, the error is rethrown).
+template <class Index, class Body, class OnFailure>
+void for_each(Index begin, Index end, Body&& body, OnFailure&& on_failure) {
+  static_assert(std::is_integral_v<Index>, "parallel::for_each: the index must be an integer type");
+  if constexpr (std::is_nothrow_invocable_v<Body&, Index>) {
+    for_each_range(begin, end, [&body](Index first, Index last) noexcept {
+      for (Index i = first; i < last; ++i) body(i);
+    });
+  } else {
+    // The failure of the lowest index, kept across the threads' ranges.
+    std::mutex failure_mutex;
+    Index failed = end;
+    std::exception_ptr failure;
+    for_each_range(begin, end, [&](Index first, Index last) noexcept {
+      for (Index i = first; i < last; ++i) {
+        try {
+          body(i);
+        } catch (...) {
+          std::lock_guard<std::mutex> lock(failure_mutex);
+          if (i < failed) {
+            failed = i;
+            failure = std::current_exception();
+          }
+        }
+      }
+    });
+    if (failure) {
+      on_failure(failed, failure);
+      std::rethrow_exception(failure);
+    }
   }
 }
 
