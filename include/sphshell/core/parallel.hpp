@@ -334,9 +334,11 @@ inline void set_spin_time(std::chrono::nanoseconds time) {
 }
 
 // Calls body(first, last) on ranges that cover [begin, end) once: each
-// thread's block of the range, cut into tasks of task_size_for() indices.
-// for_each runs its indices through the same ranges, so a thread gets the
-// same block of indices in both. For loops that make several passes over
+// thread's block of the range, cut into tasks of task_size_for() indices (a
+// thread that finishes its block early takes tasks left in the others'), or
+// one call for the whole range when the loop runs serially. for_each runs its
+// indices through the same ranges, so a thread gets the same block of indices
+// in both. For loops that make several passes over
 // each index (a pass per load, then a check) while its data is in cache.
 // body must not throw (note a failure and report it after the loop).
 template <class Index, class Body>
@@ -378,7 +380,7 @@ void for_each(Index begin, Index end, Body&& body, OnFailure&& on_failure) {
   static_assert(std::is_integral_v<Index>, "parallel::for_each: the index must be an integer type");
   if constexpr (std::is_nothrow_invocable_v<Body&, Index>) {
     for_each_range(begin, end, [&body](Index first, Index last) noexcept {
-      for (Index i = first; i < last; ++i) body(i);
+      for (Index i = first; i < last; ++i) body(static_cast<Index>(i));
     });
   } else {
     // The failure of the lowest index, kept across the threads' ranges.
@@ -388,7 +390,7 @@ void for_each(Index begin, Index end, Body&& body, OnFailure&& on_failure) {
     for_each_range(begin, end, [&](Index first, Index last) noexcept {
       for (Index i = first; i < last; ++i) {
         try {
-          body(i);
+          body(static_cast<Index>(i));
         } catch (...) {
           std::lock_guard<std::mutex> lock(failure_mutex);
           if (i < failed) {
@@ -403,6 +405,12 @@ void for_each(Index begin, Index end, Body&& body, OnFailure&& on_failure) {
       std::rethrow_exception(failure);
     }
   }
+}
+
+// for_each without on_failure: the lowest failing index's exception is rethrown as it is.
+template <class Index, class Body>
+void for_each(Index begin, Index end, Body&& body) {
+  for_each(begin, end, std::forward<Body>(body), [](Index, const std::exception_ptr&) {});
 }
 
 // Calls body(k) for k in [0, count), each k its own task: for a few large
@@ -430,12 +438,6 @@ void for_each_task(std::size_t count, Body&& body) {
   } else {
     for (std::size_t k = 0; k < count; ++k) body(k);
   }
-}
-
-// As above; the lowest failing index's exception is rethrown as it is.
-template <class Index, class Body>
-void for_each(Index begin, Index end, Body&& body) {
-  for_each(begin, end, std::forward<Body>(body), [](Index, const std::exception_ptr&) {});
 }
 
 // The message of a caught exception (for errors that add where they happened).
