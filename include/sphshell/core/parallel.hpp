@@ -338,9 +338,9 @@ inline void set_spin_time(std::chrono::nanoseconds time) {
 // thread that finishes its block early takes tasks left in the others'), or
 // one call for the whole range when the loop runs serially. for_each runs its
 // indices through the same ranges, so a thread gets the same block of indices
-// in both. For loops that make several passes over
-// each index (a pass per load, then a check) while its data is in cache.
-// body must not throw (note a failure and report it after the loop).
+// in both. For loops that make several passes over each index (a pass per
+// load, then a check) while its data is in cache. body must not throw (note a
+// failure and report it after the loop).
 template <class Index, class Body>
 void for_each_range(Index begin, Index end, Body&& body) {
   static_assert(std::is_integral_v<Index>, "parallel::for_each_range: the index must be an integer type");
@@ -378,6 +378,9 @@ void for_each_range(Index begin, Index end, Body&& body) {
 template <class Index, class Body, class OnFailure>
 void for_each(Index begin, Index end, Body&& body, OnFailure&& on_failure) {
   static_assert(std::is_integral_v<Index>, "parallel::for_each: the index must be an integer type");
+  // body gets each index as a value (static_cast<Index>(i), not the loop's
+  // variable), as the trait below checks: a body taking Index& must not move
+  // the loop.
   if constexpr (std::is_nothrow_invocable_v<Body&, Index>) {
     for_each_range(begin, end, [&body](Index first, Index last) noexcept {
       for (Index i = first; i < last; ++i) body(static_cast<Index>(i));
