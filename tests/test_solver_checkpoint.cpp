@@ -395,7 +395,7 @@ TEST_CASE("A truncated, corrupted or foreign checkpoint is refused naming the fi
     std::string other = bytes;
     other[8] = static_cast<char>(other[8] + 1);
     test_support::write_text(path, other);
-    require_refused(path, "has format version 2; this library");
+    require_refused(path, "has format version " + std::to_string(solver::checkpoint::format_version + 1) + "; this library");
   }
   SECTION("another policy combination") {
     CrackSolver solver(tearing_plate(), table_3_steel);
@@ -423,6 +423,20 @@ TEST_CASE("A truncated, corrupted or foreign checkpoint is refused naming the fi
     J2Solver lighter(j2_plate(), mild_steel, options);
     lighter.save_checkpoint(path);
     require_refused(path, "another set of options: density is 7800 there and 7850 in this solver");
+    // The two options of the shell's transverse shear change every step's
+    // forces too, though no array of the state depends on them.
+    SolverOptions hourglass;
+    hourglass.director_hourglass = true;
+    J2Solver with_hourglass(j2_plate(), mild_steel, hourglass);
+    with_hourglass.save_checkpoint(path);
+    require_refused(path, "another set of options: director_hourglass is 1 there and 0 in this solver");
+    SolverOptions gradients;
+    gradients.transverse_shear = TransverseShear::shape_functions;
+    J2Solver with_gradients(j2_plate(), mild_steel, gradients);
+    with_gradients.save_checkpoint(path);
+    require_refused(path,
+                    "another set of options: transverse_shear (0: cell_edges, 1: shape_functions) is 1 there and 0 in "
+                    "this solver");
   }
 }
 

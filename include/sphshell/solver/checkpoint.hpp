@@ -65,9 +65,12 @@
 namespace sphshell::solver::checkpoint {
 
 inline constexpr char magic[8] = {'S', 'P', 'H', 'S', 'H', 'C', 'K', 'P'};
-// Raised whenever the layout of any section changes; a file of another
-// version is refused (no silent reinterpretation).
-inline constexpr std::uint32_t format_version = 1;
+// Raised whenever the layout or the meaning of any section changes; a file
+// of another version is refused (no silent reinterpretation). Version 2: the
+// identity lists transverse_shear and director_hourglass among the options
+// that change results (version 1 did not, so a restart with either changed
+// went on with other physics).
+inline constexpr std::uint32_t format_version = 2;
 
 inline std::string library_version() {
 #ifdef SPHSHELL_VERSION_STRING
@@ -212,6 +215,9 @@ inline std::vector<NamedValue> result_options(const SolverOptions& options, doub
           {"support_radius_factor", options.support_radius_factor},
           {"rotary_inertia_scale", options.rotary_inertia_scale},
           {"shear_correction", options.shear_correction},
+          {"transverse_shear (0: cell_edges, 1: shape_functions)",
+           static_cast<double>(static_cast<int>(options.transverse_shear))},
+          {"director_hourglass", options.director_hourglass ? 1.0 : 0.0},
           {"particle_integration_share", options.particle_integration_share},
           {"particle_shear_weight", options.particle_shear_weight},
           {"particle_shear_softening", options.particle_shear_softening},
