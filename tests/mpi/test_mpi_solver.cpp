@@ -138,6 +138,42 @@ TEST_CASE("Distributed plate, J2 plasticity: bitwise the serial Solver", "[mpi][
   CHECK(plastic > 0.0);  // the plate yielded
 }
 
+TEST_CASE("Distributed conditions and loads of every kind, by set name: bitwise the serial Solver",
+          "[mpi][solver]") {
+  // The serial Solver takes the sets; the distributed one their names, for
+  // every condition and load that has a set.
+  const ShellModel model = plate();
+  SolverOptions options;
+  options.density = 7850.0;
+  const auto ramp = [](const Vector3& X, double) { return 2e5 * (1.0 + X.x()); };
+  compare_runs<material::Elastic>(
+      "plate 21x21 every condition and load", model, {steel_E, steel_nu}, options, 200,
+      [&](Serial<material::Elastic>& s) {
+        s.symmetry_plane(model.set("x_min"), Vector3::UnitX());
+        s.symmetry_plane(model.set("y_min"), Vector3::UnitY());
+        s.simply_support_hard(model.set("x_max"), Vector3::UnitY());
+        s.fix_translation(model.set("y_max"), Vector3::UnitZ());
+        s.fix_rotation(model.set("y_max"), Vector3::UnitX());
+        s.add_pressure(model.set("boundary"), ramp);
+        s.add_uniform_pressure(model.all_particles(), 1e5);
+        s.add_point_force(model.set("centre"), Vector3(0.0, 0.0, -2e3));
+        s.add_point_moment(model.set("centre"), Vector3(50.0, 0.0, 0.0));
+        s.add_gravity(model.set("boundary"), Vector3(0.0, 0.0, -9.81));
+      },
+      [&](Distributed<material::Elastic>& s) {
+        s.symmetry_plane("x_min", Vector3::UnitX());
+        s.symmetry_plane("y_min", Vector3::UnitY());
+        s.simply_support_hard("x_max", Vector3::UnitY());
+        s.fix_translation("y_max", Vector3::UnitZ());
+        s.fix_rotation("y_max", Vector3::UnitX());
+        s.add_pressure("boundary", ramp);
+        s.add_uniform_pressure(model.all_particles(), 1e5);
+        s.add_point_force("centre", Vector3(0.0, 0.0, -2e3));
+        s.add_point_moment("centre", Vector3(50.0, 0.0, 0.0));
+        s.add_gravity("boundary", Vector3(0.0, 0.0, -9.81));
+      });
+}
+
 TEST_CASE("Distributed O-grid cap, J2 plasticity: bitwise the serial Solver", "[mpi][solver]") {
   // The paper's cap (Figs 6-7, aluminium, 600 psi inward) on a coarse O-grid.
   const double radius = 0.5657, half_angle = 26.67 * M_PI / 180.0, thickness = 0.010414;

@@ -137,12 +137,16 @@ class DistributedSolver {
       constraints_.fix_translation(local, direction);
     });
   }
+  void fix_translation(const std::string& set_name, const Vector3& direction) {
+    fix_translation(named(set_name), direction);
+  }
   void fix_rotation(const ParticleSet& set, const Vector3& axis) {
     on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
       checker_.fix_rotation(global, axis);
       constraints_.fix_rotation(local, axis);
     });
   }
+  void fix_rotation(const std::string& set_name, const Vector3& axis) { fix_rotation(named(set_name), axis); }
   // Prescribed velocity v(X, t) on all three translations (the function is
   // copied, once for the check of the whole set).
   template <class VelocityFunction>
@@ -203,6 +207,11 @@ class DistributedSolver {
       loads_.add(std::make_unique<sphshell::detail::PressureLoad<PressureFunction>>(local, std::move(pressure), direction));
     });
   }
+  template <class PressureFunction>
+  void add_pressure(const std::string& set_name, PressureFunction pressure,
+                    PressureDirection direction = PressureDirection::follower) {
+    add_pressure(named(set_name), std::move(pressure), direction);
+  }
   template <class TimeFunction = time_function::Step>
   void add_uniform_pressure(const ParticleSet& set, double pressure, TimeFunction time = {},
                             PressureDirection direction = PressureDirection::follower) {
@@ -239,12 +248,20 @@ class DistributedSolver {
     });
   }
   template <class TimeFunction = time_function::Step>
+  void add_point_moment(const std::string& set_name, const Vector3& moment, TimeFunction time = {}) {
+    add_point_moment(named(set_name), moment, time);
+  }
+  template <class TimeFunction = time_function::Step>
   void add_gravity(const ParticleSet& set, const Vector3& acceleration, TimeFunction time = {}) {
     on_set(set, [&](const ParticleSet&, const ParticleSet& local) {
       if (!acceleration.allFinite())
         sphshell::detail::invalid_parameter("gravity acceleration", acceleration.transpose(), "must be finite");
       loads_.add(std::make_unique<sphshell::detail::GravityLoad<TimeFunction>>(local, acceleration, time));
     });
+  }
+  template <class TimeFunction = time_function::Step>
+  void add_gravity(const std::string& set_name, const Vector3& acceleration, TimeFunction time = {}) {
+    add_gravity(named(set_name), acceleration, time);
   }
 
   // CSV history of one particle (global id; Solver::add_particle_probe's
