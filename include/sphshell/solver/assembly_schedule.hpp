@@ -39,7 +39,7 @@ class AssemblySchedule {
   // follow each group's arrays through memory: once the model outgrows the
   // cache (a 401×401 plate), runs of 512 rows took about 0.92 of the time per
   // step of runs of 64; runs of 4096 were slower again, the particles' sums
-  // waiting too long for their points (README, "Performance").
+  // waiting too long for their points (docs/performance.md, fourth round).
   static constexpr std::size_t max_rows_per_run = 512;
   // Runs per segment, at least, when several threads share the pass, so that
   // the segments can be cut to about equal sizes; but never shorter than 64
@@ -53,7 +53,7 @@ class AssemblySchedule {
   // two per thread measured best (eight: 94 % of the paper's plate straddled).
   // Summed in bands (band()), mostly right after their points on the thread
   // that integrated them, eight per thread took about 0.93 of the time of two
-  // summed after the pass, four about 0.95 (README, "Performance", fifth round).
+  // summed after the pass, four about 0.95 (docs/performance.md, fifth round).
   static constexpr std::size_t segments_per_thread = 8;
 
   struct Run {

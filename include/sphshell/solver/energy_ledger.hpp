@@ -58,7 +58,7 @@ namespace solver {
 // stepper's loops: each thread then reads and writes the particles whose
 // velocities it updated. Done serially, they pulled half of the particles'
 // velocities to the calling thread's core every step, and the stepper's next
-// writes had to take them back (README, "Performance", fifth round).
+// writes had to take them back (docs/performance.md, fifth round).
 class ParticleEnergyTerms {
  public:
   // Particles per partial sum in compute_and_sum(): fixed, not per thread, so that the

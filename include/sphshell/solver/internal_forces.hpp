@@ -16,7 +16,7 @@
 // its points is done, while those points' forces and shape functions are
 // still in the cache. Done as two separate passes, the sum read them back
 // from memory once the model outgrew the cache (a 401×401 plate's step cost
-// 1.6 times a 51×51 plate's per particle; README, "Performance"). A particle's
+// 1.6 times a 51×51 plate's per particle; docs/performance.md, third round). A particle's
 // sum is the same whenever it is formed, so results do not change.
 
 #include <sphshell/core/error.hpp>
