@@ -13,7 +13,9 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -338,6 +340,32 @@ std::string j2_checkpoint(const ScratchDirectory& scratch) {
   return path;
 }
 
+// A checkpoint's bytes after a change inside the payload, with both checksums
+// computed again as the writer computes them, so that only the meaning of
+// the change is left for the reader to find (header: magic, version, library
+// version, five policy names, payload size and checksum, header checksum).
+std::string resealed(std::string bytes) {
+  io::BinaryReader header(bytes, "test", sizeof solver::checkpoint::magic);
+  std::uint32_t version = 0;
+  std::string written_by;
+  std::array<std::string, 5> policies;
+  std::uint64_t payload_size = 0, payload_checksum = 0;
+  header(version, written_by);
+  for (std::string& policy : policies) header(policy);
+  header(payload_size);
+  const std::size_t payload_checksum_at = header.position();
+  header(payload_checksum);
+  const std::size_t header_checksum_at = header.position();
+  const std::size_t payload_begin = header_checksum_at + sizeof(std::uint64_t);
+  REQUIRE(payload_begin + payload_size == bytes.size());
+  // The file's numbers are little endian, as this machine's.
+  const std::uint64_t payload_sum = io::fnv1a(bytes.data() + payload_begin, bytes.size() - payload_begin);
+  std::memcpy(&bytes[payload_checksum_at], &payload_sum, sizeof payload_sum);
+  const std::uint64_t header_sum = io::fnv1a(bytes.data(), header_checksum_at);
+  std::memcpy(&bytes[header_checksum_at], &header_sum, sizeof header_sum);
+  return bytes;
+}
+
 void require_refused(const std::string& path, const std::string& problem) {
   J2Solver solver(j2_plate(), mild_steel);
   try {
@@ -396,6 +424,32 @@ TEST_CASE("A truncated, corrupted or foreign checkpoint is refused naming the fi
     other[8] = static_cast<char>(other[8] + 1);
     test_support::write_text(path, other);
     require_refused(path, "has format version " + std::to_string(solver::checkpoint::format_version + 1) + "; this library");
+  }
+  SECTION("a time step other than the one its identity lists (checksums resealed)") {
+    REQUIRE(resealed(bytes) == bytes);  // resealing an unchanged file changes nothing
+    // TIME: its tag, its size, then t0, the step count and Δt.
+    const std::size_t time_step_at = bytes.find("TIME") + 4 + 3 * sizeof(std::uint64_t);
+    J2Solver solver(j2_plate(), mild_steel);
+    double time_step = 0.0;
+    std::memcpy(&time_step, &bytes[time_step_at], sizeof time_step);
+    REQUIRE(time_step == solver.time_step());
+    time_step = std::nextafter(time_step, 1.0);
+    std::string changed = bytes;
+    std::memcpy(&changed[time_step_at], &time_step, sizeof time_step);
+    const std::string path = (scratch / "time_step.ckpt").string();
+    test_support::write_text(path, resealed(changed));
+    try {
+      solver.load_checkpoint(path);
+      FAIL("loading " << path << " was accepted");
+    } catch (const Error& error) {
+      const std::string message = error.what();
+      INFO(message);
+      CHECK(message.find(path) != std::string::npos);
+      CHECK(message.find("its time step ") != std::string::npos);
+      CHECK(message.find(" s its identity lists") != std::string::npos);
+    }
+    // Refused after its state began to load: the solver is stopped.
+    CHECK_THROWS_AS(solver.step(), Error);
   }
   SECTION("another policy combination") {
     CrackSolver solver(tearing_plate(), table_3_steel);

@@ -338,10 +338,13 @@ class Solver {
                                                     law_.shear_modulus(), law_.poisson_ratio());
       assembler_ = solver::InternalForceAssembler(options_.nonlinear, points_);
       std::int64_t steps = 0;
+      // The identity matched this solver's time step; the steps must have been taken with it.
+      const double identity_time_step = time_step_;
       in.open_section("TIME");
       in(start_time_, steps, time_step_, time_, forces_current_, latch_.message());
       in.close_section();
       steps_ = static_cast<long>(steps);
+      solver::checkpoint::check_time_step(in, time_step_, identity_time_step);
       solver::checkpoint::check_time_of_steps(in, start_time_, steps_, time_step_, time_);
       in.open_section("PART");
       particles_.load(in);
@@ -373,6 +376,11 @@ class Solver {
                                "it cannot step; the error was: ") +
                    error.what());
       throw;
+    } catch (const std::exception& error) {
+      // Not the file's fault (memory ran out, say), but the state is as mixed.
+      const std::string message = "sphshell: loading checkpoint '" + path + "' failed part-way: " + error.what();
+      latch_.close(message + "; this solver's state is mixed and it cannot step");
+      throw Error(message);
     }
     checkpoints_.written(steps_);
   }

@@ -420,22 +420,48 @@ class LineSegments {
   template <class Reader>
   void load(Reader& in) {
     require_initialized("load");
+    // Read into locals and checked before anything is stored (the checksum
+    // vouches for the bytes, this for the meaning), so a failed load leaves
+    // the topology as it was, every index in range.
+    std::vector<int> crack_point_of_stress_point(crack_point_of_stress_point_.size());
     std::uint64_t damaged = 0;
-    in.read_exact(crack_point_of_stress_point_, "crack point of each stress point");
-    in(damaged, points_, crack_of_point_, segments_, crack_id_count_, precracks_, max_segment_length_);
-    damaged_count_ = static_cast<std::size_t>(damaged);
-    // The indices must point into the arrays (the checksum vouches for the
-    // bytes, this for the meaning).
-    const auto point_count = static_cast<int>(points_.size());
-    if (crack_of_point_.size() != points_.size()) in.fail("crack ids and crack points differ in number");
-    for (const int point : crack_point_of_stress_point_)
+    std::vector<Vector3> points;
+    std::vector<int> crack_of_point;
+    std::vector<Segment> segments;
+    int crack_id_count = 0;
+    std::vector<std::vector<Vector3>> precracks;
+    double max_segment_length = 0.0;
+    in.read_exact(crack_point_of_stress_point, "crack point of each stress point");
+    in(damaged, points, crack_of_point, segments, crack_id_count, precracks, max_segment_length);
+    const auto point_count = static_cast<int>(points.size());
+    if (crack_of_point.size() != points.size()) in.fail("crack ids and crack points differ in number");
+    if (crack_id_count < 0) in.fail("its crack count " + std::to_string(crack_id_count) + " is negative");
+    for (const int point : crack_point_of_stress_point)
       if (point < -1 || point >= point_count) in.fail("a stress point names crack point " + std::to_string(point));
-    for (const int id : crack_of_point_)
-      if (id < 0 || id >= crack_id_count_) in.fail("a crack point names crack " + std::to_string(id));
-    for (const Segment& segment : segments_)
+    for (const int id : crack_of_point)
+      if (id < 0 || id >= crack_id_count) in.fail("a crack point names crack " + std::to_string(id));
+    double longest = 0.0;
+    for (const Segment& segment : segments) {
       if (segment.start_point < 0 || segment.start_point >= point_count || segment.end_point < 0 ||
-          segment.end_point >= point_count || segment.crack_id < 0 || segment.crack_id >= crack_id_count_)
+          segment.end_point >= point_count || segment.crack_id < 0 || segment.crack_id >= crack_id_count)
         in.fail("a crack segment names a point or crack that does not exist");
+      longest = std::max(longest, (points[static_cast<std::size_t>(segment.end_point)] -
+                                   points[static_cast<std::size_t>(segment.start_point)])
+                                      .norm());
+    }
+    // The segment index reaches as far as the longest segment recorded: a
+    // shorter record would hide segments from it.
+    if (!(max_segment_length >= longest) || !std::isfinite(max_segment_length))
+      in.fail("its longest crack segment is recorded as " + std::to_string(max_segment_length) +
+              " m; it must be finite and at least its segments' " + std::to_string(longest) + " m");
+    crack_point_of_stress_point_ = std::move(crack_point_of_stress_point);
+    damaged_count_ = static_cast<std::size_t>(damaged);
+    points_ = std::move(points);
+    crack_of_point_ = std::move(crack_of_point);
+    segments_ = std::move(segments);
+    crack_id_count_ = crack_id_count;
+    precracks_ = std::move(precracks);
+    max_segment_length_ = max_segment_length;
     segment_index_.reset();
     if (!segments_.empty() || !precracks_.empty()) rebuild_segment_index();
   }

@@ -628,10 +628,13 @@ class DistributedSolver {
     }
     assembler_.emplace(options_.nonlinear, *points_);
     std::int64_t steps = 0;
+    // The identity matched this solver's time step; the steps must have been taken with it.
+    const double identity_time_step = time_step_;
     in.open_section("TIME");
     in(stamp, start_time_, steps, time_step_, time_, forces_current_, latch_.message());
     in.close_section();
     steps_ = static_cast<long>(steps);
+    solver::checkpoint::check_time_step(in, time_step_, identity_time_step);
     solver::checkpoint::check_time_of_steps(in, start_time_, steps_, time_step_, time_);
     in.open_section("PART");
     particles_.load(in);

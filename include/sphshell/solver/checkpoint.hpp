@@ -258,6 +258,15 @@ inline void check_identity(const Identity& file, const Identity& here, const std
   compare_values(file.options, here.options, "set of options");
 }
 
+// A TIME section's Δt must be the one its identity lists, which matched this
+// solver's: the steps were taken with it. `in` fails naming both otherwise.
+template <class Reader>
+void check_time_step(Reader& in, double time_step, double identity_time_step) {
+  if (std::memcmp(&time_step, &identity_time_step, sizeof time_step) != 0)
+    in.fail("its time step " + number_text(time_step) + " s is not the " + number_text(identity_time_step) +
+            " s its identity lists");
+}
+
 // A TIME section's time must be t0 + n dt bit for bit (the solvers keep time
 // that way); `in` fails naming both otherwise.
 template <class Reader>
@@ -291,10 +300,15 @@ inline io::BinaryReader read_file(const std::string& path, const std::array<std:
   const std::string name = "checkpoint '" + path + "'";
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error("sphshell: cannot open " + name + " for reading");
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // The magic first: a large file of another kind is named as such before it is read whole.
+  std::string bytes(sizeof magic, '\0');
+  in.read(bytes.data(), static_cast<std::streamsize>(sizeof magic));
   if (in.bad()) throw Error("sphshell: failed while reading " + name);
-  if (bytes.size() < sizeof magic || std::memcmp(bytes.data(), magic, sizeof magic) != 0)
+  if (in.gcount() != static_cast<std::streamsize>(sizeof magic) ||
+      std::memcmp(bytes.data(), magic, sizeof magic) != 0)
     throw Error("sphshell: " + name + " is not a sphshell checkpoint (it does not start with \"SPHSHCKP\")");
+  bytes.append(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  if (in.bad()) throw Error("sphshell: failed while reading " + name);
   io::BinaryReader reader(std::move(bytes), name + " (header)", sizeof magic);
   // A field that does not fit: the file ends in its header, or a damaged
   // length points past it.

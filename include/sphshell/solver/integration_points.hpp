@@ -386,20 +386,31 @@ class IntegrationPoints {
         if (capacity != sf.capacity(row))
           in.fail(std::string(name_of(group)) + " row " + std::to_string(row) + " has " + std::to_string(capacity) +
                   " slots there and " + std::to_string(sf.capacity(row)) + " here");
-        in(sf.row_size[row], sf.shepard[row]);
-        if (sf.row_size[row] < 0 || static_cast<std::size_t>(sf.row_size[row]) > capacity)
+        // Flagged before it changes: a load that fails inside the row leaves
+        // it to be rebuilt by the next load. Each value is checked before it
+        // is stored, so a failed load leaves no index out of range.
+        rebuilt[row] = 1;
+        int row_size = 0;
+        unsigned char shepard = 0;
+        in(row_size, shepard);
+        if (row_size < 0 || static_cast<std::size_t>(row_size) > capacity)
           in.fail(std::string(name_of(group)) + " row " + std::to_string(row) + " uses more slots than it has");
+        sf.row_size[row] = row_size;
+        sf.shepard[row] = shepard;
         for (std::size_t s = sf.row_begin[row]; s < sf.row_begin[row + 1]; ++s) {
-          in(sf.neighbour[s], sf.value[s].phi, sf.value[s].dphi_d1, sf.value[s].dphi_d2);
-          if (sf.neighbour[s] < 0 || static_cast<std::size_t>(sf.neighbour[s]) >= particle_count)
+          int neighbour = 0;
+          approx::ShapeValue value;
+          in(neighbour, value.phi, value.dphi_d1, value.dphi_d2);
+          if (neighbour < 0 || static_cast<std::size_t>(neighbour) >= particle_count)
             in.fail(std::string(name_of(group)) + " row " + std::to_string(row) + " names particle " +
-                    std::to_string(sf.neighbour[s]));
+                    std::to_string(neighbour));
+          sf.neighbour[s] = neighbour;
+          sf.value[s] = value;
         }
         check_tied_corners(group, row);
         shell::SurfaceGradients g;
         in(g.a1, g.a2, g.n, g.n1, g.n2);
         set_reference(point(group, row), g);
-        rebuilt[row] = 1;
       }
     }
     build_slot_transpose(particle_count);
