@@ -230,3 +230,52 @@ TEST_CASE("The director hourglass without the edge-tied shear or without cells i
   require_error([&] { ElasticSolver(plate.build(), steel, options); }, {"director_hourglass", "cells"});
   CHECK_NOTHROW(ElasticSolver(ShellModel::rectangular_plate(0.1, 0.1, 6, 6, 0.01), steel, options));
 }
+
+TEST_CASE("A structured grid past int indices is refused before it is allocated", "[bad_input][geometry]") {
+  // 50000² = 2.5e9 particles: refused at once, naming the counts (without the
+  // check the builder would first try to allocate about 100 GB).
+  require_error([&] { ShellModel::rectangular_plate(1.0, 1.0, 50000, 50000, 0.01); },
+                {"nx × ny = 2500000000", "at most 2^31 - 1"});
+  require_error([&] { ShellModel::cylindrical_panel(1.0, 1.0, 1.0, 50000, 50000, 0.01); },
+                {"n_circumferential × n_axial = 2500000000"});
+  require_error([&] { ShellModel::spherical_cap(1.0, 0.5, 50000, 0.01); }, {"n × n = 2500000000"});
+  require_error([&] { spherical_cap_ogrid(1.0, 0.5, 50000, 0.01); }, {"m = 50000", "at most 46339"});
+}
+
+TEST_CASE("The O-grid's options and radius are checked against the rim", "[bad_input][geometry]") {
+  OGridOptions bulging;
+  bulging.block_fraction = 0.7;  // corners inside the rim (0.7·√2 < 1) ...
+  bulging.bulge = 0.45;          // ... but the sides' midpoints at 0.7 × 1.45 > 1 outside it
+  require_error([&] { spherical_cap_ogrid(1.0, 0.5, 8, 0.01, bulging); },
+                {"block_fraction × (1 + bulge)", "must be below 1"});
+  require_error([&] { spherical_cap_ogrid_quality(1.0, 0.5, 8, bulging); }, {"block_fraction × (1 + bulge)"});
+  require_error([&] { spherical_cap_ogrid(std::numeric_limits<double>::infinity(), 0.5, 8, 0.01); },
+                {"radius = inf", "must be finite and > 0"});
+  bulging.bulge = 0.4;  // 0.7 × 1.4 = 0.98: inside
+  CHECK(spherical_cap_ogrid(1.0, 0.5, 8, 0.01, bulging).particle_count() > 0);
+}
+
+TEST_CASE("The nearest particle of a NaN point is an Error, not particle 0", "[bad_input][geometry]") {
+  const ShellModel model = ShellModel::rectangular_plate(0.1, 0.1, 5, 5, 0.01);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  CHECK(model.nearest_particle(Vector3(0.1, 0.1, 0.0)) == 24);
+  require_error([&] { model.nearest_particle(Vector3(nan, 0.0, 0.0)); }, {"nearest_particle point", "must be finite"});
+  require_error([&] { model.nearest_stress_point(Vector3(0.0, nan, 0.0)); }, {"nearest_stress_point point"});
+}
+
+TEST_CASE("A symmetry plane or hard support with a bad vector names it and changes no particle",
+          "[bad_input][geometry]") {
+  const ShellModel model = ShellModel::rectangular_plate(0.1, 0.1, 5, 5, 0.01);
+  ElasticSolver solver(model, steel);
+  // The plate's normals are +z: a plane normal along them leaves no rotation axis.
+  require_error([&] { solver.symmetry_plane(model.set("x_min"), Vector3::UnitZ()); },
+                {"plane_normal = 0 0 1", "must not lie along the particle's normal", "at particle 0"});
+  require_error([&] { solver.symmetry_plane(model.set("x_min"), Vector3::Zero()); },
+                {"plane_normal = 0 0 0", "finite and non-zero"});
+  require_error([&] { solver.simply_support_hard(model.set("x_min"), Vector3::UnitZ()); },
+                {"edge_tangent = 0 0 1", "must not lie along the particle's normal"});
+  // Nothing was fixed by the refused calls: the plate moves freely along x.
+  solver.prescribe_velocity(model.set("x_min"), [](const Vector3&, double) { return Vector3(1.0, 0.0, 0.0); });
+  solver.step();
+  CHECK(solver.displacement(0).x() > 0.0);
+}

@@ -571,6 +571,14 @@ TEST_CASE("SVG plot errors name the series and leave existing output alone", "[i
   io::PlotLayout cramped;
   cramped.margin_left = 600.0;
   CHECK_THROWS_WITH(io::write_svg_plot(path, {good}, cramped), Catch::Contains("no plot area"));
+  // NaN slips past "width > margins"; a negative margin draws outside the panel.
+  io::PlotLayout nan_width;
+  nan_width.panel_width = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_WITH(io::write_svg_plot(path, {good}, nan_width), Catch::Contains("PlotLayout::panel_width = nan"));
+  io::PlotLayout negative_margin;
+  negative_margin.margin_left = -100.0;
+  CHECK_THROWS_WITH(io::write_svg_plot(path, {good}, negative_margin),
+                    Catch::Contains("PlotLayout::margin_left = -100") && Catch::Contains(">= 0"));
   CHECK(read_whole_file(path) == before);
   // A panel without data still gets axes (a run that ended before anything happened).
   io::PlotPanel empty{"empty", "x", "y", {{"nothing", {}, {}, io::PlotStyle::line}}};

@@ -449,6 +449,13 @@ TEST_CASE("Malformed Gmsh files are Errors naming the file, the place and the pr
     const std::string entities = "$Entities\n0 0 1 0\n1 0 0 0 2 1 0 0 0\n$EndEntities\n";
     check_message(read("empty_group.msh", names + entities + strip_nodes + strip_elements),
                   {"empty_group.msh", "line 6", "physical group 'ghost'", "holds no element"});
+    // A second name for the same group would silently replace the first.
+    const std::string twice = gmsh_header + "$PhysicalNames\n2\n2 5 \"ghost\"\n2 5 \"spirit\"\n$EndPhysicalNames\n";
+    check_message(read("named_twice.msh", twice + entities + strip_nodes + strip_elements),
+                  {"named_twice.msh", "physical group (dimension 2, tag 5) is named twice"});
+    const std::string wide = gmsh_header + "$PhysicalNames\n1\n2 4294967301 \"ghost\"\n$EndPhysicalNames\n";
+    check_message(read("wide_tag.msh", wide + entities + strip_nodes + strip_elements),
+                  {"wide_tag.msh", "tag does not fit in an int"});
   }
   check_message(error_of([&] { io::read_gmsh((directory / "absent.msh").string(), 0.01); }),
                 {"cannot open mesh file", "absent.msh"});
@@ -503,6 +510,12 @@ TEST_CASE("Malformed Abaqus files are Errors naming the file, the line and the p
                 {"twice.inp", "line 14", "node 3 is defined twice", "line 4"});
   check_message(read("generate.inp", abaqus_strip(strip_section + "*NSET, NSET=A, GENERATE\n5, 1\n")),
                 {"generate.inp", "line 14", "the last is below the first"});
+  // A range no file of this size can define is refused before it fills memory.
+  check_message(read("generate_huge.inp", abaqus_strip(strip_section + "*NSET, NSET=A, GENERATE\n1, 100000000000\n")),
+                {"generate_huge.inp", "line 14", "names 100000000000 nodes, more than the input's"});
+  check_message(read("generate_end.inp",
+                     abaqus_strip(strip_section + "*NSET, NSET=A, GENERATE\n1, 9223372036854775807, 2\n")),
+                {"generate_end.inp", "line 14", "names 4611686018427387904 nodes"});
   check_message(read("ngen.inp", abaqus_strip(strip_section + "*NGEN, NSET=LINE\n1, 3\n")),
                 {"ngen.inp", "line 13", "*NGEN changes the geometry"});
   check_message(read("offset.inp", abaqus_strip("*SHELL SECTION, ELSET=STRIP, OFFSET=SPOS\n0.01\n")),

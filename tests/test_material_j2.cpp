@@ -241,6 +241,20 @@ TEST_CASE("Closed-form and generic return maps agree, every start converges to t
       }
 }
 
+TEST_CASE("A negative count of fixed Newton steps is an Error, not Newton to convergence", "[material]") {
+  const PlaneStressElasticity elasticity(youngs_modulus, poisson_ratio);
+  const StressVoigt trial(330e6, -40e6, 30e6);
+  ReturnMapOptions options;
+  options.fixed_iterations = -1;
+  CHECK_THROWS_WITH(return_map::closed_form(elasticity, trial, yield_stress, 1e9, options),
+                    Catch::Contains("fixed_iterations = -1") && Catch::Contains("must be >= 0"));
+  CHECK_THROWS_WITH(return_map::generic(elasticity, trial, yield_stress, 1e9, options),
+                    Catch::Contains("fixed_iterations = -1"));
+  const material::J2Plasticity law({youngs_modulus, poisson_ratio, yield_stress, 1e9});
+  material::J2Plasticity::State state = law.initial_state();
+  CHECK_THROWS_WITH(law.update(state, StrainVoigt(0.01, 0.0, 0.0), options), Catch::Contains("fixed_iterations"));
+}
+
 TEST_CASE("Fixed-iteration Newton runs exactly the requested steps without a test", "[material]") {
   const PlaneStressElasticity elasticity(youngs_modulus, poisson_ratio);
   const StressVoigt trial(330e6, -40e6, 30e6);

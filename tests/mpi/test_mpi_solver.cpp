@@ -174,6 +174,24 @@ TEST_CASE("Distributed conditions and loads of every kind, by set name: bitwise 
       });
 }
 
+TEST_CASE("Distributed accessors refuse indices and fields out of range", "[mpi][solver][errors]") {
+  const mpi::Communicator comm;
+  SolverOptions options;
+  options.density = 7850.0;
+  const ShellModel model = plate();
+  Distributed<material::Elastic> distributed(comm, model, {steel_E, steel_nu}, options);
+  const int particles = static_cast<int>(model.particle_count());
+  CHECK_FALSE(distributed.is_fragment(particles - 1));
+  CHECK_THROWS_WITH(distributed.is_fragment(-1), Catch::Contains("particle index"));
+  CHECK_THROWS_WITH(distributed.is_fragment(particles), Catch::Contains("particle index"));
+  const std::size_t local = distributed.layout().local_count();
+  CHECK(distributed.global_id(local - 1) >= 0);
+  CHECK_THROWS_WITH(distributed.global_id(local), Catch::Contains("local particle index"));
+  // Every rank is refused together (none is left waiting in the gather).
+  CHECK_THROWS_WITH(distributed.gathered({}), Catch::Contains("local field size"));
+  CHECK(distributed.gathered(std::vector<Vector3>(local, Vector3::UnitX())).size() == model.particle_count());
+}
+
 TEST_CASE("Distributed O-grid cap, J2 plasticity: bitwise the serial Solver", "[mpi][solver]") {
   // The paper's cap (Figs 6-7, aluminium, 600 psi inward) on a coarse O-grid.
   const double radius = 0.5657, half_angle = 26.67 * M_PI / 180.0, thickness = 0.010414;

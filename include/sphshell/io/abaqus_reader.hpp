@@ -387,8 +387,14 @@ class AbaqusParser {
       if (values[1] < values[0])
         fail(line.origin, "GENERATE from " + std::to_string(values[0]) + " to " + std::to_string(values[1]) +
                               ": the last is below the first");
-      for (long long member = values[0]; member <= values[1]; member += step)
-        set.members.emplace_back(member, line.origin);
+      // Counted first: each label a file defines takes a line of its own, so a
+      // range longer than the input cannot be defined (and would only fill memory).
+      const long long count = (values[1] - values[0]) / step + 1;
+      if (count > static_cast<long long>(lines_.size()))
+        fail(line.origin, "GENERATE from " + std::to_string(values[0]) + " to " + std::to_string(values[1]) + " by " +
+                              std::to_string(step) + " names " + std::to_string(count) + " " + what +
+                              "s, more than the input's " + std::to_string(lines_.size()) + " lines can define");
+      for (long long k = 0; k < count; ++k) set.members.emplace_back(values[0] + k * step, line.origin);
       return;
     }
     for (const std::string& field : fields) {

@@ -25,6 +25,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <set>
 #include <string>
@@ -256,7 +257,15 @@ class GmshParser {
       const std::string name = data_.substr(position_ + 1, close - position_ - 1);
       position_ = close + 1;
       if (name.empty()) fail("a physical name is empty");
-      physical_names_[{static_cast<int>(dimension), static_cast<int>(tag)}] = {name, start};
+      if (dimension < 0 || dimension > 3) fail("a physical group's dimension must be 0 to 3");
+      if (tag > std::numeric_limits<int>::max() || tag < std::numeric_limits<int>::min())
+        fail("a physical group's tag does not fit in an int");
+      const bool added =
+          physical_names_.emplace(EntityKey{static_cast<int>(dimension), static_cast<int>(tag)}, PhysicalName{name, start})
+              .second;
+      if (!added)
+        fail("physical group (dimension " + std::to_string(dimension) + ", tag " + std::to_string(tag) +
+             ") is named twice");
     }
   }
 

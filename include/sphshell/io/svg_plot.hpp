@@ -256,6 +256,12 @@ inline void write_panel(std::ostream& out, const PlotPanel& panel, const PlotLay
 inline void write_svg_plot(const std::string& path, const std::vector<PlotPanel>& panels,
                            const PlotLayout& layout = {}) {
   if (panels.empty()) throw Error("sphshell: SVG plot '" + path + "' needs at least one panel");
+  sphshell::detail::require_positive("PlotLayout::panel_width", layout.panel_width);
+  sphshell::detail::require_positive("PlotLayout::panel_height", layout.panel_height);
+  sphshell::detail::require_nonnegative("PlotLayout::margin_left", layout.margin_left);
+  sphshell::detail::require_nonnegative("PlotLayout::margin_right", layout.margin_right);
+  sphshell::detail::require_nonnegative("PlotLayout::margin_top", layout.margin_top);
+  sphshell::detail::require_nonnegative("PlotLayout::margin_bottom", layout.margin_bottom);
   if (layout.plot_width() <= 0.0 || layout.plot_height() <= 0.0)
     throw Error("sphshell: SVG plot '" + path + "': the margins leave no plot area (" +
                 detail::round_trip_decimal(layout.plot_width()) + " × " +

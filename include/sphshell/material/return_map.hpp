@@ -77,6 +77,14 @@ struct ClosedFormConstants {
 
 namespace detail {
 
+// A negative count of fixed Newton steps would silently mean "iterate to
+// convergence" (0); it is refused instead.
+inline void require_valid(const ReturnMapOptions& options) {
+  if (options.fixed_iterations < 0)
+    sphshell::detail::invalid_parameter("fixed_iterations", options.fixed_iterations,
+                                        "must be >= 0 (0: Newton to convergence)");
+}
+
 [[noreturn]] [[gnu::noinline, gnu::cold]] inline void throw_not_converged(
     double increment, double relative_residual) {
   std::ostringstream message;
@@ -587,6 +595,7 @@ struct LaneReturn {
 
 inline Solution closed_form(const ClosedFormConstants& constants, const StressVoigt& trial,
                             double yield_stress, const ReturnMapOptions& options = {}) {
+  detail::require_valid(options);
   if (options.initial_guess == InitialGuess::appendix_b && options.fixed_iterations <= 0 &&
       options.newton_function == NewtonFunction::normalized)
     return detail::closed_form_default(constants, trial, yield_stress);
@@ -603,6 +612,7 @@ inline Solution closed_form(const PlaneStressElasticity& elasticity, const Stres
 inline Solution generic(const PlaneStressElasticity& elasticity, const StressVoigt& trial,
                         double yield_stress, double plastic_modulus,
                         const ReturnMapOptions& options = {}) {
+  detail::require_valid(options);
   detail::GenericKernel kernel(elasticity, trial, yield_stress, plastic_modulus,
                                options.newton_function);
   const double excess = kernel.trial_equivalent() - yield_stress;

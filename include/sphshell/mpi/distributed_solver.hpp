@@ -332,7 +332,12 @@ class DistributedSolver {
   const Crack& crack() const { return fracture_.crack(); }
   std::size_t damaged_stress_point_count() const { return fracture_.damaged_stress_point_count(); }
   std::size_t precrack_stress_point_count() const { return fracture_.precrack_stress_point_count(); }
-  bool is_fragment(int particle) const { return fracture_.is_fragment(static_cast<std::size_t>(particle)); }
+  bool is_fragment(int particle) const {
+    if (particle < 0 || static_cast<std::size_t>(particle) >= model_.particle_count())
+      sphshell::detail::invalid_parameter("particle index", particle,
+                                          "must lie in [0, " + std::to_string(model_.particle_count()) + ")");
+    return fracture_.is_fragment(static_cast<std::size_t>(particle));
+  }
   std::size_t fragment_count() const { return fracture_.fragment_count(); }
 
   // One step on every rank (collective). A step that stopped with an Error
@@ -465,11 +470,25 @@ class DistributedSolver {
   // This rank's particles in the local numbering (owned [0, owned), then ghosts).
   const solver::ParticleState& local_particles() const { return particles_; }
   const solver::ParticleForces& local_forces() const { return forces_; }
-  int global_id(std::size_t local) const { return layout_.global_of(local); }
+  int global_id(std::size_t local) const {
+    if (local >= layout_.local_count())
+      sphshell::detail::invalid_parameter("local particle index", local,
+                                          "must be below this rank's local_count() = " +
+                                              std::to_string(layout_.local_count()));
+    return layout_.global_of(local);
+  }
 
   // The owned values of a per-particle field, in global order on every rank
   // (collective; O(N) bytes: for checks and small runs).
   std::vector<Vector3> gathered(const std::vector<Vector3>& local_field) const {
+    // Checked on every rank together, so that a short field on one rank is
+    // an Error on all of them, not a rank left waiting in the gather.
+    collectively(comm_, [&] {
+      if (local_field.size() < layout_.owned_count())
+        sphshell::detail::invalid_parameter("local field size", local_field.size(),
+                                            "must cover this rank's " + std::to_string(layout_.owned_count()) +
+                                                " owned particles (local numbering: owned, then ghosts)");
+    });
     struct Entry {
       std::int64_t id;
       double value[3];

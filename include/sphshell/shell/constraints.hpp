@@ -87,6 +87,7 @@ class Constraints {
   void simply_support_hard(const std::vector<int>& set, const std::vector<Vector3>& normal,
                            const Vector3& edge_tangent) {
     require_no_motion(set);
+    require_rotation_axes(set, normal, edge_tangent, "edge_tangent", "along the particle's normal");
     for (int i : set) {
       fix_all_translations(i);
       fix_rotation(i, normal[i].cross(edge_tangent));
@@ -95,6 +96,8 @@ class Constraints {
   // No translation across the plane and no rotation tilting the director out of it.
   void symmetry_plane(const std::vector<int>& set, const std::vector<Vector3>& normal, const Vector3& plane_normal) {
     require_no_motion(set);
+    require_rotation_axes(set, normal, plane_normal, "plane_normal",
+                          "along the particle's normal (the plane must contain the normal)");
     for (int i : set) {
       fix_translation(i, plane_normal);
       fix_rotation(i, normal[i].cross(plane_normal));
@@ -202,6 +205,18 @@ class Constraints {
     return entries_.back();
   }
   // Checked for a whole set before any of it changes.
+  // Checked for the whole set before any particle changes, under the name the
+  // caller used: `vector` must be finite, non-zero and, at every particle,
+  // not along its normal (the rotation axis n × vector would vanish).
+  static void require_rotation_axes(const std::vector<int>& set, const std::vector<Vector3>& normal,
+                                    const Vector3& vector, const char* name, const char* parallel) {
+    if (!vector.allFinite() || vector.norm() == 0.0)
+      invalid_parameter(name, vector.transpose(), "must be finite and non-zero");
+    for (int i : set)
+      if (normal[std::size_t(i)].cross(vector).norm() == 0.0)
+        invalid_parameter(name, vector.transpose(), std::string("must not lie ") + parallel + " at particle " +
+                                                        std::to_string(i));
+  }
   void require_no_motion(const std::vector<int>& set) {
     for (int i : set) {
       const auto found = index_.find(i);

@@ -342,10 +342,10 @@ class ShellModel {
   }
 
   int nearest_particle(const Vector3& point) const {
-    return nearest(particle_position, point);
+    return nearest(particle_position, point, "nearest_particle");
   }
   int nearest_stress_point(const Vector3& point) const {
-    return nearest(stress_point_position, point);
+    return nearest(stress_point_position, point, "nearest_stress_point");
   }
 
  private:
@@ -381,7 +381,11 @@ class ShellModel {
     const bool triangle = !cells_.empty() && cells_[p].is_triangle();
     return triangle ? 2.0 * stress_point_area[p] : stress_point_area[p];
   }
-  static int nearest(const std::vector<Vector3>& points, const Vector3& point) {
+  // A NaN coordinate would make every distance NaN and silently pick index 0.
+  static int nearest(const std::vector<Vector3>& points, const Vector3& point, const char* caller) {
+    if (!point.allFinite())
+      detail::invalid_parameter(std::string(caller) + " point", point.transpose(), "must be finite");
+    if (points.empty()) detail::invalid_parameter(std::string(caller) + ": the model's point count", 0, "is zero");
     int best = 0;
     double best_distance = (points[0] - point).squaredNorm();
     for (std::size_t i = 1; i < points.size(); ++i) {

@@ -11,6 +11,7 @@ inline ShellModel ShellModel::rectangular_plate(double length_x, double length_y
   detail::require_positive("length_y", length_y);
   detail::model_checks::require_count("nx", nx, 2);
   detail::model_checks::require_count("ny", ny, 2);
+  detail::model_checks::require_grid_size("nx × ny", static_cast<long long>(nx) * ny);
   auto surface = [&](double u, double v) {
     return std::make_pair(Vector3(u * length_x, v * length_y, 0.0), Vector3(0.0, 0.0, 1.0));
   };
@@ -35,6 +36,8 @@ inline ShellModel ShellModel::cylindrical_panel(double radius, double length, do
   const bool closed = angle > 2.0 * kPi - 1e-12;
   detail::model_checks::require_count("n_circumferential", n_circumferential, closed ? 3 : 2);
   detail::model_checks::require_count("n_axial", n_axial, 2);
+  detail::model_checks::require_grid_size("n_circumferential × n_axial",
+                                          static_cast<long long>(n_circumferential) * n_axial);
   auto surface = [&](double u, double v) {
     const double theta = u * angle;
     const Vector3 normal(std::cos(theta), std::sin(theta), 0.0);
@@ -62,6 +65,7 @@ inline ShellModel ShellModel::spherical_cap(double radius, double half_angle, in
   if (!(half_angle > 0.0 && half_angle < kPi / 2))
     detail::invalid_parameter("half_angle", half_angle, "must lie in (0, π/2)");
   detail::model_checks::require_count("n", n, 3);
+  detail::model_checks::require_grid_size("n × n", static_cast<long long>(n) * n);
   auto surface = [&](double u, double v) {
     const double s = 2.0 * u - 1.0;
     const double t = 2.0 * v - 1.0;

@@ -263,6 +263,12 @@ inline void require_count(const char* name, int value, int minimum) {
   if (value < minimum)
     detail::invalid_parameter(name, value, "must be at least " + std::to_string(minimum));
 }
+// A structured grid's particle count, checked before anything is allocated:
+// the library's particle indices are int.
+inline void require_grid_size(const char* names, long long count) {
+  if (count > static_cast<long long>(std::numeric_limits<int>::max()))
+    detail::invalid_parameter(names, count, "must be at most 2^31 - 1 particles (the library's indices are int)");
+}
 inline void check_sizes(const std::vector<Vector3>& positions, const std::vector<Vector3>& normals) {
   if (normals.size() != positions.size())
     detail::invalid_parameter("normal count", normals.size(),

@@ -54,6 +54,8 @@ struct OGridQuality {
 
 namespace detail::ogrid {
 inline constexpr double pi = 3.14159265358979323846;
+// The largest m whose (m + 1)² block nodes have int indices.
+inline constexpr int max_block_divisions = 46339;
 
 struct Plane {
   double x, y;
@@ -72,7 +74,7 @@ struct Layout {
 };
 
 inline Layout layout(double radius, double half_angle, int m, const OGridOptions& options) {
-  if (!(radius > 0.0)) sphshell::detail::invalid_parameter("radius", radius, "must be positive");
+  sphshell::detail::require_positive("radius", radius);
   if (!(half_angle > 0.0 && half_angle < pi / 2))
     sphshell::detail::invalid_parameter("half_angle", half_angle, "must lie in (0, π/2)");
   if (m < 2 || m % 2 != 0)
@@ -84,6 +86,14 @@ inline Layout layout(double radius, double half_angle, int m, const OGridOptions
     sphshell::detail::invalid_parameter("radial_growth", options.radial_growth, "must lie in [0, 1]");
   if (!(options.bulge >= 0.0 && options.bulge < 0.5))
     sphshell::detail::invalid_parameter("bulge", options.bulge, "must lie in [0, 0.5)");
+  // The bulged sides' midpoints lie at b (1 + bulge) from the apex.
+  if (!(options.block_fraction * (1.0 + options.bulge) < 1.0))
+    sphshell::detail::invalid_parameter("block_fraction × (1 + bulge)", options.block_fraction * (1.0 + options.bulge),
+                                        "must be below 1: the block's bulged sides must stay inside the rim");
+  // (m + 1)² block nodes (and the rings around them, checked below) with int indices.
+  if (m > max_block_divisions)
+    sphshell::detail::invalid_parameter("m", m, "must be at most " + std::to_string(max_block_divisions) +
+                                                    " (the library's particle indices are int)");
   const double L = radius * half_angle, b = options.block_fraction * L, c = options.bulge;
   Layout g;
   // Block sides (parameter t ∈ [−1, 1]) and their Coons patch.
@@ -113,7 +123,12 @@ inline Layout layout(double radius, double half_angle, int m, const OGridOptions
   const double h_out = h_in + options.radial_growth * (h_rim - h_in);
   double mean_width = 0.0;
   for (int node : boundary) mean_width += (L - length(g.nodes[std::size_t(node)])) / around;
-  g.rings = std::max(1, int(std::lround(mean_width / (0.5 * (h_in + h_out)))));
+  const double rings = std::max(1.0, std::round(mean_width / (0.5 * (h_in + h_out))));
+  const double nodes = double(g.nodes.size()) + double(around) * rings;
+  if (!(nodes <= double(std::numeric_limits<int>::max())))
+    sphshell::detail::invalid_parameter("m", m, "gives " + std::to_string(nodes) +
+                                                    " particles with these options; at most 2^31 - 1 (int indices)");
+  g.rings = int(rings);
   // Normalized position along a ray, s(t) = a t + (1 − a) t² with
   // s'(0)/s'(1) = h_in/h_out.
   const double ratio = h_in / h_out, a = 2.0 * ratio / (1.0 + ratio);
