@@ -1,3 +1,4 @@
+#include <sphshell/io/binary_stream.hpp>
 #include <sphshell/io/csv_probe.hpp>
 #include <sphshell/io/pvd_collection.hpp>
 #include <sphshell/io/svg_plot.hpp>
@@ -583,4 +584,19 @@ TEST_CASE("SVG plot errors name the series and leave existing output alone", "[i
   // A panel without data still gets axes (a run that ended before anything happened).
   io::PlotPanel empty{"empty", "x", "y", {{"nothing", {}, {}, io::PlotStyle::line}}};
   CHECK_NOTHROW(io::write_svg_plot(directory.file("empty.svg"), {empty}));
+}
+
+TEST_CASE("A fixed-length list is read in place, and a list of another length is refused naming both", "[io]") {
+  io::BinaryWriter out;
+  const std::vector<double> written{1.5, -2.25, 3.0};
+  out(written);
+  out(written);
+  io::BinaryReader in(std::string(out.bytes()), "list.bin");
+  std::vector<double> same(3, 0.0);
+  in.read_exact(same, "values");
+  CHECK(same == written);
+  std::vector<double> shorter(2, 7.0);
+  CHECK_THROWS_WITH(in.read_exact(shorter, "values"),
+                    Catch::Contains("values: the file holds 3 entries, this solver has 2") && Catch::Contains("list.bin"));
+  CHECK(shorter == std::vector<double>{7.0, 7.0});  // refused before anything was read into it
 }

@@ -260,13 +260,14 @@ class BinaryReader {
   // say): the file must hold exactly as many, else an Error naming `what`.
   template <class T, class A>
   void read_exact(std::vector<T, A>& value, const std::string& what) {
-    const std::size_t expected = value.size();
-    std::vector<T, A> read_back;
-    read(read_back);
-    if (read_back.size() != expected)
-      fail(what + ": the file holds " + std::to_string(read_back.size()) + " entries, this solver has " +
-           std::to_string(expected));
-    value = std::move(read_back);
+    // The count first, so a file of another size is refused before anything
+    // is read; then the entries straight into `value`, so that a large array
+    // is not held twice while it loads.
+    const std::size_t n = read_size(1, "list");
+    if (n != value.size())
+      fail(what + ": the file holds " + std::to_string(n) + " entries, this solver has " +
+           std::to_string(value.size()));
+    for (auto& element : value) read(element);
   }
 
   // A 64-bit count, checked against the bytes left (each item takes at
