@@ -25,15 +25,17 @@
 #include <Eigen/Core>
 #include <benchmark/benchmark.h>
 
+#include "bench_support.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstring>
 #include <vector>
 
-#include <time.h>
-
 using namespace sphshell;
+using sphshell::bench::median;
+using sphshell::bench::thread_seconds;
 
 namespace {
 
@@ -41,18 +43,6 @@ using Points = solver::IntegrationPoints<approx::MLS<kernel::CubicSpline>>;
 
 constexpr std::size_t lanes = 8;  // one AVX-512 register of doubles
 constexpr int components = 15;    // a1, a2, n, n1, n2
-
-double thread_seconds() {
-  timespec now{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
-  return double(now.tv_sec) + 1e-9 * double(now.tv_nsec);
-}
-
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  const std::size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
 
 // The points' shape functions rearranged for lanes: per batch of eight rows
 // of a group, slot s of every lane side by side (a lane past its row's end

@@ -16,6 +16,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include "bench_support.hpp"
+
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -24,10 +26,11 @@
 #include <string>
 #include <vector>
 
-#include <time.h>
 #include <unistd.h>
 
 using namespace sphshell;
+using sphshell::bench::median;
+using sphshell::bench::thread_seconds;
 
 namespace {
 
@@ -56,25 +59,11 @@ double resident_bytes() {
   return read == 2 ? double(resident) * double(sysconf(_SC_PAGESIZE)) : 0.0;
 }
 
-// CPU seconds of the calling thread (the solvers run on one thread here): on
-// a loaded machine wall time mostly measures the other processes.
-double thread_seconds() {
-  timespec now{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
-  return double(now.tv_sec) + 1e-9 * double(now.tv_nsec);
-}
-
 template <class S>
 double seconds_for_steps(S& solver, int steps) {
   const double start = thread_seconds();
   for (int k = 0; k < steps; ++k) solver.step();
   return thread_seconds() - start;
-}
-
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  const std::size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
 void use_one_thread() {

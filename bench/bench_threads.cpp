@@ -19,6 +19,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include "bench_support.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
@@ -34,6 +36,7 @@
 #include <unistd.h>
 
 using namespace sphshell;
+using sphshell::bench::median;
 
 namespace {
 
@@ -112,12 +115,6 @@ CpuTicks cpu_ticks() {
 double steal_share(const CpuTicks& before, const CpuTicks& after) {
   if (before.total < 0.0 || after.total <= before.total) return -1.0;
   return (after.steal - before.steal) / (after.total - before.total);
-}
-
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  const std::size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
 void two_against_one_thread(benchmark::State& state, bool with_busy_process) {
