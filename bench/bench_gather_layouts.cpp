@@ -43,6 +43,22 @@ using Points = solver::IntegrationPoints<approx::MLS<kernel::CubicSpline>>;
 
 constexpr std::size_t lanes = 8;  // one AVX-512 register of doubles
 constexpr int components = 15;    // a1, a2, n, n1, n2
+constexpr int packed_doubles = 6;  // a particle's position, then its director
+static_assert(sizeof(solver::PackedKinematics) == packed_doubles * sizeof(double), "the lanes read six doubles a particle");
+
+// Calls body(group, row, first) for every point: its component c goes to
+// out[first + c × 8] in the lanes' order (out[(batch × 15 + c) × 8 + lane],
+// each group's rows in batches of eight).
+template <class Body>
+void for_each_point(const Points& points, Body&& body) {
+  std::size_t first_batch = 0;
+  for (solver::PointGroup group : solver::point_groups) {
+    const std::size_t rows = points.count(group);
+    for (std::size_t row = 0; row < rows; ++row)
+      body(group, row, (first_batch + row / lanes) * components * lanes + row % lanes);
+    first_batch += (rows + lanes - 1) / lanes;
+  }
+}
 
 // The points' shape functions rearranged for lanes: per batch of eight rows
 // of a group, slot s of every lane side by side (a lane past its row's end
@@ -90,7 +106,7 @@ void gather_lanes(const LaneLayout& layout, const std::vector<solver::PackedKine
       const double* const d2 = &layout.dphi_d2[s * lanes];
 #pragma omp simd
       for (std::size_t l = 0; l < lanes; ++l) {
-        const int at = 6 * j[l];
+        const int at = packed_doubles * j[l];
         const double x = kinematics[at], y = kinematics[at + 1], z = kinematics[at + 2];
         const double dx = kinematics[at + 3], dy = kinematics[at + 4], dz = kinematics[at + 5];
         sum[0][l] += d1[l] * x;  // a1
@@ -120,43 +136,37 @@ using PaddedKinematics = std::vector<Padded, Eigen::aligned_allocator<Padded>>;
 
 // The library's gather on padded kinematics, the sums in the lanes' order.
 void gather_padded(const Points& points, const PaddedKinematics& padded, std::vector<double>& out) {
-  std::size_t batch = 0;
-  for (solver::PointGroup group : solver::point_groups) {
+  for_each_point(points, [&](solver::PointGroup group, std::size_t row, std::size_t first) {
+    // Local pointers and bounds, as in the library's gather: read through the
+    // captured vectors, they would be reloaded at every slot.
     const approx::ShapeFunctions& sf = points.shape(group);
-    const std::size_t rows = points.count(group);
-    for (std::size_t row = 0; row < rows; ++row) {
-      Padded d1_sum = Padded::Zero(), d2_sum = Padded::Zero();
-      Eigen::Vector4d n = Eigen::Vector4d::Zero();
-      for (std::size_t s = sf.row_begin[row]; s < sf.row_begin[row] + sf.row_size[row]; ++s) {
-        const Padded& particle = padded[std::size_t(sf.neighbour[s])];
-        d1_sum += sf.value[s].dphi_d1 * particle;
-        d2_sum += sf.value[s].dphi_d2 * particle;
-        n += sf.value[s].phi * particle.tail<4>();
-      }
-      const std::array<double, components> sums{d1_sum[0], d1_sum[1], d1_sum[2], d2_sum[0], d2_sum[1],
-                                                d2_sum[2], n[0],      n[1],      n[2],      d1_sum[4],
-                                                d1_sum[5], d1_sum[6], d2_sum[4], d2_sum[5], d2_sum[6]};
-      for (int c = 0; c < components; ++c)
-        out[((batch + row / lanes) * components + std::size_t(c)) * lanes + row % lanes] = sums[std::size_t(c)];
+    const int* const neighbour = sf.neighbour.data();
+    const approx::ShapeValue* const value = sf.value.data();
+    const Padded* const particles = padded.data();
+    const std::size_t begin = sf.row_begin[row], end = begin + sf.row_size[row];
+    Padded d1_sum = Padded::Zero(), d2_sum = Padded::Zero();
+    Eigen::Vector4d n = Eigen::Vector4d::Zero();
+    for (std::size_t s = begin; s < end; ++s) {
+      const Padded& particle = particles[std::size_t(neighbour[s])];
+      d1_sum += value[s].dphi_d1 * particle;
+      d2_sum += value[s].dphi_d2 * particle;
+      n += value[s].phi * particle.tail<4>();
     }
-    batch += (rows + lanes - 1) / lanes;
-  }
+    const std::array<double, components> sums{d1_sum[0], d1_sum[1], d1_sum[2], d2_sum[0], d2_sum[1],
+                                              d2_sum[2], n[0],      n[1],      n[2],      d1_sum[4],
+                                              d1_sum[5], d1_sum[6], d2_sum[4], d2_sum[5], d2_sum[6]};
+    for (int c = 0; c < components; ++c) out[first + std::size_t(c) * lanes] = sums[std::size_t(c)];
+  });
 }
 
 // The library's gather of every point, its fifteen sums in the lanes' order.
 void gather_by_point(const Points& points, const std::vector<solver::PackedKinematics>& packed,
                      std::vector<double>& out) {
-  std::size_t batch = 0;
-  for (solver::PointGroup group : solver::point_groups) {
-    const std::size_t rows = points.count(group);
-    for (std::size_t row = 0; row < rows; ++row) {
-      const shell::SurfaceGradients g = points.gather(group, row, packed);
-      const std::array<const Vector3*, 5> vectors{&g.a1, &g.a2, &g.n, &g.n1, &g.n2};
-      for (int c = 0; c < components; ++c)
-        out[((batch + row / lanes) * components + std::size_t(c)) * lanes + row % lanes] = (*vectors[c / 3])[c % 3];
-    }
-    batch += (rows + lanes - 1) / lanes;
-  }
+  for_each_point(points, [&](solver::PointGroup group, std::size_t row, std::size_t first) {
+    const shell::SurfaceGradients g = points.gather(group, row, packed);
+    const std::array<const Vector3*, 5> vectors{&g.a1, &g.a2, &g.n, &g.n1, &g.n2};
+    for (int c = 0; c < components; ++c) out[first + std::size_t(c) * lanes] = (*vectors[c / 3])[c % 3];
+  });
 }
 
 void gather_layouts(benchmark::State& state) {
@@ -182,18 +192,14 @@ void gather_layouts(benchmark::State& state) {
   gather_lanes(layout, packed, in_lanes);
   gather_padded(points, padded, by_padded);
   // Lanes past a group's last row repeat that row; compare the real ones.
-  std::size_t batch = 0;
-  for (solver::PointGroup group : solver::point_groups) {
-    const std::size_t rows = points.count(group);
-    for (std::size_t row = 0; row < rows; ++row)
-      for (int c = 0; c < components; ++c) {
-        const std::size_t at = ((batch + row / lanes) * components + std::size_t(c)) * lanes + row % lanes;
-        if (by_point[at] != in_lanes[at] || by_point[at] != by_padded[at]) {
-          state.SkipWithError("a layout's sums differ from the library's gather");
-          return;
-        }
-      }
-    batch += (rows + lanes - 1) / lanes;
+  bool same = true;
+  for_each_point(points, [&](solver::PointGroup, std::size_t, std::size_t first) {
+    for (std::size_t at = first; at < first + components * lanes; at += lanes)
+      same = same && by_point[at] == in_lanes[at] && by_point[at] == by_padded[at];
+  });
+  if (!same) {
+    state.SkipWithError("a layout's sums differ from the library's gather");
+    return;
   }
   const double point_count = double(points.size());
   constexpr int turns = 30;
