@@ -4,9 +4,20 @@
 // counted) and floating-point peak (16 independent multiply-add chains
 // x = x·m + a, 2 flops each, in whatever vector width the build allows). One
 // thread; run it beside the step benchmarks, under the same load.
+// A third figure is for the threads paragraph: the time a cache line takes to
+// go from one processor to another and back (two threads pinned to the first
+// two processors the process may use pass a flag to and fro). What two
+// threads of a step share moves at that price: on a machine where it is
+// several hundred nanoseconds, the second thread gains less
+// (docs/performance.md, tenth round).
 #include <benchmark/benchmark.h>
 
+#include "bench_support.hpp"
+
+#include <atomic>
+#include <chrono>
 #include <cstddef>
+#include <thread>
 #include <vector>
 
 namespace {
@@ -38,9 +49,48 @@ void multiply_add_peak(benchmark::State& state) {
   state.counters["flops"] = benchmark::Counter(2.0 * chains * lanes * repeats, benchmark::Counter::kIsIterationInvariantRate);
 }
 
+void core_to_core_round_trip(benchmark::State& state) {
+  sphshell::bench::ProcessorPin pin;
+  if (pin.processors().size() < 2) {
+    state.SkipWithError("needs two processors");
+    return;
+  }
+  constexpr int trips = 100000;
+  // The flag on a cache line of its own: 1 from here, 0 back from the other thread.
+  struct alignas(64) Flag {
+    std::atomic<int> value{0};
+  } flag;
+  bool pinned = true;
+  for (auto _ : state) {
+    bool other_pinned = false;  // read after join(), which orders it
+    std::thread other([&] {
+      other_pinned = sphshell::bench::ProcessorPin::pin(pin.processors()[1]);
+      for (int k = 0; k < trips; ++k) {
+        while (flag.value.load(std::memory_order_acquire) != 1) {
+        }
+        flag.value.store(0, std::memory_order_release);
+      }
+    });
+    const bool this_pinned = pin.pin(pin.processors()[0]);
+    const auto start = std::chrono::steady_clock::now();
+    for (int k = 0; k < trips; ++k) {
+      flag.value.store(1, std::memory_order_release);
+      while (flag.value.load(std::memory_order_acquire) != 0) {
+      }
+    }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    other.join();
+    pin.release();
+    pinned = pinned && this_pinned && other_pinned;
+    state.SetIterationTime(seconds / trips);
+  }
+  if (!pinned) state.SkipWithError("could not pin the two threads to processors");
+}
+
 }  // namespace
 
 BENCHMARK(triad_bandwidth)->Unit(benchmark::kMillisecond);
 BENCHMARK(multiply_add_peak)->Unit(benchmark::kMicrosecond);
+BENCHMARK(core_to_core_round_trip)->UseManualTime()->Iterations(5)->Unit(benchmark::kNanosecond);
 
 BENCHMARK_MAIN();

@@ -15,6 +15,18 @@
 // machine can show no load of its own and still lose its cores for a while,
 // and then "idle" is not idle. The argument is the team's spin time in µs
 // (parallel::set_spin_time; 50 is the library's default).
+// threads_idle also steps a one-thread solver pinned to each of the first two
+// processors the process may use, in the same rounds: a virtual machine's two
+// processors need not be equally fast (one of ours ran the plate 1.37 times
+// slower than the other for hours, with no steal reported), and then no
+// program's two threads reach twice the speed of one thread on the faster.
+// From the pinned times t_a, t_b, ideal = 1 / (1/t_a + 1/t_b) is the time of
+// two threads that share the work perfectly between those two processors;
+// the counters `ideal_ratio` (ideal / one-thread time: what `ratio` would be
+// with perfect sharing) and `efficiency` (ideal / two-thread time: 1 is
+// perfect, 0.9 is what "1.8 times faster" asks of equal processors) are
+// medians over the rounds, `core_speed_ratio` the slower pinned time over the
+// faster (docs/performance.md, tenth round).
 #include <sphshell/sphshell.hpp>
 
 #include <benchmark/benchmark.h>
@@ -37,6 +49,7 @@
 
 using namespace sphshell;
 using sphshell::bench::median;
+using sphshell::bench::ProcessorPin;
 
 namespace {
 
@@ -127,27 +140,54 @@ void two_against_one_thread(benchmark::State& state, bool with_busy_process) {
   double load1 = 0.0;
   getloadavg(&load1, 1);
   PlateSolver one = loaded_plate(), two = loaded_plate();
+  // One-thread solvers pinned to each processor (threads_idle only), stepped
+  // in the same rounds so that every solver is at the same step.
+  ProcessorPin pin;
+  const bool per_processor = !with_busy_process && pin.processors().size() == 2;
+  std::vector<PlateSolver> pinned;
+  if (per_processor) {
+    pinned.push_back(loaded_plate());
+    pinned.push_back(loaded_plate());
+  }
   constexpr int chunk = 20, rounds = 15;
   for (auto _ : state) {
     BusyProcess* busy = with_busy_process ? new BusyProcess : nullptr;
     if (busy && !busy->running()) state.SkipWithError("could not start the busy process");
-    std::vector<double> ratios;
-    double one_seconds = 0.0, two_seconds = 0.0;
+    std::vector<double> ratios, ideal_ratios, efficiencies, speed_ratios;
+    double one_seconds = 0.0, two_seconds = 0.0, pinned_seconds[2] = {0.0, 0.0};
+    bool pinned_ok = per_processor;
     const CpuTicks ticks_before = cpu_ticks();
     for (int round = 0; round < rounds; ++round) {
-      double t1 = 0.0, t2 = 0.0;
-      for (int turn = 0; turn < 2; ++turn) {
-        if ((turn == 0) == (round % 2 == 0)) {
+      // The chunks of a round in turn, starting one later every round.
+      const int turns = per_processor ? 4 : 2;
+      double t1 = 0.0, t2 = 0.0, t_pinned[2] = {0.0, 0.0};
+      for (int turn = 0; turn < turns; ++turn) {
+        const int which = (turn + round) % turns;
+        if (which == 0) {
           use_threads(1);
           t1 = seconds_for_steps(one, chunk);
-        } else {
+        } else if (which == 1) {
           use_threads(2);
           t2 = seconds_for_steps(two, chunk);
+        } else {
+          const int k = which - 2;
+          use_threads(1);
+          pinned_ok = pin.pin(pin.processors()[std::size_t(k)]) && pinned_ok;
+          t_pinned[k] = seconds_for_steps(pinned[std::size_t(k)], chunk);
+          pin.release();
         }
       }
       ratios.push_back(t2 / t1);
       one_seconds += t1;
       two_seconds += t2;
+      if (per_processor) {
+        const double ideal = 1.0 / (1.0 / t_pinned[0] + 1.0 / t_pinned[1]);
+        ideal_ratios.push_back(ideal / t1);
+        efficiencies.push_back(ideal / t2);
+        speed_ratios.push_back(std::max(t_pinned[0], t_pinned[1]) / std::min(t_pinned[0], t_pinned[1]));
+        pinned_seconds[0] += t_pinned[0];
+        pinned_seconds[1] += t_pinned[1];
+      }
     }
     const CpuTicks ticks_after = cpu_ticks();
     delete busy;
@@ -158,6 +198,15 @@ void two_against_one_thread(benchmark::State& state, bool with_busy_process) {
     state.counters["two_threads_us_per_step"] = 1e6 * two_seconds / (rounds * chunk);
     state.counters["load1"] = load1;
     state.counters["steal"] = steal_share(ticks_before, ticks_after);
+    if (per_processor && !pinned_ok) state.SkipWithError("could not pin the calling thread to a processor");
+    if (per_processor && pinned_ok) {
+      for (int k = 0; k < 2; ++k)
+        state.counters["cpu" + std::to_string(pin.processors()[std::size_t(k)]) + "_us_per_step"] =
+            1e6 * pinned_seconds[k] / (rounds * chunk);
+      state.counters["core_speed_ratio"] = median(speed_ratios);
+      state.counters["ideal_ratio"] = median(ideal_ratios);
+      state.counters["efficiency"] = median(efficiencies);
+    }
   }
   parallel::set_spin_time(previous_spin);
 }
