@@ -2,14 +2,14 @@
 // bandwidth (STREAM-like triad a = b + s·c on three 32 MiB arrays, counted as
 // 24 bytes per element: two reads and a write; write-allocate traffic not
 // counted) and floating-point peak (16 independent multiply-add chains
-// x = x·m + a, 2 flops each, in whatever vector width the build allows). One
-// thread; run it beside the step benchmarks, under the same load.
+// x = x·m + a, 2 flops each, in whatever vector width the build allows), each
+// on one thread; run them beside the step benchmarks, under the same load.
 // A third figure is for the threads paragraph: the time a cache line takes to
 // go from one processor to another and back (two threads pinned to the first
 // two processors the process may use pass a flag to and fro). What two
-// threads of a step share moves at that price: on a machine where it is
-// several hundred nanoseconds, the second thread gains less
-// (docs/performance.md, tenth round).
+// threads of a step share moves at that price (docs/performance.md, tenth
+// round). It wants both processors free: with another process on one of
+// them, each trip can wait for a time slice.
 #include <benchmark/benchmark.h>
 
 #include "bench_support.hpp"
@@ -50,38 +50,44 @@ void multiply_add_peak(benchmark::State& state) {
 }
 
 void core_to_core_round_trip(benchmark::State& state) {
-  sphshell::bench::ProcessorPin pin;
-  if (pin.processors().size() < 2) {
-    state.SkipWithError("needs two processors");
+  const std::vector<int> processors = sphshell::bench::first_two_processors();
+  if (processors.size() < 2) {
+    state.SkipWithError("needs two processors to pin threads to");
     return;
   }
   constexpr int trips = 100000;
-  // The flag on a cache line of its own: 1 from here, 0 back from the other thread.
+  // The flag on a cache line of its own: `ready` from the other thread once it
+  // is pinned, then `there` from this one and `back` from the other per trip.
+  enum : int { back = 0, there = 1, ready = 2 };
   struct alignas(64) Flag {
-    std::atomic<int> value{0};
+    std::atomic<int> value{back};
   } flag;
   bool pinned = true;
   for (auto _ : state) {
+    flag.value.store(back);
     bool other_pinned = false;  // read after join(), which orders it
     std::thread other([&] {
-      other_pinned = sphshell::bench::ProcessorPin::pin(pin.processors()[1]);
+      const sphshell::bench::ProcessorPin pin(processors[1]);
+      other_pinned = pin.pinned();
+      flag.value.store(ready, std::memory_order_release);
       for (int k = 0; k < trips; ++k) {
-        while (flag.value.load(std::memory_order_acquire) != 1) {
+        while (flag.value.load(std::memory_order_acquire) != there) {
         }
-        flag.value.store(0, std::memory_order_release);
+        flag.value.store(back, std::memory_order_release);
       }
     });
-    const bool this_pinned = pin.pin(pin.processors()[0]);
+    const sphshell::bench::ProcessorPin pin(processors[0]);
+    while (flag.value.load(std::memory_order_acquire) != ready) {
+    }
     const auto start = std::chrono::steady_clock::now();
     for (int k = 0; k < trips; ++k) {
-      flag.value.store(1, std::memory_order_release);
-      while (flag.value.load(std::memory_order_acquire) != 0) {
+      flag.value.store(there, std::memory_order_release);
+      while (flag.value.load(std::memory_order_acquire) != back) {
       }
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     other.join();
-    pin.release();
-    pinned = pinned && this_pinned && other_pinned;
+    pinned = pinned && pin.pinned() && other_pinned;
     state.SetIterationTime(seconds / trips);
   }
   if (!pinned) state.SkipWithError("could not pin the two threads to processors");

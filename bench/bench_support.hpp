@@ -6,9 +6,12 @@
 #include <cstddef>
 #include <vector>
 
+#include <time.h>
+
+#ifdef __linux__
 #include <pthread.h>
 #include <sched.h>
-#include <time.h>
+#endif
 
 namespace sphshell::bench {
 
@@ -27,33 +30,52 @@ inline double median(std::vector<double> values) {
   return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
-// The first two processors the calling thread may run on (fewer if it may
-// use fewer), and pinning the calling thread to one of them and back (the
-// processors it was allowed before, also when the pin goes out of scope).
+// Pinning threads to processors, for the benchmarks that compare processors
+// (Linux: elsewhere no processor is listed and those benchmarks leave the
+// comparison out).
+#ifdef __linux__
+// The first two processors the calling thread may run on (fewer if it may use
+// fewer, none if they cannot be read).
+inline std::vector<int> first_two_processors() {
+  std::vector<int> processors;
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  if (pthread_getaffinity_np(pthread_self(), sizeof allowed, &allowed) != 0) return processors;
+  for (int cpu = 0; cpu < CPU_SETSIZE && processors.size() < 2; ++cpu)
+    if (CPU_ISSET(cpu, &allowed)) processors.push_back(cpu);
+  return processors;
+}
+
+// Pins the thread that constructs it to one processor while it lives; the
+// destructor gives that thread back the processors it was allowed before.
 class ProcessorPin {
  public:
-  ProcessorPin() {
+  explicit ProcessorPin(int cpu) {
     CPU_ZERO(&allowed_);
     if (pthread_getaffinity_np(pthread_self(), sizeof allowed_, &allowed_) != 0) return;
-    for (int cpu = 0; cpu < CPU_SETSIZE && processors_.size() < 2; ++cpu)
-      if (CPU_ISSET(cpu, &allowed_)) processors_.push_back(cpu);
-  }
-  ~ProcessorPin() { release(); }
-  ProcessorPin(const ProcessorPin&) = delete;
-  ProcessorPin& operator=(const ProcessorPin&) = delete;
-  const std::vector<int>& processors() const { return processors_; }
-  // Pins the calling thread (any thread) to processor `cpu`.
-  static bool pin(int cpu) {
     cpu_set_t one;
     CPU_ZERO(&one);
     CPU_SET(cpu, &one);
-    return pthread_setaffinity_np(pthread_self(), sizeof one, &one) == 0;
+    pinned_ = pthread_setaffinity_np(pthread_self(), sizeof one, &one) == 0;
   }
-  void release() { pthread_setaffinity_np(pthread_self(), sizeof allowed_, &allowed_); }
+  ~ProcessorPin() {
+    if (pinned_) pthread_setaffinity_np(pthread_self(), sizeof allowed_, &allowed_);
+  }
+  ProcessorPin(const ProcessorPin&) = delete;
+  ProcessorPin& operator=(const ProcessorPin&) = delete;
+  bool pinned() const { return pinned_; }
 
  private:
   cpu_set_t allowed_;
-  std::vector<int> processors_;
+  bool pinned_ = false;
 };
+#else
+inline std::vector<int> first_two_processors() { return {}; }
+class ProcessorPin {
+ public:
+  explicit ProcessorPin(int) {}
+  bool pinned() const { return false; }
+};
+#endif
 
 }  // namespace sphshell::bench

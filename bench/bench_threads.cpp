@@ -15,18 +15,20 @@
 // machine can show no load of its own and still lose its cores for a while,
 // and then "idle" is not idle. The argument is the team's spin time in µs
 // (parallel::set_spin_time; 50 is the library's default).
-// threads_idle also steps a one-thread solver pinned to each of the first two
-// processors the process may use, in the same rounds: a virtual machine's two
-// processors need not be equally fast (one of ours ran the plate 1.37 times
-// slower than the other for hours, with no steal reported), and then no
-// program's two threads reach twice the speed of one thread on the faster.
-// From the pinned times t_a, t_b, ideal = 1 / (1/t_a + 1/t_b) is the time of
-// two threads that share the work perfectly between those two processors;
-// the counters `ideal_ratio` (ideal / one-thread time: what `ratio` would be
-// with perfect sharing) and `efficiency` (ideal / two-thread time: 1 is
-// perfect, 0.9 is what "1.8 times faster" asks of equal processors) are
-// medians over the rounds, `core_speed_ratio` the slower pinned time over the
-// faster (docs/performance.md, tenth round).
+// threads_idle also steps, in the same rounds, a one-thread solver pinned to
+// each of the first two processors the process may use (the four chunks of a
+// round in the orders of a Williams square), because a virtual machine's two
+// processors need not be equally fast, and then no program's two threads are
+// twice as fast as one thread on the faster (docs/performance.md, tenth
+// round). From the pinned chunk times t_a, t_b, ideal = 1 / (1/t_a + 1/t_b) is
+// the time of two threads that share the work perfectly between the two
+// processors. Counters, medians over the rounds: `ideal_ratio` (ideal over the
+// one-thread time: what `ratio` would be with perfect sharing; the unpinned
+// one-thread chunk runs wherever the scheduler leaves it), `efficiency` (ideal
+// over the two-thread time: 1 is perfect, 0.9 is what "1.8 times faster" asks
+// of equal processors), `core_speed_ratio` (the slower pinned time over the
+// faster) and `cpuN_us_per_step` for each pinned processor N. They are left
+// out where the process may use fewer than two processors or pinning fails.
 #include <sphshell/sphshell.hpp>
 
 #include <benchmark/benchmark.h>
@@ -50,6 +52,7 @@
 using namespace sphshell;
 using sphshell::bench::median;
 using sphshell::bench::ProcessorPin;
+using sphshell::bench::first_two_processors;
 
 namespace {
 
@@ -142,14 +145,18 @@ void two_against_one_thread(benchmark::State& state, bool with_busy_process) {
   PlateSolver one = loaded_plate(), two = loaded_plate();
   // One-thread solvers pinned to each processor (threads_idle only), stepped
   // in the same rounds so that every solver is at the same step.
-  ProcessorPin pin;
-  const bool per_processor = !with_busy_process && pin.processors().size() == 2;
+  const std::vector<int> processors = first_two_processors();
+  const bool per_processor = !with_busy_process && processors.size() == 2;
   std::vector<PlateSolver> pinned;
   if (per_processor) {
     pinned.push_back(loaded_plate());
     pinned.push_back(loaded_plate());
   }
-  constexpr int chunk = 20, rounds = 15;
+  constexpr int chunk = 20, rounds = 16;
+  // A round's chunks: 0 one thread, 1 two threads, 2 and 3 pinned. Four of
+  // them in the rows of a Williams square (each chunk in each place once, and
+  // after each other chunk once, every four rounds); two alternate.
+  constexpr int four_orders[4][4] = {{0, 1, 3, 2}, {1, 2, 0, 3}, {2, 3, 1, 0}, {3, 0, 2, 1}};
   for (auto _ : state) {
     BusyProcess* busy = with_busy_process ? new BusyProcess : nullptr;
     if (busy && !busy->running()) state.SkipWithError("could not start the busy process");
@@ -158,11 +165,10 @@ void two_against_one_thread(benchmark::State& state, bool with_busy_process) {
     bool pinned_ok = per_processor;
     const CpuTicks ticks_before = cpu_ticks();
     for (int round = 0; round < rounds; ++round) {
-      // The chunks of a round in turn, starting one later every round.
       const int turns = per_processor ? 4 : 2;
       double t1 = 0.0, t2 = 0.0, t_pinned[2] = {0.0, 0.0};
       for (int turn = 0; turn < turns; ++turn) {
-        const int which = (turn + round) % turns;
+        const int which = per_processor ? four_orders[round % 4][turn] : (turn + round) % 2;
         if (which == 0) {
           use_threads(1);
           t1 = seconds_for_steps(one, chunk);
@@ -172,9 +178,9 @@ void two_against_one_thread(benchmark::State& state, bool with_busy_process) {
         } else {
           const int k = which - 2;
           use_threads(1);
-          pinned_ok = pin.pin(pin.processors()[std::size_t(k)]) && pinned_ok;
+          ProcessorPin pin(processors[std::size_t(k)]);  // for this chunk
+          pinned_ok = pin.pinned() && pinned_ok;
           t_pinned[k] = seconds_for_steps(pinned[std::size_t(k)], chunk);
-          pin.release();
         }
       }
       ratios.push_back(t2 / t1);
@@ -198,10 +204,9 @@ void two_against_one_thread(benchmark::State& state, bool with_busy_process) {
     state.counters["two_threads_us_per_step"] = 1e6 * two_seconds / (rounds * chunk);
     state.counters["load1"] = load1;
     state.counters["steal"] = steal_share(ticks_before, ticks_after);
-    if (per_processor && !pinned_ok) state.SkipWithError("could not pin the calling thread to a processor");
     if (per_processor && pinned_ok) {
       for (int k = 0; k < 2; ++k)
-        state.counters["cpu" + std::to_string(pin.processors()[std::size_t(k)]) + "_us_per_step"] =
+        state.counters["cpu" + std::to_string(processors[std::size_t(k)]) + "_us_per_step"] =
             1e6 * pinned_seconds[k] / (rounds * chunk);
       state.counters["core_speed_ratio"] = median(speed_ratios);
       state.counters["ideal_ratio"] = median(ideal_ratios);
