@@ -21,7 +21,6 @@
 #include <sphshell/approx/memory_estimate.hpp>
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/parallel.hpp>
-#include <sphshell/core/statistics.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/crack/crack.hpp>
 #include <sphshell/crack/none.hpp>
@@ -580,13 +579,12 @@ class Solver {
   }
 
   EnergyReport energy() const {
-    std::vector<double> stored(states_.size(), 0.0);
-    assembler_.for_each_point(points_, [&](std::size_t p) noexcept {
-      if (states_.active(p))
-        stored[p] = states_.stored_energy(p, points_.membrane_bending_weight(p), points_.shear_weight(p));
-    });
     // A point out of action holds 0, which adds nothing.
-    return ledger_.report(detail::interleaved_sum(stored), fracture_.released_energy());
+    const double stored = assembler_.sum_over_points(points_, [&](std::size_t p) {
+      return states_.active(p) ? states_.stored_energy(p, points_.membrane_bending_weight(p), points_.shear_weight(p))
+                               : 0.0;
+    });
+    return ledger_.report(stored, fracture_.released_energy());
   }
 
  private:
@@ -640,7 +638,7 @@ class Solver {
 
   void compute_internal_forces() {
     assembler_.compute(now(), particles_, points_, states_, forces_);
-    ledger_.book_internal_work(assembler_.work_increments());
+    ledger_.book_internal_work(assembler_.internal_work());
     forces_current_ = true;
   }
 

@@ -31,6 +31,34 @@
 
 namespace sphshell::solver {
 
+// The fixed chunks of a sum over the points (the energy books): consecutive
+// rows of one group, AssemblySchedule::rows_per_sum_chunk at most, the stress
+// points' chunks first. Each chunk is added in row order, then the chunks'
+// sums in chunk order (InternalForceAssembler::sum_over_points): the chunks
+// depend only on the groups' sizes, so the sum is the same for any thread count.
+class PointChunks {
+ public:
+  static constexpr std::size_t rows = 64;
+
+  template <class Approx>
+  explicit PointChunks(const IntegrationPoints<Approx>& points)
+      : stress_chunks_(chunks_of(points.count(PointGroup::stress_points))),
+        count_(stress_chunks_ + chunks_of(points.count(PointGroup::particles))) {}
+
+  std::size_t count() const { return count_; }
+  // Chunk c's group and first row (its rows end at the next chunk's first row or the group's end).
+  PointGroup group(std::size_t c) const { return c < stress_chunks_ ? PointGroup::stress_points : PointGroup::particles; }
+  std::size_t first_row(std::size_t c) const { return (c < stress_chunks_ ? c : c - stress_chunks_) * rows; }
+  // The chunk that holds a group's row.
+  std::size_t chunk_of(PointGroup g, std::size_t row) const {
+    return (g == PointGroup::stress_points ? 0 : stress_chunks_) + row / rows;
+  }
+
+ private:
+  static std::size_t chunks_of(std::size_t group_rows) { return (group_rows + rows - 1) / rows; }
+  std::size_t stress_chunks_, count_;
+};
+
 class AssemblySchedule {
  public:
   // Rows of one group integrated before the other group's turn, at most. One
@@ -55,6 +83,12 @@ class AssemblySchedule {
   // that integrated them, eight per thread took about 0.93 of the time of two
   // summed after the pass, four about 0.95 (docs/performance.md, fifth round).
   static constexpr std::size_t segments_per_thread = 8;
+  // Rows of one group per partial sum of a sum over the points (PointChunks).
+  // Every run starts at a multiple of it, so each chunk lies in one run and is
+  // summed by the thread that integrated its points.
+  static constexpr std::size_t rows_per_sum_chunk = PointChunks::rows;
+  static_assert(min_rows_per_run % rows_per_sum_chunk == 0 && max_rows_per_run % rows_per_sum_chunk == 0,
+                "AssemblySchedule: a run's length must be a whole number of sum chunks");
 
   struct Run {
     PointGroup group;
@@ -118,10 +152,12 @@ class AssemblySchedule {
     for (std::vector<std::size_t>& first_rows : group_run_first_row_) first_rows.clear();
     for (std::vector<std::uint32_t>& index : group_run_index_) index.clear();
     const std::size_t count[2] = {points.count(PointGroup::stress_points), points.count(PointGroup::particles)};
+    // A whole number of sum chunks (rows_per_sum_chunk).
     const std::size_t rows_per_run =
         segment_count_ == 1
             ? max_rows_per_run
-            : std::clamp(points.size() / (segment_count_ * min_runs_per_segment), min_rows_per_run, max_rows_per_run);
+            : std::clamp(points.size() / (segment_count_ * min_runs_per_segment), min_rows_per_run, max_rows_per_run) /
+                  rows_per_sum_chunk * rows_per_sum_chunk;
     std::size_t next[2] = {0, 0};
     while (next[0] < count[0] || next[1] < count[1]) {
       // The group less far through its rows goes next (next/count compared

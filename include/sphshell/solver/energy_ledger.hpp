@@ -4,14 +4,13 @@
 // kinetic energy, the internal work done on the material, and their balance,
 // checked while the run goes.
 //
-// Every sum over particles or points adds terms a parallel loop wrote to an
-// array in an order that depends only on their count (fixed chunks of
-// particles, interleaved partial sums over points), so the books are
+// Every sum over particles or points adds fixed chunks of them, each in index
+// (or row) order on a thread, then the chunks' sums in a fixed order
+// (ParticleEnergyTerms here, PointChunks for the points), so the books are
 // identical for any thread count.
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/parallel.hpp>
-#include <sphshell/core/statistics.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/solver/options.hpp>
 #include <sphshell/solver/particles.hpp>
@@ -189,10 +188,11 @@ class EnergyLedger {
     kinetic_energy_ = sums.kinetic;
   }
 
-  // The internal work of one force evaluation, per point in index order.
-  void book_internal_work(const std::vector<double>& work_increments) {
+  // The internal work of one force evaluation, summed over the points
+  // (InternalForceAssembler::internal_work).
+  void book_internal_work(double work) {
     previous_internal_energy_ = internal_energy_;
-    internal_energy_ += detail::interleaved_sum(work_increments);
+    internal_energy_ += work;
   }
 
   // After a static solve (solver/static_solution.hpp): the shell at rest

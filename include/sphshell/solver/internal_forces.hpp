@@ -17,10 +17,13 @@
 // still in the cache. Done as two separate passes, the sum read them back
 // from memory once the model outgrew the cache (a 401×401 plate's step cost
 // 1.6 times a 51×51 plate's per particle; docs/performance.md, third round). A particle's
-// sum is the same whenever it is formed, so results do not change.
+// sum is the same whenever it is formed, so results do not change. The points'
+// work is summed in the same pass, chunk by chunk (PointChunks), after the run
+// that integrated the chunk's points.
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/parallel.hpp>
+#include <sphshell/core/statistics.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/shell/cell_shear.hpp>
 #include <sphshell/shell/kinematics.hpp>
@@ -66,6 +69,9 @@ class InternalForceAssembler {
     // completes; a band of particles whose points lie in several segments is
     // summed by the segment that finishes its share of them last.
     const ForceSum<Approx> sum(points, *this);
+    const PointChunks chunks(points);
+    work_chunk_sums_.resize(chunks.count());
+    const auto work_of = [this](std::size_t p) { return work_increment_[p]; };
     failures_.assign(schedule_.segments(), PointFailure{});
     band_countdown_.start(schedule_);
     parallel::for_each_task(schedule_.segments(), [&](std::size_t segment) noexcept {
@@ -79,6 +85,7 @@ class InternalForceAssembler {
             failure.keep_lowest(rows.group, row, std::current_exception());
           }
         }
+        sum_run_chunks(points, chunks, rows, work_of, work_chunk_sums_.data());
         for (const std::uint32_t i : schedule_.completed_by(run)) sum(i, forces);
         for (const std::uint32_t band : schedule_.bands_after(run))
           if (band_countdown_.report(band))
@@ -86,6 +93,7 @@ class InternalForceAssembler {
       }
     });
     report_failure(at, points);
+    internal_work_ = detail::interleaved_sum(work_chunk_sums_);
   }
 
   // Forces of one point's stored resultants (no material update), from the
@@ -126,33 +134,45 @@ class InternalForceAssembler {
     parallel::for_each(std::size_t{0}, forces.internal.size(), [&](std::size_t i) noexcept { sum(i, forces); });
   }
 
-  // Calls body(p) for every point p, each thread taking the points it updates
-  // in compute(), whose data its core's cache then still holds; a pass over
-  // all points in index order would move a quarter of them to the other
-  // core and back on two threads (README, "Thread counts"). Before the first
-  // compute(), or after the points' force entries or the thread count
-  // changed, the points in index order. body must not throw and writes only
-  // what belongs to p.
-  template <class Approx, class Body>
-  void for_each_point(const IntegrationPoints<Approx>& points, Body&& body) const {
-    if (!schedule_.is_current(points, segment_count())) {
-      parallel::for_each(std::size_t{0}, points.size(), [&](std::size_t p) noexcept { body(p); });
-      return;
+  // The sum over the points of value(p) in fixed chunks (PointChunks): each
+  // chunk added in row order on the thread that updates its points in
+  // compute(), whose core's cache then still holds their data, then the
+  // chunks' sums in chunk order, so the sum is the same for any thread count.
+  // A pass over the points in index order would move a quarter of them to the
+  // other core and back on two threads (README, "Thread counts"); added on the
+  // calling thread, half of them (docs/performance.md, eleventh round). Before
+  // the first compute(), or after the points' force entries or the thread
+  // count changed, the chunks in turn. value must not throw.
+  template <class Approx, class Value>
+  double sum_over_points(const IntegrationPoints<Approx>& points, Value&& value) const {
+    const PointChunks chunks(points);
+    std::vector<double> chunk_sums(chunks.count(), 0.0);
+    if (schedule_.is_current(points, segment_count())) {
+      parallel::for_each_task(schedule_.segments(), [&](std::size_t segment) noexcept {
+        for (std::size_t run = schedule_.first_run(segment); run < schedule_.end_run(segment); ++run)
+          sum_run_chunks(points, chunks, schedule_.run(run), value, chunk_sums.data());
+      });
+    } else {
+      parallel::for_each_task(chunks.count(), [&](std::size_t c) noexcept {
+        const PointGroup group = chunks.group(c);
+        const std::size_t first = chunks.first_row(c);
+        const AssemblySchedule::Run rows{group, first, std::min(first + PointChunks::rows, points.count(group))};
+        sum_run_chunks(points, chunks, rows, value, chunk_sums.data());
+      });
     }
-    parallel::for_each_task(schedule_.segments(), [&](std::size_t segment) noexcept {
-      for (std::size_t run = schedule_.first_run(segment); run < schedule_.end_run(segment); ++run) {
-        const AssemblySchedule::Run& rows = schedule_.run(run);
-        for (std::size_t row = rows.first_row; row < rows.end_row; ++row) body(points.point(rows.group, row));
-      }
-    });
+    return detail::interleaved_sum(chunk_sums);
   }
+
+  // The work of the generalized stresses over the last compute(), summed over
+  // the points as sum_over_points() does.
+  double internal_work() const { return internal_work_; }
 
   // The point whose failure stopped the last compute() (the lowest failing
   // index of its group).
   std::size_t failed_point() const { return failed_point_; }
 
   // Work of the generalized stresses over the last update, per point (zero
-  // for inactive points), for the energy ledger.
+  // for inactive points), for the distributed ledger (mpi/distributed_ledger.hpp).
   const std::vector<double>& work_increments() const { return work_increment_; }
 
   // Strains of point p's current gradients against its reference (the
@@ -212,6 +232,19 @@ class InternalForceAssembler {
     const approx::ShapeValue* value_of_[2];
     std::size_t first_particle_point_;
   };
+
+  // The sums of value(p) over the chunks of a run's rows (a run starts at a
+  // chunk's first row and ends at a chunk's end), each in row order.
+  template <class Approx, class Value>
+  static void sum_run_chunks(const IntegrationPoints<Approx>& points, const PointChunks& chunks,
+                             const AssemblySchedule::Run& rows, Value& value, double* chunk_sums) {
+    for (std::size_t first = rows.first_row; first < rows.end_row; first += PointChunks::rows) {
+      const std::size_t end = std::min(first + PointChunks::rows, rows.end_row);
+      double sum = 0.0;
+      for (std::size_t row = first; row < end; ++row) sum += value(points.point(rows.group, row));
+      chunk_sums[chunks.chunk_of(rows.group, first)] = sum;
+    }
+  }
 
   // The lowest failing point of a segment, in the order of the separate
   // passes (every stress point before every particle point), so that the
@@ -384,6 +417,8 @@ class InternalForceAssembler {
   std::vector<shell::ConjugateForces> conjugate_;
   std::vector<Vector3> tied_force_, tied_director_force_;
   std::vector<double> work_increment_;
+  std::vector<double> work_chunk_sums_;  // per PointChunks chunk, in the last compute()
+  double internal_work_ = 0.0;
   std::vector<PackedKinematics> packed_;  // this step's positions and directors
   AssemblySchedule schedule_;
   std::vector<PointFailure> failures_;  // per segment of the last compute()
