@@ -20,7 +20,10 @@
 //   Π_s = ½ Σ_k (κs G d A / m) |γ_k|² = ½ eᵀ C e,  C = Σ_k (κs G d A / m) P_kᵀ (T_k T_kᵀ)⁻¹ P_k.
 // A uniform shear field is recovered exactly at every corner (the patch test),
 // and every edge strain is penalised, so the checkerboard deflection that a
-// one-point (cell-centre) shear cannot see has stiffness.
+// one-point (cell-centre) shear cannot see has stiffness. Corner k couples
+// only its two edges, k − 1 and k, so C is cyclic tridiagonal: its diagonal
+// and one coupling per corner hold it (a full 4 × 4 matrix held 16 numbers
+// for 8; of a triangle's 3 × 3 every entry is one of them).
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/frame.hpp>
@@ -37,7 +40,7 @@
 namespace sphshell::shell {
 
 inline constexpr int max_cell_corners = 4;
-using CellShearMatrix = Eigen::Matrix<double, max_cell_corners, max_cell_corners>;
+using CellEdgeVector = Eigen::Matrix<double, max_cell_corners, 1>;
 
 // What is fixed about one cell's tied shear (reference configuration). Edge e
 // runs from corner e to corner (e + 1) mod corners. CellShearTie is what both
@@ -48,7 +51,10 @@ struct CellShearTie {
   std::array<int, max_cell_corners> particle{};             // corner particle indices
   std::array<double, max_cell_corners> inverse_length{};    // 1 / ℓ_ab
   std::array<double, max_cell_corners> reference_strain{};  // chord·normal_sum / (2ℓ)
-  CellShearMatrix stiffness = CellShearMatrix::Zero();      // C (N/m × m²: κs G d A per unit strain²)
+  // C (N/m × m²: κs G d A per unit strain²): C_ee, and C_{k−1,k} = C_{k,k−1}
+  // of the two edges that meet at corner k.
+  std::array<double, max_cell_corners> diagonal{};
+  std::array<double, max_cell_corners> coupling{};
 };
 struct CellShearEdges {
   CellShearEdges() {
@@ -95,10 +101,9 @@ inline CellShearTying tie_cell_shear(const int* corners, int corner_count, const
                                 std::sqrt(std::max(0.0, sine_squared)), "must not vanish (a degenerate cell)");
     // (T Tᵀ)⁻¹ for the unit tangents of the two edges: the inverse Gram matrix.
     const double scale = corner_weight / sine_squared;
-    tying.stiffness(before, before) += scale;
-    tying.stiffness(k, k) += scale;
-    tying.stiffness(before, k) -= scale * cosine;
-    tying.stiffness(k, before) -= scale * cosine;
+    tying.diagonal[std::size_t(before)] += scale;
+    tying.diagonal[std::size_t(k)] += scale;
+    tying.coupling[std::size_t(k)] -= scale * cosine;
   }
   return tying;
 }
@@ -119,6 +124,31 @@ struct CellShearForces {
 // not (k + 1) % corners, whose integer division cost more than the rest of a
 // cell's edge in the step's hot loop.
 inline int next_corner(int k, int corners) { return k + 1 < corners ? k + 1 : 0; }
+inline int previous_corner(int k, int corners) { return k > 0 ? k - 1 : corners - 1; }
+
+// ∂Π/∂e = C e for a cell of a known corner count, each row's terms added in
+// column order, as the product with the full matrix added them (less the
+// zeros of the edges that share no corner), so the forces keep their bits.
+// The entries past the corner count stay zero.
+template <int Corners>
+inline CellEdgeVector tied_edge_forces(const CellShearTie& t, const CellEdgeVector& strain) {
+  CellEdgeVector edge_force = CellEdgeVector::Zero();
+  for (int e = 0; e < Corners; ++e) {
+    const int before = previous_corner(e, Corners), after = next_corner(e, Corners);
+    double sum = 0.0;
+    bool started = false;
+    for (int k = 0; k < Corners; ++k) {
+      if (k != e && k != before && k != after) continue;  // C_ek = 0
+      const double c = k == e ? t.diagonal[std::size_t(e)]
+                       : k == after ? t.coupling[std::size_t(after)]  // edges e and e + 1 meet at corner e + 1
+                                    : t.coupling[std::size_t(e)];     // edges e − 1 and e at corner e
+      sum = started ? sum + c * strain[k] : c * strain[k];
+      started = true;
+    }
+    edge_force[e] = sum;
+  }
+  return edge_force;
+}
 
 // corner_shear_forces for a cell of a known corner count, so the edge loops
 // unroll. The edges' chords and director sums are kept from the strains for
@@ -129,7 +159,7 @@ template <int Corners, class CornerPosition, class CornerDirector>
 inline double corner_shear_forces_of(const CellShearTie& t, const CellShearEdges* edges, const CornerPosition& x,
                                      const CornerDirector& d, bool nonlinear, Vector3* force, Vector3* director_force) {
   std::array<Vector3, Corners> chord, director_sum;
-  Eigen::Matrix<double, max_cell_corners, 1> strain = Eigen::Matrix<double, max_cell_corners, 1>::Zero();
+  CellEdgeVector strain = CellEdgeVector::Zero();
   for (int e = 0; e < Corners; ++e) {
     const int b = next_corner(e, Corners);
     chord[e] = x(b) - x(e);
@@ -140,7 +170,7 @@ inline double corner_shear_forces_of(const CellShearTie& t, const CellShearEdges
                                          edges->chord[e].dot(edges->normal_sum[e]);
     strain[e] = value * 0.5 * t.inverse_length[e] - t.reference_strain[e];
   }
-  const Eigen::Matrix<double, max_cell_corners, 1> edge_force = t.stiffness * strain;  // ∂Π/∂e
+  const CellEdgeVector edge_force = tied_edge_forces<Corners>(t, strain);  // ∂Π/∂e
   std::array<Vector3, Corners> corner_force, corner_director_force;
   corner_force.fill(Vector3::Zero());
   corner_director_force.fill(Vector3::Zero());
