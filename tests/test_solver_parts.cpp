@@ -17,6 +17,7 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 using namespace sphshell;
@@ -488,8 +489,9 @@ TEST_CASE("A sum over the points adds fixed chunks of rows in order, on any thre
   // of one group at a time, each chunk in row order, the stress points'
   // chunks first, then the chunks' sums as detail::interleaved_sum does. The
   // same order written out here must give the same bits whether the chunks
-  // follow the force pass's segments (after compute()) or come in turn
-  // (before it), on 1, 2 and 3 threads. The 111 × 87 plate's groups are no
+  // follow the force pass's segments (after compute()) or are tasks of their own
+  // (before it), on 1, 2 and 3 threads; and the force pass's own sum of its
+  // points' work (internal_work()) likewise. The 111 × 87 plate's groups are no
   // multiple of 64 rows, and on two threads the force pass's runs would be
   // 149 rows long if they were not cut to whole chunks.
   const SolverOptions options;
@@ -498,26 +500,32 @@ TEST_CASE("A sum over the points adds fixed chunks of rows in order, on any thre
   using Approx = approx::MLS<kernel::CubicSpline>;
   const solver::IntegrationPoints<Approx> points(plate, options.physics(), options.particle_integration(),
                                                  law.shear_modulus());
-  const auto value = [](std::size_t p) { return 1.0 / (1.0 + 0.37 * static_cast<double>(p)); };
+  // The sum in that order, and a long double sum of the same values.
   constexpr std::size_t chunk_rows = 64;
-  std::vector<double> chunk_sums;
-  long double exact = 0.0L;
-  for (const solver::PointGroup group : solver::point_groups)
-    for (std::size_t first = 0; first < points.count(group); first += chunk_rows) {
-      double sum = 0.0;
-      for (std::size_t row = first; row < std::min(first + chunk_rows, points.count(group)); ++row) {
-        sum += value(points.point(group, row));
-        exact += value(points.point(group, row));
+  const auto chunked_sum = [&](const auto& value) {
+    std::vector<double> chunk_sums;
+    long double exact = 0.0L;
+    for (const solver::PointGroup group : solver::point_groups)
+      for (std::size_t first = 0; first < points.count(group); first += chunk_rows) {
+        double sum = 0.0;
+        for (std::size_t row = first; row < std::min(first + chunk_rows, points.count(group)); ++row) {
+          sum += value(points.point(group, row));
+          exact += value(points.point(group, row));
+        }
+        chunk_sums.push_back(sum);
       }
-      chunk_sums.push_back(sum);
-    }
+    double partial[8] = {};
+    for (std::size_t c = 0; c < chunk_sums.size(); ++c) partial[c % 8] += chunk_sums[c];
+    double total = 0.0;
+    for (const double sum : partial) total += sum;
+    return std::make_pair(total, static_cast<double>(exact));
+  };
   REQUIRE(points.count(solver::PointGroup::stress_points) % chunk_rows != 0);
   REQUIRE(points.count(solver::PointGroup::particles) % chunk_rows != 0);
-  double partial[8] = {};
-  for (std::size_t c = 0; c < chunk_sums.size(); ++c) partial[c % 8] += chunk_sums[c];
-  double expected = 0.0;
-  for (const double sum : partial) expected += sum;
-  CHECK(std::abs(expected - static_cast<double>(exact)) <= 1e-14 * expected);
+  const auto value = [](std::size_t p) { return 1.0 / (1.0 + 0.37 * static_cast<double>(p)); };
+  const auto [expected, exact] = chunked_sum(value);
+  CHECK(std::abs(expected - exact) <= 1e-14 * expected);
+  std::vector<double> works;
   for (const int threads : {1, 2, 3}) {
 #ifdef _OPENMP
     omp_set_num_threads(threads);
@@ -532,10 +540,23 @@ TEST_CASE("A sum over the points adds fixed chunks of rows in order, on any thre
     assembler.compute(StepTime{}, particles, points, states, forces);
     CHECK(assembler.sum_over_points(points, value) == expected);
     CHECK(assembler.internal_work() == 0.0);  // at rest
+    // Bent (the directors left as they were, so the shear strains too): the
+    // pass's own sum of its points' work, formed inside the pass, in that
+    // order too, and positive (from rest, the work is the energy taken up).
+    for (Vector3& x : particles.position) x.z() += 0.02 * x.x() * x.x() + 0.01 * x.x() * x.y();
+    assembler.compute(StepTime{1, 0.0}, particles, points, states, forces);
+    const std::vector<double> work = assembler.work_increments();
+    const auto [expected_work, exact_work] = chunked_sum([&](std::size_t p) { return work[p]; });
+    CHECK(expected_work > 0.0);
+    CHECK(std::abs(expected_work - exact_work) <= 1e-13 * expected_work);
+    CHECK(assembler.internal_work() == expected_work);
+    works.push_back(assembler.internal_work());
   }
 #ifdef _OPENMP
   omp_set_num_threads(1);
 #endif
+  CHECK(works[1] == works[0]);
+  CHECK(works[2] == works[0]);
 }
 
 TEST_CASE("The assembly schedule sums each particle once, after every point that refers to it",

@@ -5,11 +5,11 @@
 //  - each index of the range is visited once, by one thread; a body writes
 //    only what belongs to its own index, so what it writes is the same
 //    whichever thread runs it and however many threads there are;
-//  - sums over indices are never formed inside the loop: a body writes its
-//    term to an array and the caller adds the array up in an order that
-//    depends only on the count (index order, fixed chunks, or
-//    detail::interleaved_sum), so reductions are identical for any thread
-//    count too;
+//  - sums over indices are never formed across tasks: a body writes its
+//    term to an array, or the sum of a fixed chunk of indices in index
+//    order, and the caller adds those up in an order that depends only on
+//    the count (index order, chunk order, or detail::interleaved_sum), so
+//    reductions are identical for any thread count too;
 //  - an exception must not leave a worker thread (that would call
 //    std::terminate): for_each keeps the error of the lowest failing index
 //    and rethrows it after the loop, the same one whatever the thread count;

@@ -21,9 +21,8 @@
 // A uniform shear field is recovered exactly at every corner (the patch test),
 // and every edge strain is penalised, so the checkerboard deflection that a
 // one-point (cell-centre) shear cannot see has stiffness. Corner k couples
-// only its two edges, k − 1 and k, so C is cyclic tridiagonal: its diagonal
-// and one coupling per corner hold it (a full 4 × 4 matrix held 16 numbers
-// for 8; of a triangle's 3 × 3 every entry is one of them).
+// only its two edges, k − 1 and k (mod m), so C is symmetric and cyclic
+// tridiagonal: its diagonal and one coupling per corner hold all of it.
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/frame.hpp>
@@ -52,7 +51,7 @@ struct CellShearTie {
   std::array<double, max_cell_corners> inverse_length{};    // 1 / ℓ_ab
   std::array<double, max_cell_corners> reference_strain{};  // chord·normal_sum / (2ℓ)
   // C (N/m × m²: κs G d A per unit strain²): C_ee, and C_{k−1,k} = C_{k,k−1}
-  // of the two edges that meet at corner k.
+  // of the two edges that meet at corner k (k − 1 taken mod corners).
   std::array<double, max_cell_corners> diagonal{};
   std::array<double, max_cell_corners> coupling{};
 };
@@ -127,8 +126,8 @@ inline int next_corner(int k, int corners) { return k + 1 < corners ? k + 1 : 0;
 inline int previous_corner(int k, int corners) { return k > 0 ? k - 1 : corners - 1; }
 
 // ∂Π/∂e = C e for a cell of a known corner count, each row's terms added in
-// column order, as the product with the full matrix added them (less the
-// zeros of the edges that share no corner), so the forces keep their bits.
+// column order (the zeros of the edges that share no corner left out), the
+// order of earlier versions' full-matrix product, so results match theirs.
 // The entries past the corner count stay zero.
 template <int Corners>
 inline CellEdgeVector tied_edge_forces(const CellShearTie& t, const CellEdgeVector& strain) {

@@ -142,7 +142,8 @@ class InternalForceAssembler {
   // other core and back on two threads (README, "Thread counts"); added on the
   // calling thread, half of them (docs/performance.md, eleventh round). Before
   // the first compute(), or after the points' force entries or the thread
-  // count changed, the chunks in turn. value must not throw.
+  // count changed, each chunk is a task of its own (same sums, any thread).
+  // value must not throw.
   template <class Approx, class Value>
   double sum_over_points(const IntegrationPoints<Approx>& points, Value&& value) const {
     const PointChunks chunks(points);
