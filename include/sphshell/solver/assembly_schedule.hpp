@@ -32,8 +32,8 @@
 namespace sphshell::solver {
 
 // The fixed chunks of a sum over the points (the energy books): consecutive
-// rows of one group, AssemblySchedule::rows_per_sum_chunk at most, the stress
-// points' chunks first. Each chunk is added in row order, then the chunks'
+// rows of one group, PointChunks::rows at most, the stress points' chunks
+// first. Each chunk is added in row order, then the chunks'
 // sums in chunk order (InternalForceAssembler::sum_over_points): the chunks
 // depend only on the groups' sizes, so the sum is the same for any thread count.
 class PointChunks {
@@ -83,12 +83,11 @@ class AssemblySchedule {
   // that integrated them, eight per thread took about 0.93 of the time of two
   // summed after the pass, four about 0.95 (docs/performance.md, fifth round).
   static constexpr std::size_t segments_per_thread = 8;
-  // Rows of one group per partial sum of a sum over the points (PointChunks).
-  // Every run starts at a multiple of it, so each chunk lies in one run and is
-  // summed by the thread that integrated its points.
-  static constexpr std::size_t rows_per_sum_chunk = PointChunks::rows;
-  static_assert(min_rows_per_run % rows_per_sum_chunk == 0 && max_rows_per_run % rows_per_sum_chunk == 0,
-                "AssemblySchedule: a run's length must be a whole number of sum chunks");
+  // Every run starts at a multiple of PointChunks::rows, so each chunk of a
+  // sum over the points lies in one run and is summed by the thread that
+  // integrated its points.
+  static_assert(min_rows_per_run % PointChunks::rows == 0 && max_rows_per_run % PointChunks::rows == 0,
+                "AssemblySchedule: a run's length must be a whole number of PointChunks");
 
   struct Run {
     PointGroup group;
@@ -152,12 +151,12 @@ class AssemblySchedule {
     for (std::vector<std::size_t>& first_rows : group_run_first_row_) first_rows.clear();
     for (std::vector<std::uint32_t>& index : group_run_index_) index.clear();
     const std::size_t count[2] = {points.count(PointGroup::stress_points), points.count(PointGroup::particles)};
-    // A whole number of sum chunks (rows_per_sum_chunk).
+    // A whole number of PointChunks.
     const std::size_t rows_per_run =
         segment_count_ == 1
             ? max_rows_per_run
             : std::clamp(points.size() / (segment_count_ * min_runs_per_segment), min_rows_per_run, max_rows_per_run) /
-                  rows_per_sum_chunk * rows_per_sum_chunk;
+                  PointChunks::rows * PointChunks::rows;
     std::size_t next[2] = {0, 0};
     while (next[0] < count[0] || next[1] < count[1]) {
       // The group less far through its rows goes next (next/count compared
