@@ -24,18 +24,22 @@ using namespace sphshell;
 
 namespace {
 
-// Counts its calls and otherwise steps exactly as the central difference.
+// Counts the particles it updates and otherwise steps exactly as the central
+// difference. The solver calls it on chunks of particles from several threads
+// at once, so the counts are atomic (shared by copies of the stepper).
 struct CountingStepper : stepper::CentralDifference {
-  long velocity_updates = 0;
-  long configuration_updates = 0;
+  std::shared_ptr<std::atomic<long>> velocity_updates = std::make_shared<std::atomic<long>>(0);
+  std::shared_ptr<std::atomic<long>> configuration_updates = std::make_shared<std::atomic<long>>(0);
   void advance_velocities(const stepper::StepContext& context, solver::ParticleState& state,
-                          const solver::Inertia& inertia, const solver::ParticleForces& forces) {
-    ++velocity_updates;
-    CentralDifference::advance_velocities(context, state, inertia, forces);
+                          const solver::Inertia& inertia, const solver::ParticleForces& forces, std::size_t first,
+                          std::size_t last) {
+    *velocity_updates += static_cast<long>(last - first);
+    CentralDifference::advance_velocities(context, state, inertia, forces, first, last);
   }
-  void advance_configuration(const stepper::StepContext& context, solver::ParticleState& state) {
-    ++configuration_updates;
-    CentralDifference::advance_configuration(context, state);
+  void advance_configuration(const stepper::StepContext& context, solver::ParticleState& state, std::size_t first,
+                             std::size_t last) {
+    *configuration_updates += static_cast<long>(last - first);
+    CentralDifference::advance_configuration(context, state, first, last);
   }
 };
 
@@ -43,8 +47,8 @@ struct CountingStepper : stepper::CentralDifference {
 struct FrozenStepper {
   double velocity_step(long, double time_step) const { return time_step; }
   void advance_velocities(const stepper::StepContext&, solver::ParticleState&, const solver::Inertia&,
-                          const solver::ParticleForces&) {}
-  void advance_configuration(const stepper::StepContext&, solver::ParticleState&) {}
+                          const solver::ParticleForces&, std::size_t, std::size_t) {}
+  void advance_configuration(const stepper::StepContext&, solver::ParticleState&, std::size_t, std::size_t) {}
 };
 
 struct NotAStepper {
@@ -77,8 +81,10 @@ TEST_CASE("A user stepper passed as the fifth parameter advances the solver", "[
     counted.step();
     reference.step();
   }
-  CHECK(counted.integrator().velocity_updates == steps);
-  CHECK(counted.integrator().configuration_updates == steps);
+  // Every particle once per step.
+  const long particles = static_cast<long>(counted.particle_count());
+  CHECK(*counted.integrator().velocity_updates == steps * particles);
+  CHECK(*counted.integrator().configuration_updates == steps * particles);
   // The counting stepper steps as the default one: the same state, bit for bit.
   const int centre = counted.model().nearest_particle(Vector3(0.1, 0.1, 0.0));
   CHECK(counted.displacement(centre).z() != 0.0);
@@ -445,6 +451,79 @@ TEST_CASE("A plate's step is bitwise the same on 1, 2 and 3 threads", "[core][pa
     CHECK(positions[run] == positions[0]);
     CHECK(directors[run] == directors[0]);
   }
+}
+
+namespace {
+// Steps as the central difference, then makes three particles' positions NaN
+// from step 3 on (a blow-up the solver must report).
+struct PoisonStepper : stepper::CentralDifference {
+  static constexpr long first_poisoned_step = 3;
+  void advance_configuration(const stepper::StepContext& context, solver::ParticleState& state, std::size_t first,
+                             std::size_t last) {
+    CentralDifference::advance_configuration(context, state, first, last);
+    if (context.at.step < first_poisoned_step) return;
+    for (const std::size_t i : {std::size_t{1200}, std::size_t{700}, std::size_t{301}})
+      if (first <= i && i < last) state.position[i].x() = std::nan("");
+  }
+};
+}  // namespace
+
+TEST_CASE("A step's particle pass reports failures as its parts one after the other would, on any thread count",
+          "[solver][parallel][errors]") {
+  // 41 × 31 = 1271 particles: five chunks of the pass, on 1, 2 and 3 threads.
+  const ShellModel plate = ShellModel::rectangular_plate(0.4, 0.3, 41, 31, 0.004);
+  REQUIRE(plate.particle_count() > 4 * solver::ParticleEnergyTerms::sum_chunk);
+  using Plate = Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<3>, material::Elastic>;
+  using PoisonedPlate =
+      Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<3>, material::Elastic, crack::None, PoisonStepper>;
+  const double nan = std::nan("");
+  for (const int threads : {1, 2, 3}) {
+#ifdef _OPENMP
+    omp_set_num_threads(threads);
+#endif
+    INFO("threads " << threads);
+    // Step 3 is the first whose loads (at the step's start, 3 Δt) and
+    // prescribed velocities (at its middle, 3.5 Δt) are taken past 2.75 Δt.
+    const auto failing_after = [](double time_step) { return 2.75 * time_step; };
+
+    // A non-finite state: the lowest particle, at the step's end.
+    {
+      PoisonedPlate solver(plate, {70e9, 0.3});
+      solver.clamp(solver.model().set("boundary"));
+      for (int n = 0; n < PoisonStepper::first_poisoned_step; ++n) solver.step();
+      CHECK_THROWS_WITH(solver.step(), Catch::Contains("unstable at step 4,") &&
+                                           Catch::Contains("non-finite state at particle 301 "));
+    }
+    // A prescribed motion that is not finite: the first condition in the
+    // order they were added (1200, not the lowest particle), at the step's
+    // start; it comes before the non-finite state it leaves.
+    {
+      PoisonedPlate solver(plate, {70e9, 0.3});
+      const double after = failing_after(solver.time_step());
+      solver.prescribe_velocity({1200, 700, 301}, [after, nan](const Vector3&, double t) {
+        return t > after ? Vector3(nan, 0.0, 0.0) : Vector3::Zero();
+      });
+      for (int n = 0; n < 3; ++n) solver.step();
+      CHECK_THROWS_WITH(solver.step(), Catch::Contains("unstable at step 3,") &&
+                                           Catch::Contains("prescribed motion of particle 1200 is not finite"));
+    }
+    // A non-finite load: the lowest particle, before the failing motion.
+    {
+      Plate solver(plate, {70e9, 0.3});
+      const double after = failing_after(solver.time_step());
+      solver.prescribe_velocity({1200, 700, 301}, [after, nan](const Vector3&, double t) {
+        return t > after ? Vector3(nan, 0.0, 0.0) : Vector3::Zero();
+      });
+      solver.add_point_force({1250, 640, 900}, Vector3(0.0, 0.0, 1.0),
+                             [after, nan](double t) { return t > after ? nan : 1.0; });
+      for (int n = 0; n < 3; ++n) solver.step();
+      CHECK_THROWS_WITH(solver.step(), Catch::Contains("unstable at step 3,") &&
+                                           Catch::Contains("non-finite external load at particle 640 "));
+    }
+  }
+#ifdef _OPENMP
+  omp_set_num_threads(1);
+#endif
 }
 
 TEST_CASE("The energy books are the same on 1, 2 and 3 threads and add up every particle", "[core][parallel]") {

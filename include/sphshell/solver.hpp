@@ -53,7 +53,10 @@
 #include <cstring>
 #include <limits>
 #include <array>
+#include <atomic>
+#include <exception>
 #include <memory>
+#include <mutex>
 #include <new>
 #include <sstream>
 #include <string>
@@ -400,18 +403,11 @@ class Solver {
     if (steps_ == 0) output_.start(*this);
     const stepper::StepContext context{now(), time_step_, stepper_.velocity_step(steps_, time_step_),
                                        options_.damping};
-    apply_loads(context.at);
-    ledger_.remember_velocities(particles_);
-    stepper_.advance_velocities(context, particles_, inertia_, forces_);
-    ledger_.remember_free_velocities(particles_);
-    constraints_.impose(context.at, model_.particle_position, time_step_, particles_.director, particles_.velocity,
-                        particles_.angular_velocity);
-    ledger_.book_step(context, particles_, inertia_, forces_);
-    stepper_.advance_configuration(context, particles_);
+    const std::size_t unstable = advance_particles(context);
     ++steps_;
     time_ = start_time_ + static_cast<double>(steps_) * time_step_;  // t = t0 + n Δt, never summed
     forces_current_ = false;
-    check_configuration();
+    if (unstable < particles_.size()) fail_non_finite_state(unstable);
     compute_internal_forces();
     if constexpr (Crack::enabled) fracture_.update(fracture_parts());
     if (solver::EnergyLedger::is_check_step(steps_)) ledger_.check_balance(now(), energy());
@@ -630,10 +626,13 @@ class Solver {
   }
 
   void apply_loads(const StepTime& at) {
-    detail::LoadContext context{at.time,           model_.particle_position, model_.particle_normal,
-                                particles_.director, model_.particle_area,  inertia_.mass,
-                                forces_.external,  forces_.external_moment};
+    detail::LoadContext context = load_context_at(at.time);
     loads_.apply(at, context);
+  }
+  detail::LoadContext load_context_at(double time) {
+    return {time,         model_.particle_position, model_.particle_normal,
+            particles_.director, model_.particle_area,  inertia_.mass,
+            forces_.external,    forces_.external_moment};
   }
 
   void compute_internal_forces() {
@@ -642,14 +641,76 @@ class Solver {
     forces_current_ = true;
   }
 
-  void check_configuration() const {
-    parallel::for_each(std::size_t{0}, particles_.size(), [&](std::size_t i) {
-      if (!all_finite(particles_.position[i], particles_.director[i], particles_.velocity[i],
-                      particles_.angular_velocity[i]))
-        detail::fail_unstable(now(), "non-finite state at particle " + std::to_string(i) + " (external force " +
-                                         solver::number_text(forces_.external[i].norm()) + " N, internal force " +
-                                         solver::number_text(forces_.internal[i].norm()) + " N)");
+  // The particles' part of a step, in one parallel pass over the energy
+  // books' chunks of particles (ParticleEnergyTerms::sum_chunk), each chunk on
+  // one thread and in this order: its loads, the stepper's velocity update,
+  // the kinematic conditions, its energy terms, the configuration update, and
+  // a look for non-finite values, while the chunk's data is in that core's
+  // cache. The parts one after the other took eight parallel regions, each
+  // costing two threads more than the part's work on the paper's plate
+  // (docs/performance.md, twelfth round). Serial loads (user pressure
+  // functions, detail::Load::serial) are applied before the pass.
+  // Failures are reported as the parts would one after the other: a
+  // non-finite load (the lowest particle), then a failing condition (the
+  // first in the order they were added); the lowest particle with a
+  // non-finite position, director or velocity is returned (particle count if
+  // none) for advance() to report at the step's end time.
+  std::size_t advance_particles(const stepper::StepContext& context) {
+    const bool loads_in_pass = loads_.applies_in_chunks();
+    if (loads_in_pass) {
+      loads_.start_step(context.at.time);
+    } else {
+      apply_loads(context.at);
+    }
+    detail::LoadContext load_context = load_context_at(context.at.time);
+    constraints_.prepare();
+    ledger_.start_step(particles_);
+    const std::size_t count = particles_.size();
+    std::atomic<std::size_t> load_failure{count}, state_failure{count};
+    std::mutex condition_mutex;
+    std::size_t failed_condition = constraints_.particles().size();
+    std::exception_ptr condition_error;
+    const auto keep_lowest = [](std::atomic<std::size_t>& lowest, std::size_t i) noexcept {
+      std::size_t current = lowest.load();
+      while (i < current && !lowest.compare_exchange_weak(current, i)) {
+      }
+    };
+    parallel::for_each_task(ledger_.chunk_count(particles_), [&](std::size_t chunk) noexcept {
+      const auto [first, last] = solver::EnergyLedger::particle_chunk(particles_, chunk);
+      if (loads_in_pass) {
+        const std::size_t i = loads_.apply_range(load_context, first, last);
+        if (i < last) keep_lowest(load_failure, i);
+      }
+      ledger_.remember_velocities(particles_, first, last);
+      stepper_.advance_velocities(context, particles_, inertia_, forces_, first, last);
+      ledger_.remember_free_velocities(particles_, first, last);
+      constraints_.impose(context.at, model_.particle_position, time_step_, particles_.director, particles_.velocity,
+                          particles_.angular_velocity, first, last, [&](std::size_t k, std::exception_ptr error) {
+                            std::lock_guard<std::mutex> lock(condition_mutex);
+                            if (k < failed_condition) {
+                              failed_condition = k;
+                              condition_error = std::move(error);
+                            }
+                          });
+      ledger_.book_chunk(context, particles_, inertia_, forces_, chunk);
+      stepper_.advance_configuration(context, particles_, first, last);
+      for (std::size_t i = first; i < last; ++i)
+        if (!all_finite(particles_.position[i], particles_.director[i], particles_.velocity[i],
+                        particles_.angular_velocity[i])) {
+          keep_lowest(state_failure, i);
+          break;
+        }
     });
+    ledger_.finish_step();
+    if (load_failure.load() < count) ExternalLoads::fail_non_finite(context.at, load_failure.load());
+    if (condition_error) std::rethrow_exception(condition_error);
+    return state_failure.load();
+  }
+
+  [[noreturn]] void fail_non_finite_state(std::size_t i) const {
+    detail::fail_unstable(now(), "non-finite state at particle " + std::to_string(i) + " (external force " +
+                                     solver::number_text(forces_.external[i].norm()) + " N, internal force " +
+                                     solver::number_text(forces_.internal[i].norm()) + " N)");
   }
 
   ShellModel model_;

@@ -4,7 +4,8 @@
 struct HalfAStepper {
   double velocity_step(long, double time_step) const { return time_step; }
   void advance_velocities(const sphshell::stepper::StepContext&, sphshell::solver::ParticleState&,
-                          const sphshell::solver::Inertia&, const sphshell::solver::ParticleForces&) {}
+                          const sphshell::solver::Inertia&, const sphshell::solver::ParticleForces&, std::size_t,
+                          std::size_t) {}
 };
 
 int main() {

@@ -702,11 +702,17 @@ class DistributedSolver {
     std::optional<Failure> failure;
     apply_loads(context.at, failure);
     ledger_->remember_velocities(particles_);
-    stepper_.advance_velocities(context, particles_, inertia_, forces_);
+    parallel::for_each_range(particles_.ranges.owned_begin, particles_.ranges.owned_end,
+                             [&](std::size_t first, std::size_t last) noexcept {
+                               stepper_.advance_velocities(context, particles_, inertia_, forces_, first, last);
+                             });
     ledger_->remember_free_velocities(particles_);
     impose_conditions(context.at, failure);
     ledger_->book_step(context, particles_, inertia_, forces_);
-    stepper_.advance_configuration(context, particles_);
+    parallel::for_each_range(particles_.ranges.owned_begin, particles_.ranges.owned_end,
+                             [&](std::size_t first, std::size_t last) noexcept {
+                               stepper_.advance_configuration(context, particles_, first, last);
+                             });
     ++steps_;
     time_ = start_time_ + static_cast<double>(steps_) * time_step_;  // t = t0 + n Δt, as the Solver
     forces_current_ = false;

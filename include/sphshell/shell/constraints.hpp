@@ -11,6 +11,9 @@
 #include <sphshell/core/parallel.hpp>
 #include <sphshell/core/types.hpp>
 
+#include <algorithm>
+#include <cstddef>
+#include <exception>
 #include <memory>
 #include <string>
 #include <unordered_map>
@@ -167,28 +170,44 @@ class Constraints {
   // the angular velocity onto the free rotations normal to the director.
   // The position update always spans time_step (also on the half-step
   // start-up of the velocities), so the imposed velocity does too.
+  // On failure (a prescribed motion that is not finite, or whose function
+  // throws) the error of the lowest failing condition, in the order they
+  // were added, is thrown after the others are imposed.
   void impose(const StepTime& at, const std::vector<Vector3>& reference_position, double time_step,
               const std::vector<Vector3>& director, std::vector<Vector3>& velocity,
               std::vector<Vector3>& angular_velocity) const {
     parallel::for_each(std::size_t{0}, particles_.size(), [&](std::size_t k) {
-      const int i = particles_[k];
-      const ParticleConstraint& constraint = entries_[k];
-      Vector3 prescribed = Vector3::Zero();
-      for (const PrescribedMotion* motion : constraint.motions)
-        prescribed += motion->velocity(i, reference_position[i], at.time, time_step);
-      if (!prescribed.allFinite())
-        fail_unstable(at, "prescribed motion of particle " + std::to_string(i) + " is not finite");
-      velocity[i] = constraint.free_translation * velocity[i] +
-                    (Matrix3::Identity() - constraint.free_translation) * prescribed;
-      // Project onto the free rotations and the plane normal to the director at
-      // once: projecting one after the other would let the drilling removal
-      // reintroduce a fixed component when the director is tilted.
-      Matrix3 free = constraint.free_rotation;
-      const Vector3 drilling = free * director[i];
-      if (drilling.squaredNorm() > negligible_drilling_squared)
-        free -= drilling * drilling.transpose() / drilling.squaredNorm();
-      angular_velocity[i] = free * angular_velocity[i];
+      impose_one(k, at, reference_position, time_step, director, velocity, angular_velocity);
     });
+  }
+
+  // The same for the conditions of particles [first, last) only, for a pass
+  // that steps the particles in chunks (Solver::advance_particles): call
+  // prepare() once after the last condition was added and before such
+  // passes. A failing condition k (its place in the order they were added)
+  // is handed to failed(k, error) and the others are imposed; failed must
+  // not throw.
+  void prepare() {
+    if (by_particle_.size() == entries_.size()) return;
+    by_particle_.resize(entries_.size());
+    for (std::size_t k = 0; k < entries_.size(); ++k) by_particle_[k] = k;
+    std::sort(by_particle_.begin(), by_particle_.end(),
+              [&](std::size_t a, std::size_t b) { return particles_[a] < particles_[b]; });
+  }
+  template <class Failed>
+  void impose(const StepTime& at, const std::vector<Vector3>& reference_position, double time_step,
+              const std::vector<Vector3>& director, std::vector<Vector3>& velocity,
+              std::vector<Vector3>& angular_velocity, std::size_t first, std::size_t last, Failed&& failed) const
+      noexcept {
+    const auto start = std::lower_bound(by_particle_.begin(), by_particle_.end(), first,
+                                        [&](std::size_t k, std::size_t i) { return std::size_t(particles_[k]) < i; });
+    for (auto it = start; it != by_particle_.end() && std::size_t(particles_[*it]) < last; ++it) {
+      try {
+        impose_one(*it, at, reference_position, time_step, director, velocity, angular_velocity);
+      } catch (...) {
+        failed(*it, std::current_exception());
+      }
+    }
   }
 
   bool empty() const { return particles_.empty(); }
@@ -196,6 +215,28 @@ class Constraints {
   const ParticleConstraint& at(std::size_t k) const { return entries_[k]; }
 
  private:
+  void impose_one(std::size_t k, const StepTime& at, const std::vector<Vector3>& reference_position, double time_step,
+                  const std::vector<Vector3>& director, std::vector<Vector3>& velocity,
+                  std::vector<Vector3>& angular_velocity) const {
+    const int i = particles_[k];
+    const ParticleConstraint& constraint = entries_[k];
+    Vector3 prescribed = Vector3::Zero();
+    for (const PrescribedMotion* motion : constraint.motions)
+      prescribed += motion->velocity(i, reference_position[i], at.time, time_step);
+    if (!prescribed.allFinite())
+      fail_unstable(at, "prescribed motion of particle " + std::to_string(i) + " is not finite");
+    velocity[i] = constraint.free_translation * velocity[i] +
+                  (Matrix3::Identity() - constraint.free_translation) * prescribed;
+    // Project onto the free rotations and the plane normal to the director at
+    // once: projecting one after the other would let the drilling removal
+    // reintroduce a fixed component when the director is tilted.
+    Matrix3 free = constraint.free_rotation;
+    const Vector3 drilling = free * director[i];
+    if (drilling.squaredNorm() > negligible_drilling_squared)
+      free -= drilling * drilling.transpose() / drilling.squaredNorm();
+    angular_velocity[i] = free * angular_velocity[i];
+  }
+
   ParticleConstraint& entry(int particle) {
     auto found = index_.find(particle);
     if (found != index_.end()) return entries_[found->second];
@@ -246,6 +287,7 @@ class Constraints {
 
   std::vector<int> particles_;
   std::vector<ParticleConstraint> entries_;
+  std::vector<std::size_t> by_particle_;  // entries_' indices by particle (prepare())
   std::unordered_map<int, std::size_t> index_;
   std::vector<std::unique_ptr<PrescribedMotion>> owned_;
 };

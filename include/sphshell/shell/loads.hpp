@@ -104,8 +104,10 @@ class Load {
   // The load's time factor at `time` (1 for a load without a time function).
   virtual double factor(double time) const = 0;
   // Adds the load, scaled by `factor`, to the particles of its set whose
-  // index is in [first, last). Unless serial(), it runs inside a parallel
-  // loop and must not throw (the library's loads are declared noexcept).
+  // index is in [first, last), reading only those particles' entries of the
+  // context (the solver steps other ranges meanwhile). Unless serial(), it
+  // runs inside a parallel loop and must not throw (the library's loads are
+  // declared noexcept).
   virtual void apply(LoadContext& context, double factor, std::size_t first, std::size_t last) const = 0;
   // True when apply() calls user code per particle: it is then called once,
   // on the whole range, by the calling thread.
@@ -248,9 +250,10 @@ class GravityLoad final : public Load {
 
 // The loads of a run: each applied in turn into zeroed force and moment
 // arrays; a load that produces a non-finite value stops the run.
-// Without a serial load (a pressure function p(X, t)) this is one pass over
-// the particles, shared by the threads: each thread zeroes a range, adds
-// every load to it and checks it while its particles are in cache. The sums
+// Without a serial load (a pressure function p(X, t)) the loads are part of
+// the solver's pass over the particles (apply_range): each thread zeroes a
+// range, adds every load to it and checks it while its particles are in
+// cache; apply() does the same in a pass of its own. The sums
 // are those of one load after the other (each particle receives its loads in
 // the order they were added), so they are the same for any thread count.
 class ExternalLoads {
@@ -263,22 +266,13 @@ class ExternalLoads {
   bool empty() const { return loads_.empty(); }
 
   void apply(const StepTime& at, detail::LoadContext& context) {
-    factors_.resize(loads_.size());
-    for (std::size_t l = 0; l < loads_.size(); ++l) factors_[l] = loads_[l]->factor(context.time);
+    start_step(context.time);
     const std::size_t count = context.force.size();
     std::atomic<std::size_t> first_non_finite{count};
-    const auto check = [&](std::size_t first, std::size_t last) noexcept {
-      for (std::size_t i = first; i < last; ++i)
-        if (!all_finite(context.force[i], context.moment[i])) {
-          note_lowest(first_non_finite, i);
-          return;
-        }
-    };
     if (!any_serial_) {
       parallel::for_each_range(std::size_t{0}, count, [&](std::size_t first, std::size_t last) noexcept {
-        zero(context, first, last);
-        for (std::size_t l = 0; l < loads_.size(); ++l) loads_[l]->apply(context, factors_[l], first, last);
-        check(first, last);
+        const std::size_t i = apply_range(context, first, last);
+        if (i < last) note_lowest(first_non_finite, i);
       });
     } else {
       parallel::for_each_range(std::size_t{0}, count,
@@ -293,15 +287,43 @@ class ExternalLoads {
             load.apply(context, factor, first, last);
           });
       }
-      parallel::for_each_range(std::size_t{0}, count, check);
+      parallel::for_each_range(std::size_t{0}, count, [&](std::size_t first, std::size_t last) noexcept {
+        const std::size_t i = first_non_finite_in(context, first, last);
+        if (i < last) note_lowest(first_non_finite, i);
+      });
     }
     const std::size_t i = first_non_finite.load();
-    if (i < count)
-      detail::fail_unstable(at, "non-finite external load at particle " + std::to_string(i) +
-                                    " (a pressure, force or moment function returned NaN or infinity)");
+    if (i < count) fail_non_finite(at, i);
+  }
+
+  // The same in a pass that steps the particles in chunks
+  // (Solver::advance_particles), possible when no load is serial(): start_step()
+  // once before the pass, then apply_range(context, first, last) for each chunk,
+  // which zeroes the chunk's forces and moments, adds every load to them and
+  // returns the first particle of the chunk whose load is not finite (last if
+  // none): the run then stops with fail_non_finite() at the lowest of them.
+  bool applies_in_chunks() const { return !any_serial_; }
+  void start_step(double time) {
+    factors_.resize(loads_.size());
+    for (std::size_t l = 0; l < loads_.size(); ++l) factors_[l] = loads_[l]->factor(time);
+  }
+  std::size_t apply_range(detail::LoadContext& context, std::size_t first, std::size_t last) const noexcept {
+    zero(context, first, last);
+    for (std::size_t l = 0; l < loads_.size(); ++l) loads_[l]->apply(context, factors_[l], first, last);
+    return first_non_finite_in(context, first, last);
+  }
+  [[noreturn]] static void fail_non_finite(const StepTime& at, std::size_t i) {
+    detail::fail_unstable(at, "non-finite external load at particle " + std::to_string(i) +
+                                  " (a pressure, force or moment function returned NaN or infinity)");
   }
 
  private:
+  static std::size_t first_non_finite_in(const detail::LoadContext& context, std::size_t first,
+                                         std::size_t last) noexcept {
+    for (std::size_t i = first; i < last; ++i)
+      if (!all_finite(context.force[i], context.moment[i])) return i;
+    return last;
+  }
   static void zero(detail::LoadContext& context, std::size_t first, std::size_t last) noexcept {
     for (std::size_t i = first; i < last; ++i) {
       context.force[i].setZero();

@@ -22,6 +22,7 @@
 #include <ostream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace sphshell {
@@ -49,42 +50,68 @@ namespace solver {
 // work over the step of the external forces and moments with the reactions of
 // the kinematic conditions, f · Δt · (v^{n−½} + v^{n+½})/2 with the reactions
 // m (v − v_free)/Δt; the damping work c m |v̄|²Δt; the kinetic energy at n+½.
-// Each term is written to an array by a parallel loop. The serial ledger adds
-// them in fixed chunks of particles (compute_and_sum()), the MPI one in index order, so
-// the books are identical for any thread count.
+// Each term is written to an array. The serial ledger adds them in fixed
+// chunks of sum_chunk particles, each in index order, then the chunks' sums in
+// chunk order (book_chunk(), total()); the MPI one in index order. So the
+// books are identical for any thread count.
 //
-// The copies of the velocities and the chunks run on the threads like the
-// stepper's loops: each thread then reads and writes the particles whose
-// velocities it updated. Done serially, they pulled half of the particles'
-// velocities to the calling thread's core every step, and the stepper's next
-// writes had to take them back (docs/performance.md, fifth round).
+// The members taking a range [first, last) are for the solver's particle
+// pass (Solver::advance_particles): the terms of a chunk of particles are
+// formed on the thread that steps that chunk, while its velocities are in
+// that core's cache. Done in a pass of their own on the calling thread, they
+// pulled half of the particles' velocities to that core every step, and the
+// stepper's next writes had to take them back (docs/performance.md, fifth
+// round). Call prepare() before a pass.
 class ParticleEnergyTerms {
  public:
-  // Particles per partial sum in compute_and_sum(): fixed, not per thread, so that the
-  // sums are the same whatever the thread count.
+  // Particles per partial sum in book_chunk(): fixed, not per thread, so that
+  // the sums are the same whatever the thread count.
   static constexpr std::size_t sum_chunk = 256;
 
-  // v^{n−½} and ω^{n−½}, before the stepper updates them.
-  void remember_velocities(const ParticleState& state) {
-    old_velocity_.resize(state.velocity.size());
-    old_angular_velocity_.resize(state.angular_velocity.size());
-    parallel::for_each(std::size_t{0}, state.velocity.size(), [&](std::size_t i) noexcept {
+  // The arrays for particles [0, end), and chunk sums for the chunks of [begin, end).
+  void prepare(std::size_t begin, std::size_t end) {
+    old_velocity_.resize(end);
+    old_angular_velocity_.resize(end);
+    free_velocity_.resize(end);
+    external_.resize(end);
+    damping_.resize(end);
+    kinetic_.resize(end);
+    chunk_sums_.assign(chunk_count(begin, end), Sums{});
+  }
+  static std::size_t chunk_count(std::size_t begin, std::size_t end) {
+    return (end - begin + sum_chunk - 1) / sum_chunk;
+  }
+
+  // v^{n−½} and ω^{n−½} of particles [first, last), before the stepper updates them.
+  void remember_velocities(const ParticleState& state, std::size_t first, std::size_t last) {
+    for (std::size_t i = first; i < last; ++i) {
       old_velocity_[i] = state.velocity[i];
       old_angular_velocity_[i] = state.angular_velocity[i];
-    });
+    }
   }
   // The velocities the unconstrained update produced, before the kinematic
   // conditions: their difference is the reactions' impulse.
+  void remember_free_velocities(const ParticleState& state, std::size_t first, std::size_t last) {
+    for (std::size_t i = first; i < last; ++i) free_velocity_[i] = state.velocity[i];
+  }
+  // The same for every particle, in parallel passes (the MPI ledger).
+  void remember_velocities(const ParticleState& state) {
+    prepare(0, state.velocity.size());
+    parallel::for_each_range(std::size_t{0}, state.velocity.size(),
+                             [&](std::size_t first, std::size_t last) noexcept {
+                               remember_velocities(state, first, last);
+                             });
+  }
   void remember_free_velocities(const ParticleState& state) {
-    free_velocity_.resize(state.velocity.size());
-    parallel::for_each(std::size_t{0}, state.velocity.size(),
-                       [&](std::size_t i) noexcept { free_velocity_[i] = state.velocity[i]; });
+    parallel::for_each_range(std::size_t{0}, state.velocity.size(),
+                             [&](std::size_t first, std::size_t last) noexcept {
+                               remember_free_velocities(state, first, last);
+                             });
   }
 
-  // The terms of particles [begin, end) (the arrays are sized to end).
+  // The terms of particles [begin, end) (the arrays are sized to end), in a parallel pass.
   void compute(const stepper::StepContext& context, const ParticleState& state, const Inertia& inertia,
                const ParticleForces& forces, std::size_t begin, std::size_t end) {
-    size_to(end);
     parallel::for_each(begin, end,
                        [&](std::size_t i) noexcept { compute_particle(i, context, state, inertia, forces); });
   }
@@ -93,24 +120,27 @@ class ParticleEnergyTerms {
   struct Sums {
     double external = 0.0, damping = 0.0, kinetic = 0.0;
   };
-  // compute() and the sums in one parallel pass: each chunk of sum_chunk
-  // particles is added in index order, then the chunks' sums in chunk order.
-  Sums compute_and_sum(const stepper::StepContext& context, const ParticleState& state, const Inertia& inertia,
-                       const ParticleForces& forces, std::size_t begin, std::size_t end) {
-    size_to(end);
-    const std::size_t chunks = (end - begin + sum_chunk - 1) / sum_chunk;
-    chunk_sums_.resize(chunks);
-    parallel::for_each_task(chunks, [&](std::size_t chunk) noexcept {
-      Sums sums;
-      const std::size_t last = std::min(end, begin + (chunk + 1) * sum_chunk);
-      for (std::size_t i = begin + chunk * sum_chunk; i < last; ++i) {
-        compute_particle(i, context, state, inertia, forces);
-        sums.external += external_[i];
-        sums.damping += damping_[i];
-        sums.kinetic += kinetic_[i];
-      }
-      chunk_sums_[chunk] = sums;
-    });
+  // The particles [first, last) of the chunks of [begin, end) that start at
+  // `begin`: chunk k holds [begin + k sum_chunk, begin + (k + 1) sum_chunk).
+  static std::size_t chunk_first(std::size_t begin, std::size_t chunk) { return begin + chunk * sum_chunk; }
+  static std::size_t chunk_last(std::size_t begin, std::size_t end, std::size_t chunk) {
+    return std::min(end, begin + (chunk + 1) * sum_chunk);
+  }
+  // The terms of chunk `chunk` of [begin, end) and their sums, added in index order.
+  void book_chunk(const stepper::StepContext& context, const ParticleState& state, const Inertia& inertia,
+                  const ParticleForces& forces, std::size_t begin, std::size_t end, std::size_t chunk) {
+    Sums sums;
+    const std::size_t last = chunk_last(begin, end, chunk);
+    for (std::size_t i = chunk_first(begin, chunk); i < last; ++i) {
+      compute_particle(i, context, state, inertia, forces);
+      sums.external += external_[i];
+      sums.damping += damping_[i];
+      sums.kinetic += kinetic_[i];
+    }
+    chunk_sums_[chunk] = sums;
+  }
+  // The chunks' sums (book_chunk) added in chunk order.
+  Sums total() const {
     Sums total;
     for (const Sums& sums : chunk_sums_) {
       total.external += sums.external;
@@ -125,11 +155,6 @@ class ParticleEnergyTerms {
   const std::vector<double>& kinetic() const { return kinetic_; }
 
  private:
-  void size_to(std::size_t end) {
-    external_.resize(end);
-    damping_.resize(end);
-    kinetic_.resize(end);
-  }
   void compute_particle(std::size_t i, const stepper::StepContext& context, const ParticleState& state,
                         const Inertia& inertia, const ParticleForces& forces) {
     const double dt = context.velocity_step;
@@ -171,18 +196,37 @@ class EnergyLedger {
   EnergyLedger(const MonitoringOptions& monitoring, double youngs_modulus, double volume)
       : monitoring_(monitoring), round_off_energy_(youngs_modulus * volume * round_off_strain_squared) {}
 
-  // v^{n−½} and ω^{n−½}, before the stepper updates them.
-  void remember_velocities(const ParticleState& state) { terms_.remember_velocities(state); }
-  // The velocities the unconstrained update produced, before the kinematic
-  // conditions: their difference is the reactions' impulse.
-  void remember_free_velocities(const ParticleState& state) { terms_.remember_free_velocities(state); }
-
-  // The step's work of the external forces (reactions included) and of the
-  // damping, and the kinetic energy at n+½ (ParticleEnergyTerms).
-  void book_step(const stepper::StepContext& context, const ParticleState& state, const Inertia& inertia,
-                 const ParticleForces& forces) {
-    const ParticleEnergyTerms::Sums sums =
-        terms_.compute_and_sum(context, state, inertia, forces, state.ranges.owned_begin, state.ranges.owned_end);
+  // The step's books (the particles' part of the step, Solver::advance_particles):
+  // start_step() before the pass; in it, for each chunk of particles
+  // (particle_chunk()), remember_velocities() before the stepper updates the
+  // velocities, remember_free_velocities() after it and before the kinematic
+  // conditions (their difference is the reactions' impulse), book_chunk()
+  // after them: the chunk's work of the external forces (reactions included)
+  // and of the damping, and its kinetic energy at n+½ (ParticleEnergyTerms);
+  // finish_step() after the pass.
+  void start_step(const ParticleState& state) {
+    terms_.prepare(state.ranges.owned_begin, state.ranges.owned_end);
+  }
+  std::size_t chunk_count(const ParticleState& state) const {
+    return ParticleEnergyTerms::chunk_count(state.ranges.owned_begin, state.ranges.owned_end);
+  }
+  // The particles [first, last) of chunk `chunk`.
+  static std::pair<std::size_t, std::size_t> particle_chunk(const ParticleState& state, std::size_t chunk) {
+    return {ParticleEnergyTerms::chunk_first(state.ranges.owned_begin, chunk),
+            ParticleEnergyTerms::chunk_last(state.ranges.owned_begin, state.ranges.owned_end, chunk)};
+  }
+  void remember_velocities(const ParticleState& state, std::size_t first, std::size_t last) {
+    terms_.remember_velocities(state, first, last);
+  }
+  void remember_free_velocities(const ParticleState& state, std::size_t first, std::size_t last) {
+    terms_.remember_free_velocities(state, first, last);
+  }
+  void book_chunk(const stepper::StepContext& context, const ParticleState& state, const Inertia& inertia,
+                  const ParticleForces& forces, std::size_t chunk) {
+    terms_.book_chunk(context, state, inertia, forces, state.ranges.owned_begin, state.ranges.owned_end, chunk);
+  }
+  void finish_step() {
+    const ParticleEnergyTerms::Sums sums = terms_.total();
     external_work_ += sums.external;
     damping_work_ += sums.damping;
     kinetic_energy_ = sums.kinetic;

@@ -9,7 +9,6 @@
 // steps, so the first update spans half a step. Mass-proportional damping is
 // taken at the mid-step velocity, which keeps the update explicit.
 
-#include <sphshell/core/parallel.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/stepper/stepper.hpp>
 
@@ -24,24 +23,25 @@ class CentralDifference {
   double velocity_step(long step, double time_step) const { return step == 0 ? 0.5 * time_step : time_step; }
 
   void advance_velocities(const StepContext& context, solver::ParticleState& state, const solver::Inertia& inertia,
-                          const solver::ParticleForces& forces) {
+                          const solver::ParticleForces& forces, std::size_t first, std::size_t last) {
     const double dt = context.velocity_step;
     const double c = context.damping;
     const double keep = (1.0 - 0.5 * c * dt) / (1.0 + 0.5 * c * dt);
     const double gain = dt / (1.0 + 0.5 * c * dt);
-    parallel::for_each(state.ranges.owned_begin, state.ranges.owned_end, [&](std::size_t i) noexcept {
+    for (std::size_t i = first; i < last; ++i) {
       const Vector3 force = forces.external[i] - forces.internal[i];
       state.velocity[i] = keep * state.velocity[i] + gain * force / inertia.mass[i];
       // δΠ = g·δd with δd = δθ × d gives ∂Π/∂θ = d × g, so the moment is −d × g.
       const Vector3 moment = forces.external_moment[i] - state.director[i].cross(forces.internal_director[i]);
       const Vector3 omega = keep * state.angular_velocity[i] + gain * moment / inertia.rotary_inertia[i];
       state.angular_velocity[i] = omega - omega.dot(state.director[i]) * state.director[i];  // no drilling
-    });
+    }
   }
 
-  void advance_configuration(const StepContext& context, solver::ParticleState& state) {
+  void advance_configuration(const StepContext& context, solver::ParticleState& state, std::size_t first,
+                             std::size_t last) {
     const double dt = context.time_step;
-    parallel::for_each(state.ranges.owned_begin, state.ranges.owned_end, [&](std::size_t i) noexcept {
+    for (std::size_t i = first; i < last; ++i) {
       state.position[i] += dt * state.velocity[i];
       const Vector3 rotation = dt * state.angular_velocity[i];
       const double angle = rotation.norm();
@@ -52,7 +52,7 @@ class CentralDifference {
             (d * std::cos(angle) + axis.cross(d) * std::sin(angle) + axis * axis.dot(d) * (1.0 - std::cos(angle)))
                 .normalized();
       }
-    });
+    }
   }
 };
 

@@ -7,15 +7,23 @@
 //       the span of step n's velocity update (the central difference starts
 //       its staggered velocities with half a step);
 //   void advance_velocities(const StepContext&, solver::ParticleState&,
-//                           const solver::Inertia&, const solver::ParticleForces&);
-//       v and ω over context.velocity_step from the forces, with the
-//       mass-proportional damping context.damping (ω stays normal to d);
-//   void advance_configuration(const StepContext&, solver::ParticleState&);
-//       x and d over context.time_step from v and ω.
-// Each step the solver calls advance_velocities, then imposes the kinematic
-// conditions on the new velocities and books the energies, then calls
-// advance_configuration. Only the owned particles
-// (state.ranges.owned_begin … owned_end) are the stepper's to update.
+//                           const solver::Inertia&, const solver::ParticleForces&,
+//                           std::size_t first, std::size_t last);
+//       v and ω of particles [first, last) over context.velocity_step from
+//       the forces, with the mass-proportional damping context.damping (ω
+//       stays normal to d);
+//   void advance_configuration(const StepContext&, solver::ParticleState&,
+//                              std::size_t first, std::size_t last);
+//       x and d of particles [first, last) over context.time_step from v and ω.
+// The solver steps the particles in one pass over chunks of them, each chunk
+// on one thread and several chunks at once: for each chunk it calls
+// advance_velocities, then imposes the kinematic conditions on the new
+// velocities and books the energies, then calls advance_configuration. So a
+// particle's update reads and writes that particle's entries only, the two
+// members write nothing else (a stepper's own members are for its settings,
+// set before the run) and they must not throw (a non-finite result is found
+// by the solver's check after the update). Only the owned particles
+// (state.ranges.owned_begin … owned_end) are given to the stepper.
 // check_stepper<S>() names a missing member.
 //
 // Checkpoints: a stepper is part of the solver's state. An empty one (as
@@ -28,6 +36,7 @@
 #include <sphshell/core/error.hpp>
 #include <sphshell/solver/particles.hpp>
 
+#include <cstddef>
 #include <type_traits>
 #include <utility>
 
@@ -55,15 +64,16 @@ template <class S>
 struct has_advance_velocities<
     S, std::void_t<decltype(std::declval<S&>().advance_velocities(
            std::declval<const StepContext&>(), std::declval<solver::ParticleState&>(),
-           std::declval<const solver::Inertia&>(), std::declval<const solver::ParticleForces&>()))>>
+           std::declval<const solver::Inertia&>(), std::declval<const solver::ParticleForces&>(),
+           std::size_t{}, std::size_t{}))>>
     : std::true_type {};
 
 template <class S, class = void>
 struct has_advance_configuration : std::false_type {};
 template <class S>
 struct has_advance_configuration<
-    S, std::void_t<decltype(std::declval<S&>().advance_configuration(std::declval<const StepContext&>(),
-                                                                     std::declval<solver::ParticleState&>()))>>
+    S, std::void_t<decltype(std::declval<S&>().advance_configuration(
+           std::declval<const StepContext&>(), std::declval<solver::ParticleState&>(), std::size_t{}, std::size_t{}))>>
     : std::true_type {};
 
 }  // namespace detail
@@ -86,10 +96,11 @@ constexpr bool check_stepper() {
                 "sphshell stepper: missing velocity step; add `double velocity_step(long step, double time_step) const`");
   static_assert(detail::has_advance_velocities<S>::value,
                 "sphshell stepper: missing velocity update; add `void advance_velocities(const StepContext&, "
-                "solver::ParticleState&, const solver::Inertia&, const solver::ParticleForces&)`");
+                "solver::ParticleState&, const solver::Inertia&, const solver::ParticleForces&, std::size_t first, "
+                "std::size_t last)` (particles [first, last) only)");
   static_assert(detail::has_advance_configuration<S>::value,
                 "sphshell stepper: missing configuration update; add `void advance_configuration(const "
-                "StepContext&, solver::ParticleState&)`");
+                "StepContext&, solver::ParticleState&, std::size_t first, std::size_t last)` (particles [first, last) only)");
   return is_stepper_v<S>;
 }
 
