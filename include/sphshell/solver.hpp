@@ -408,7 +408,7 @@ class Solver {
     time_ = start_time_ + static_cast<double>(steps_) * time_step_;  // t = t0 + n Δt, never summed
     forces_current_ = false;
     if (unstable < particles_.size()) fail_non_finite_state(unstable);
-    compute_internal_forces();
+    compute_internal_forces(Packing::done_by_particle_pass);
     if constexpr (Crack::enabled) fracture_.update(fracture_parts());
     if (solver::EnergyLedger::is_check_step(steps_)) ledger_.check_balance(now(), energy());
     if (progress_.is_due(steps_)) progress_.write(now(), energy());
@@ -635,8 +635,14 @@ class Solver {
             forces_.external,    forces_.external_moment};
   }
 
-  void compute_internal_forces() {
-    assembler_.compute(now(), particles_, points_, states_, forces_);
+  // Whether the particles' positions and directors were packed for the
+  // gathers by the particle pass since they last moved (advance_particles).
+  enum class Packing { needed, done_by_particle_pass };
+  void compute_internal_forces(Packing packing = Packing::needed) {
+    if (packing == Packing::done_by_particle_pass)
+      assembler_.compute_packed(now(), points_, states_, forces_);
+    else
+      assembler_.compute(now(), particles_, points_, states_, forces_);
     ledger_.book_internal_work(assembler_.internal_work());
     forces_current_ = true;
   }
@@ -646,9 +652,11 @@ class Solver {
   // one thread and in this order: its loads, the stepper's velocity update,
   // the kinematic conditions, its energy terms, the configuration update, and
   // a look for non-finite values, while the chunk's data is in that core's
-  // cache. The parts one after the other took eight parallel regions, each
-  // costing two threads more than the part's work on the paper's plate
-  // (docs/performance.md, twelfth round). Serial loads (user pressure
+  // cache; last, it packs the chunk's positions and directors for the force
+  // pass's gathers (InternalForceAssembler::pack). The parts one after the
+  // other took nine parallel regions, each costing two threads more than the
+  // part's work on the paper's plate (docs/performance.md, twelfth round).
+  // Serial loads (user pressure
   // functions, detail::Load::serial) are applied before the pass.
   // Failures are reported as the parts would one after the other: a
   // non-finite load (the lowest particle), then a failing condition (the
@@ -665,6 +673,7 @@ class Solver {
     detail::LoadContext load_context = load_context_at(context.at.time);
     constraints_.prepare();
     ledger_.start_step(particles_);
+    assembler_.start_packing(particles_.size());
     const std::size_t count = particles_.size();
     std::atomic<std::size_t> load_failure{count}, state_failure{count};
     std::mutex condition_mutex;
@@ -700,6 +709,7 @@ class Solver {
           keep_lowest(state_failure, i);
           break;
         }
+      assembler_.pack(particles_, first, last);
     });
     ledger_.finish_step();
     if (load_failure.load() < count) ExternalLoads::fail_non_finite(context.at, load_failure.load());

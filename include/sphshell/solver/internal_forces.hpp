@@ -59,12 +59,28 @@ class InternalForceAssembler {
   template <class Approx, class Rule, class Law>
   void compute(const StepTime& at, const ParticleState& particles, const IntegrationPoints<Approx>& points,
                SectionStates<Rule, Law>& states, ParticleForces& forces) {
+    start_packing(particles.size());
+    parallel::for_each_range(std::size_t{0}, particles.size(),
+                             [&](std::size_t first, std::size_t last) noexcept { pack(particles, first, last); });
+    compute_packed(at, points, states, forces);
+  }
+
+  // The gathers read each particle's position and director packed side by
+  // side (PackedKinematics). compute() packs them in a pass of its own; the
+  // solver's particle pass instead packs each chunk of particles right after
+  // moving it (Solver::advance_particles), one parallel region less per step,
+  // and then calls compute_packed(). start_packing(count) before the packing;
+  // pack() for every particle since it last moved before compute_packed().
+  void start_packing(std::size_t count) { packed_.resize(count); }
+  void pack(const ParticleState& particles, std::size_t first, std::size_t last) noexcept {
+    for (std::size_t i = first; i < last; ++i)
+      packed_[i] = PackedKinematics{particles.position[i], particles.director[i]};
+  }
+  template <class Approx, class Rule, class Law>
+  void compute_packed(const StepTime& at, const IntegrationPoints<Approx>& points, SectionStates<Rule, Law>& states,
+                      ParticleForces& forces) {
     prepare(points);
     schedule_.update(points, forces.internal.size(), segment_count());
-    packed_.resize(particles.size());
-    parallel::for_each(std::size_t{0}, particles.size(), [&](std::size_t i) noexcept {
-      packed_[i] = PackedKinematics{particles.position[i], particles.director[i]};
-    });
     // Each segment integrates its runs and sums the particles that each run
     // completes; a band of particles whose points lie in several segments is
     // summed by the segment that finishes its share of them last.
