@@ -454,15 +454,15 @@ TEST_CASE("A plate's step is bitwise the same on 1, 2 and 3 threads", "[core][pa
 }
 
 namespace {
-// Steps as the central difference, then makes three particles' positions NaN
-// from step 3 on (a blow-up the solver must report).
+// Steps as the central difference, then makes four particles' positions NaN
+// from step 3 on (a blow-up the solver must report); 301 and 310 share a chunk.
 struct PoisonStepper : stepper::CentralDifference {
   static constexpr long first_poisoned_step = 3;
   void advance_configuration(const stepper::StepContext& context, solver::ParticleState& state, std::size_t first,
                              std::size_t last) {
     CentralDifference::advance_configuration(context, state, first, last);
     if (context.at.step < first_poisoned_step) return;
-    for (const std::size_t i : {std::size_t{1200}, std::size_t{700}, std::size_t{301}})
+    for (const std::size_t i : {std::size_t{1200}, std::size_t{700}, std::size_t{310}, std::size_t{301}})
       if (first <= i && i < last) state.position[i].x() = std::nan("");
   }
 };
@@ -486,7 +486,7 @@ TEST_CASE("A step's particle pass reports failures as its parts one after the ot
     // prescribed velocities (at its middle, 3.5 Δt) are taken past 2.75 Δt.
     const auto failing_after = [](double time_step) { return 2.75 * time_step; };
 
-    // A non-finite state: the lowest particle, at the step's end.
+    // A non-finite state: the lowest particle (not the last of its chunk), at the step's end.
     {
       PoisonedPlate solver(plate, {70e9, 0.3});
       solver.clamp(solver.model().set("boundary"));
@@ -507,14 +507,15 @@ TEST_CASE("A step's particle pass reports failures as its parts one after the ot
       CHECK_THROWS_WITH(solver.step(), Catch::Contains("unstable at step 3,") &&
                                            Catch::Contains("prescribed motion of particle 1200 is not finite"));
     }
-    // A non-finite load: the lowest particle, before the failing motion.
+    // A non-finite load: the lowest particle (640 and 650 share a chunk),
+    // before the failing motion.
     {
       Plate solver(plate, {70e9, 0.3});
       const double after = failing_after(solver.time_step());
       solver.prescribe_velocity({1200, 700, 301}, [after, nan](const Vector3&, double t) {
         return t > after ? Vector3(nan, 0.0, 0.0) : Vector3::Zero();
       });
-      solver.add_point_force({1250, 640, 900}, Vector3(0.0, 0.0, 1.0),
+      solver.add_point_force({1250, 650, 640, 900}, Vector3(0.0, 0.0, 1.0),
                              [after, nan](double t) { return t > after ? nan : 1.0; });
       for (int n = 0; n < 3; ++n) solver.step();
       CHECK_THROWS_WITH(solver.step(), Catch::Contains("unstable at step 3,") &&
@@ -527,7 +528,7 @@ TEST_CASE("A step's particle pass reports failures as its parts one after the ot
 }
 
 TEST_CASE("The energy books are the same on 1, 2 and 3 threads and add up every particle", "[core][parallel]") {
-  // EnergyLedger::book_step adds the particles' terms in chunks of
+  // EnergyLedger::book_chunk adds the particles' terms in chunks of
   // ParticleEnergyTerms::sum_chunk on the threads; 31 × 21 particles make
   // three chunks, the last one short.
   const ShellModel plate = ShellModel::rectangular_plate(0.3, 0.2, 31, 21, 0.004);

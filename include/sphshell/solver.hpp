@@ -711,9 +711,9 @@ class Solver {
         }
       assembler_.pack(particles_, first, last);
     });
-    ledger_.finish_step();
     if (load_failure.load() < count) ExternalLoads::fail_non_finite(context.at, load_failure.load());
     if (condition_error) std::rethrow_exception(condition_error);
+    ledger_.finish_step();  // a failed step's terms never reach the books
     return state_failure.load();
   }
 

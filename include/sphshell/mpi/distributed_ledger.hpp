@@ -66,7 +66,7 @@ class DistributedLedger {
   void remember_velocities(const solver::ParticleState& state) { terms_.remember_velocities(state); }
   void remember_free_velocities(const solver::ParticleState& state) { terms_.remember_free_velocities(state); }
 
-  // The serial book_step's terms (solver::ParticleEnergyTerms), owned particles only.
+  // The serial ledger's terms (solver::ParticleEnergyTerms), owned particles only.
   void book_step(const stepper::StepContext& context, const solver::ParticleState& state,
                  const solver::Inertia& inertia, const solver::ParticleForces& forces) {
     terms_.compute(context, state, inertia, forces, state.ranges.owned_begin, state.ranges.owned_end);

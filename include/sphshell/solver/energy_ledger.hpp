@@ -70,12 +70,8 @@ class ParticleEnergyTerms {
 
   // The arrays for particles [0, end), and chunk sums for the chunks of [begin, end).
   void prepare(std::size_t begin, std::size_t end) {
-    old_velocity_.resize(end);
-    old_angular_velocity_.resize(end);
-    free_velocity_.resize(end);
-    external_.resize(end);
-    damping_.resize(end);
-    kinetic_.resize(end);
+    size_velocities(end);
+    size_terms(end);
     chunk_sums_.assign(chunk_count(begin, end), Sums{});
   }
   static std::size_t chunk_count(std::size_t begin, std::size_t end) {
@@ -96,7 +92,7 @@ class ParticleEnergyTerms {
   }
   // The same for every particle, in parallel passes (the MPI ledger).
   void remember_velocities(const ParticleState& state) {
-    prepare(0, state.velocity.size());
+    size_velocities(state.velocity.size());
     parallel::for_each_range(std::size_t{0}, state.velocity.size(),
                              [&](std::size_t first, std::size_t last) noexcept {
                                remember_velocities(state, first, last);
@@ -109,9 +105,10 @@ class ParticleEnergyTerms {
                              });
   }
 
-  // The terms of particles [begin, end) (the arrays are sized to end), in a parallel pass.
+  // The terms of particles [begin, end) (the terms' arrays are sized to end), in a parallel pass.
   void compute(const stepper::StepContext& context, const ParticleState& state, const Inertia& inertia,
                const ParticleForces& forces, std::size_t begin, std::size_t end) {
+    size_terms(end);
     parallel::for_each(begin, end,
                        [&](std::size_t i) noexcept { compute_particle(i, context, state, inertia, forces); });
   }
@@ -155,6 +152,16 @@ class ParticleEnergyTerms {
   const std::vector<double>& kinetic() const { return kinetic_; }
 
  private:
+  void size_velocities(std::size_t end) {
+    old_velocity_.resize(end);
+    old_angular_velocity_.resize(end);
+    free_velocity_.resize(end);
+  }
+  void size_terms(std::size_t end) {
+    external_.resize(end);
+    damping_.resize(end);
+    kinetic_.resize(end);
+  }
   void compute_particle(std::size_t i, const stepper::StepContext& context, const ParticleState& state,
                         const Inertia& inertia, const ParticleForces& forces) {
     const double dt = context.velocity_step;

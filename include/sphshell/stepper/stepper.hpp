@@ -21,8 +21,9 @@
 // velocities and books the energies, then calls advance_configuration. So a
 // particle's update reads and writes that particle's entries only, the two
 // members write nothing else (a stepper's own members are for its settings,
-// set before the run) and they must not throw (a non-finite result is found
-// by the solver's check after the update). Only the owned particles
+// set before the run) and they must not throw: the solver calls them inside
+// a noexcept task, so an exception would end the program (a non-finite result
+// needs no exception: the solver's check after the update finds it). Only the owned particles
 // (state.ranges.owned_begin … owned_end) are given to the stepper.
 // check_stepper<S>() names a missing member.
 //
