@@ -649,14 +649,14 @@ class Solver {
 
   // The particles' part of a step, in one parallel pass over the energy
   // books' chunks of particles (ParticleEnergyTerms::sum_chunk), each chunk on
-  // one thread and in this order: its loads, the stepper's velocity update,
-  // the kinematic conditions, its energy terms, the configuration update, and
-  // a look for non-finite values, while the chunk's data is in that core's
-  // cache; last, it packs the chunk's positions and directors for the force
-  // pass's gathers (InternalForceAssembler::pack). The parts one after the
-  // other took nine parallel regions, each costing two threads more than the
-  // part's work on the paper's plate (docs/performance.md, twelfth round).
-  // Serial loads (user pressure
+  // one thread, while its data is in that core's cache: its loads, the copy of
+  // v^{n−½}, the stepper's velocity update, the copy of the free velocities,
+  // the kinematic conditions, its energy terms, the configuration update, a
+  // look for non-finite values, and the packing of its positions and
+  // directors for the force pass's gathers (InternalForceAssembler::pack).
+  // The parts one after the other took nine parallel regions, each costing
+  // two threads more than the part's work on the paper's plate
+  // (docs/performance.md, twelfth round). Serial loads (user pressure
   // functions, detail::Load::serial) are applied before the pass.
   // Failures are reported as the parts would one after the other: a
   // non-finite load (the lowest particle), then a failing condition (the
