@@ -679,16 +679,11 @@ class Solver {
     std::mutex condition_mutex;
     std::size_t failed_condition = constraints_.particles().size();
     std::exception_ptr condition_error;
-    const auto keep_lowest = [](std::atomic<std::size_t>& lowest, std::size_t i) noexcept {
-      std::size_t current = lowest.load();
-      while (i < current && !lowest.compare_exchange_weak(current, i)) {
-      }
-    };
     parallel::for_each_task(ledger_.chunk_count(particles_), [&](std::size_t chunk) noexcept {
       const auto [first, last] = solver::EnergyLedger::particle_chunk(particles_, chunk);
       if (loads_in_pass) {
         const std::size_t i = loads_.apply_range(load_context, first, last);
-        if (i < last) keep_lowest(load_failure, i);
+        if (i < last) parallel::keep_lowest(load_failure, i);
       }
       ledger_.remember_velocities(particles_, first, last);
       stepper_.advance_velocities(context, particles_, inertia_, forces_, first, last);
@@ -706,7 +701,7 @@ class Solver {
       for (std::size_t i = first; i < last; ++i)
         if (!all_finite(particles_.position[i], particles_.director[i], particles_.velocity[i],
                         particles_.angular_velocity[i])) {
-          keep_lowest(state_failure, i);
+          parallel::keep_lowest(state_failure, i);
           break;
         }
       assembler_.pack(particles_, first, last);

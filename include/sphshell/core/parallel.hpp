@@ -443,6 +443,16 @@ void for_each_task(std::size_t count, Body&& body) {
   }
 }
 
+// Lowers `lowest` to i if i is below it, whichever thread gets there first:
+// for for_each_range and for_each_task bodies, which must not throw, to note
+// the lowest failing index and report it after the loop (the loop's end
+// orders the threads' writes before that read).
+inline void keep_lowest(std::atomic<std::size_t>& lowest, std::size_t i) noexcept {
+  std::size_t current = lowest.load(std::memory_order_relaxed);
+  while (i < current && !lowest.compare_exchange_weak(current, i, std::memory_order_relaxed)) {
+  }
+}
+
 // The message of a caught exception (for errors that add where they happened).
 inline std::string what(const std::exception_ptr& error) {
   try {

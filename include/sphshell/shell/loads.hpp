@@ -272,7 +272,7 @@ class ExternalLoads {
     if (!any_serial_) {
       parallel::for_each_range(std::size_t{0}, count, [&](std::size_t first, std::size_t last) noexcept {
         const std::size_t i = apply_range(context, first, last);
-        if (i < last) note_lowest(first_non_finite, i);
+        if (i < last) parallel::keep_lowest(first_non_finite, i);
       });
     } else {
       parallel::for_each_range(std::size_t{0}, count,
@@ -289,7 +289,7 @@ class ExternalLoads {
       }
       parallel::for_each_range(std::size_t{0}, count, [&](std::size_t first, std::size_t last) noexcept {
         const std::size_t i = first_non_finite_in(context, first, last);
-        if (i < last) note_lowest(first_non_finite, i);
+        if (i < last) parallel::keep_lowest(first_non_finite, i);
       });
     }
     const std::size_t i = first_non_finite.load();
@@ -330,13 +330,6 @@ class ExternalLoads {
       context.moment[i].setZero();
     }
   }
-  // Keeps the lowest non-finite particle whatever thread finds it first.
-  static void note_lowest(std::atomic<std::size_t>& lowest, std::size_t i) noexcept {
-    std::size_t current = lowest.load(std::memory_order_relaxed);
-    while (i < current && !lowest.compare_exchange_weak(current, i, std::memory_order_relaxed)) {
-    }
-  }
-
   std::vector<std::unique_ptr<detail::Load>> loads_;
   std::vector<double> factors_;  // each load's time factor this step
   bool any_serial_ = false;
