@@ -2,7 +2,7 @@
 // (IntegrationPoints::gather) forms a1, a2, n, n1, n2 of a point from its
 // neighbours' positions and directors; it is one of the step's two per-slot
 // loops (the particles' force sums are the other), which together take about
-// a third of the paper plate's step (docs/performance.md, ninth round). This
+// a third of the paper plate's step (docs/performance.md, the profile). This
 // benchmark times, on the paper plate's own shape functions, the library's
 // gather point by point (a particle's six numbers as one 6-vector) against
 //  - padded: the same, each particle's position and director padded with a

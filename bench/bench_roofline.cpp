@@ -1,4 +1,4 @@
-// The machine's two roofs, for the README's roofline paragraph: memory
+// The machine's two roofs, for the roofline in docs/performance.md: memory
 // bandwidth (STREAM-like triad a = b + s·c on three 32 MiB arrays, counted as
 // 24 bytes per element: two reads and a write; write-allocate traffic not
 // counted) and floating-point peak (16 independent multiply-add chains
@@ -7,8 +7,8 @@
 // A third figure is for the threads paragraph: the time a cache line takes to
 // go from one processor to another and back (two threads pinned to the first
 // two processors the process may use pass a flag to and fro). What two
-// threads of a step share moves at that price (docs/performance.md, tenth
-// round). It wants both processors free: with another process on one of
+// threads of a step share moves at that price (docs/performance.md,
+// "Threads"). It wants both processors free: with another process on one of
 // them, each trip can wait for a time slice.
 #include <benchmark/benchmark.h>
 

@@ -8,7 +8,7 @@
 // 1 thread and one on 2 (the order swapped every round), so a change of the
 // machine's load hits both alike. The counter `ratio` is the median over the
 // rounds of (2-thread chunk time) / (1-thread chunk time): below 1 the second
-// thread helps, 1.1 is the limit under load. `load1` is the 1-minute
+// thread helps. `load1` is the 1-minute
 // load average when the benchmark started. `steal` is the share of the
 // machine's CPU time that its hypervisor gave to other guests while the
 // rounds ran (Linux /proc/stat; −1 where it cannot be read): a virtual
@@ -19,8 +19,8 @@
 // each of the first two processors the process may use (the four chunks of a
 // round in the orders of a Williams square), because a virtual machine's two
 // processors need not be equally fast, and then no program's two threads are
-// twice as fast as one thread on the faster (docs/performance.md, tenth
-// round). From the pinned chunk times t_a, t_b, ideal = 1 / (1/t_a + 1/t_b) is
+// twice as fast as one thread on the faster (docs/performance.md,
+// "Threads"). From the pinned chunk times t_a, t_b, ideal = 1 / (1/t_a + 1/t_b) is
 // the time of two threads that share the work perfectly between the two
 // processors. Counters, medians over the rounds: `ideal_ratio` (ideal over the
 // one-thread time: what `ratio` would be with perfect sharing; the unpinned

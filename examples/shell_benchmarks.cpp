@@ -6,7 +6,7 @@
 // plate, the hemisphere under alternating forces and the pull-out of an
 // open-ended cylinder). Each case runs at three resolutions; the table
 // printed (Markdown) gives the finest one's value, reference and error with
-// the two coarser ones' errors beside it, as in the README. The cases and the
+// the two coarser ones' errors beside it, as in docs/validation.md. The cases and the
 // static Newton solution on the solver's own forces are the validation tests'
 // (tests/support/shell_benchmarks.hpp, tests/support/static_shell.hpp).
 // `shell_benchmarks --help` lists the options and the files written.
@@ -550,7 +550,7 @@ int run(const Arguments& arguments) {
 
   if (pullout_stability) {
     // Where the pull-out's path stops without the director hourglass and that
-    // it does not with it (README, "What limits them"): the tangent's
+    // it does not with it (docs/validation.md, "What limits them"): the tangent's
     // stability after every step of the −U_B control, and without the
     // hourglass the same path by arc length.
     NewtonOptions newton;
