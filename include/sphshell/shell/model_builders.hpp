@@ -89,8 +89,12 @@ inline ShellModel ShellModel::spherical_cap(double radius, double half_angle, in
 
 template <class Surface>
 ShellModel ShellModel::structured(int nu, int nv, bool periodic_u, Surface&& surface, double thickness) {
-  std::vector<Vector3> positions, normals;
   const int columns = periodic_u ? nu : nu - 1;
+  // Counted before anything is allocated: a grid too large is an Error with its size.
+  const double particles = static_cast<double>(nu) * nv, cells = static_cast<double>(columns) * (nv - 1);
+  const double estimate = detail::model_checks::require_model_memory("the structured grid", particles, cells);
+  return detail::model_checks::guard_building("the structured grid", estimate, [&] {
+  std::vector<Vector3> positions, normals;
   auto u_of = [&](double i) { return i / columns; };
   for (int j = 0; j < nv; ++j)
     for (int i = 0; i < nu; ++i) {
@@ -110,6 +114,7 @@ ShellModel ShellModel::structured(int nu, int nv, bool periodic_u, Surface&& sur
     }
   return from_quads(std::move(positions), std::move(normals), quads, std::move(centres), std::move(centre_normals),
                     thickness);
+  });
 }
 
 }  // namespace sphshell
