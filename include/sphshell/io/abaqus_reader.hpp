@@ -293,7 +293,7 @@ class AbaqusParser {
         "SURFACE BEHAVIOR", "FRICTION", "CONTACT PAIR", "CONTACT", "CONTACT INCLUSIONS",
         "CONTACT PROPERTY ASSIGNMENT", "TIE", "COUPLING", "KINEMATIC", "DISTRIBUTING", "EQUATION", "MPC",
         "RIGID BODY", "MASS", "ROTARY INERTIA", "SPRING", "DASHPOT", "AMPLITUDE", "INITIAL CONDITIONS",
-        "PHYSICAL CONSTANTS", "FILM", "RADIATE", "GAP", "USER ELEMENT",
+        "FILM", "RADIATE", "GAP", "USER ELEMENT",
         // history data: steps, loads, output requests
         "STEP", "END STEP", "STATIC", "DYNAMIC", "FREQUENCY", "BUCKLE", "VISCO", "HEAT TRANSFER",
         "COUPLED TEMPERATURE-DISPLACEMENT", "CONTROLS", "SOLVER CONTROLS", "BOUNDARY", "CLOAD", "DLOAD", "DSLOAD",
@@ -315,7 +315,7 @@ class AbaqusParser {
         {"SHELLSECTION",
          {"ELSET", "MATERIAL", "OFFSET", "ORIENTATION", "SECTION INTEGRATION", "CONTROLS", "COMPOSITE",
           "NODAL THICKNESS", "POISSON", "DENSITY", "TEMPERATURE", "THICKNESS MODULUS", "SYMMETRIC", "LAYUP",
-          "SHELL THICKNESS", "STACK DIRECTION", "THICKNESS"}},
+          "SHELL THICKNESS", "STACK DIRECTION", "THICKNESS", "ROTARY INERTIA"}},
         {"INCLUDE", {"INPUT", "PASSWORD"}},
         {"SYSTEM", {}}};
     return parameters.at(keyword);
@@ -329,7 +329,7 @@ class AbaqusParser {
     const std::vector<std::string>& known = parameters_of(keyword.name);
     for (const auto& entry : keyword.value) {
       if (listed(entry.first, known)) continue;
-      std::string message = "*" + keyword.name + " has no parameter " + entry.first;
+      std::string message = "*" + upper(keyword.written) + " has no parameter " + entry.first;
       if (!known.empty())
         message += "; did you mean " + nearest_name(entry.first, known, normalized) + "=?";
       fail(line.origin, message);

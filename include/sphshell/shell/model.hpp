@@ -67,23 +67,23 @@ class ShellModel {
     const double estimate = detail::model_checks::require_model_memory(
         "ShellModel::from_quads", static_cast<double>(positions.size()), static_cast<double>(quads.size()));
     return detail::model_checks::guard_building("ShellModel::from_quads", estimate, [&] {
-    detail::model_checks::check_sizes(positions, normals);
-    std::vector<int> turned;  // the overload below turns them again and keeps the note
-    detail::model_checks::check_quads(positions, normals, oriented_quads(positions, normals, quads, turned));
-    std::vector<Vector3> centres;
-    std::vector<Vector3> centre_normals;
-    for (const Quad& quad : quads) {
-      Vector3 centre = Vector3::Zero();
-      Vector3 normal = Vector3::Zero();
-      for (int corner : quad) {
-        centre += positions[corner] / 4.0;
-        normal += normals[corner];
+      detail::model_checks::check_sizes(positions, normals);
+      std::vector<int> turned;  // the overload below turns them again and keeps the note
+      detail::model_checks::check_quads(positions, normals, oriented_quads(positions, normals, quads, turned));
+      std::vector<Vector3> centres;
+      std::vector<Vector3> centre_normals;
+      for (const Quad& quad : quads) {
+        Vector3 centre = Vector3::Zero();
+        Vector3 normal = Vector3::Zero();
+        for (int corner : quad) {
+          centre += positions[corner] / 4.0;
+          normal += normals[corner];
+        }
+        centres.push_back(centre);
+        centre_normals.push_back(normal);
       }
-      centres.push_back(centre);
-      centre_normals.push_back(normal);
-    }
-    return from_quads(std::move(positions), std::move(normals), quads, std::move(centres),
-                      std::move(centre_normals), thickness);
+      return from_quads(std::move(positions), std::move(normals), quads, std::move(centres),
+                        std::move(centre_normals), thickness);
     });
   }
 
@@ -96,34 +96,34 @@ class ShellModel {
     const double estimate = detail::model_checks::require_model_memory(
         "ShellModel::from_quads", static_cast<double>(positions.size()), static_cast<double>(given_quads.size()));
     return detail::model_checks::guard_building("ShellModel::from_quads", estimate, [&] {
-    detail::model_checks::check_sizes(positions, normals);
-    std::vector<int> turned;
-    const std::vector<Quad> quads = oriented_quads(positions, normals, given_quads, turned);
-    detail::model_checks::check_quads(positions, normals, quads);
-    if (stress_positions.size() != quads.size() || stress_normals.size() != quads.size())
-      detail::invalid_parameter("stress point count", stress_positions.size(),
-                                "must equal the number of quads (" + std::to_string(quads.size()) + ")");
-    std::vector<double> areas(positions.size(), 0.0);
-    std::vector<double> stress_areas;
-    stress_areas.reserve(quads.size());
-    for (const Quad& quad : quads) {
-      const Vector3 diagonal1 = positions[quad[2]] - positions[quad[0]];
-      const Vector3 diagonal2 = positions[quad[3]] - positions[quad[1]];
-      const double area = 0.5 * diagonal1.cross(diagonal2).norm();
-      stress_areas.push_back(area);
-      for (int corner : quad) areas[corner] += area / 4.0;
-    }
-    for (std::size_t i = 0; i < positions.size(); ++i)
-      if (!(areas[i] > 0.0))
-        detail::invalid_parameter("particle " + std::to_string(i), positions[i].transpose(),
-                                  "belongs to no quad: every particle must be a corner of a quad");
-    std::vector<Cell> cells(quads.begin(), quads.end());
-    ShellModel model(std::move(positions), std::move(normals), std::move(areas),
-                     std::move(stress_positions), std::move(stress_normals),
-                     std::move(stress_areas), thickness, std::move(cells));
-    model.quads_ = quads;
-    model.turned_cells = std::move(turned);
-    return model;
+      detail::model_checks::check_sizes(positions, normals);
+      std::vector<int> turned;
+      const std::vector<Quad> quads = oriented_quads(positions, normals, given_quads, turned);
+      detail::model_checks::check_quads(positions, normals, quads);
+      if (stress_positions.size() != quads.size() || stress_normals.size() != quads.size())
+        detail::invalid_parameter("stress point count", stress_positions.size(),
+                                  "must equal the number of quads (" + std::to_string(quads.size()) + ")");
+      std::vector<double> areas(positions.size(), 0.0);
+      std::vector<double> stress_areas;
+      stress_areas.reserve(quads.size());
+      for (const Quad& quad : quads) {
+        const Vector3 diagonal1 = positions[quad[2]] - positions[quad[0]];
+        const Vector3 diagonal2 = positions[quad[3]] - positions[quad[1]];
+        const double area = 0.5 * diagonal1.cross(diagonal2).norm();
+        stress_areas.push_back(area);
+        for (int corner : quad) areas[corner] += area / 4.0;
+      }
+      for (std::size_t i = 0; i < positions.size(); ++i)
+        if (!(areas[i] > 0.0))
+          detail::invalid_parameter("particle " + std::to_string(i), positions[i].transpose(),
+                                    "belongs to no quad: every particle must be a corner of a quad");
+      std::vector<Cell> cells(quads.begin(), quads.end());
+      ShellModel model(std::move(positions), std::move(normals), std::move(areas),
+                       std::move(stress_positions), std::move(stress_normals),
+                       std::move(stress_areas), thickness, std::move(cells));
+      model.quads_ = quads;
+      model.turned_cells = std::move(turned);
+      return model;
     });
   }
 
@@ -142,50 +142,50 @@ class ShellModel {
     const double estimate = detail::model_checks::require_model_memory(
         "ShellModel::from_cells", static_cast<double>(positions.size()), static_cast<double>(cells.size()));
     return detail::model_checks::guard_building("ShellModel::from_cells", estimate, [&] {
-    if (cells.empty()) detail::invalid_parameter("cell count", 0, "a shell needs cells");
-    detail::model_checks::check_finite("particle", "position", positions);
-    for (std::size_t c = 0; c < cells.size(); ++c) detail::model_checks::check_cell(cells[c], c, positions.size());
-    if (const std::optional<CellEdgeProblem> problem = detail::model_checks::find_cell_edge_problem(cells))
-      detail::invalid_parameter(
-          "cells", std::to_string(problem->first_cell) + " and " + std::to_string(problem->second_cell),
-          detail::model_checks::describe_edge_problem(*problem, "particles"));
-    std::vector<Vector3> normals(positions.size(), Vector3::Zero());
-    std::vector<double> areas(positions.size(), 0.0);
-    std::vector<Vector3> centres, cell_normals;
-    std::vector<double> cell_areas;
-    centres.reserve(cells.size());
-    cell_normals.reserve(cells.size());
-    cell_areas.reserve(cells.size());
-    for (std::size_t c = 0; c < cells.size(); ++c) {
-      const Cell& cell = cells[c];
-      const double corners = static_cast<double>(cell.size());
-      // Twice the area times the unit normal, for a planar cell exactly.
-      const Vector3 doubled_area =
-          cell.is_triangle() ? Vector3((positions[cell[1]] - positions[cell[0]])
-                                           .cross(positions[cell[2]] - positions[cell[0]]))
-                             : Vector3((positions[cell[2]] - positions[cell[0]])
-                                           .cross(positions[cell[3]] - positions[cell[1]]));
-      const double area = 0.5 * doubled_area.norm();
-      if (!(area > 0.0))
-        detail::invalid_parameter("cell " + std::to_string(c) + " area", area, "must be > 0 (degenerate cell)");
-      Vector3 centre = Vector3::Zero();
-      for (int corner : cell) {
-        centre += positions[corner] / corners;
-        areas[corner] += area / corners;
-        normals[corner] += doubled_area;
+      if (cells.empty()) detail::invalid_parameter("cell count", 0, "a shell needs cells");
+      detail::model_checks::check_finite("particle", "position", positions);
+      for (std::size_t c = 0; c < cells.size(); ++c) detail::model_checks::check_cell(cells[c], c, positions.size());
+      if (const std::optional<CellEdgeProblem> problem = detail::model_checks::find_cell_edge_problem(cells))
+        detail::invalid_parameter(
+            "cells", std::to_string(problem->first_cell) + " and " + std::to_string(problem->second_cell),
+            detail::model_checks::describe_edge_problem(*problem, "particles"));
+      std::vector<Vector3> normals(positions.size(), Vector3::Zero());
+      std::vector<double> areas(positions.size(), 0.0);
+      std::vector<Vector3> centres, cell_normals;
+      std::vector<double> cell_areas;
+      centres.reserve(cells.size());
+      cell_normals.reserve(cells.size());
+      cell_areas.reserve(cells.size());
+      for (std::size_t c = 0; c < cells.size(); ++c) {
+        const Cell& cell = cells[c];
+        const double corners = static_cast<double>(cell.size());
+        // Twice the area times the unit normal, for a planar cell exactly.
+        const Vector3 doubled_area =
+            cell.is_triangle() ? Vector3((positions[cell[1]] - positions[cell[0]])
+                                             .cross(positions[cell[2]] - positions[cell[0]]))
+                               : Vector3((positions[cell[2]] - positions[cell[0]])
+                                             .cross(positions[cell[3]] - positions[cell[1]]));
+        const double area = 0.5 * doubled_area.norm();
+        if (!(area > 0.0))
+          detail::invalid_parameter("cell " + std::to_string(c) + " area", area, "must be > 0 (degenerate cell)");
+        Vector3 centre = Vector3::Zero();
+        for (int corner : cell) {
+          centre += positions[corner] / corners;
+          areas[corner] += area / corners;
+          normals[corner] += doubled_area;
+        }
+        centres.push_back(centre);
+        cell_normals.push_back(doubled_area);
+        cell_areas.push_back(area);
       }
-      centres.push_back(centre);
-      cell_normals.push_back(doubled_area);
-      cell_areas.push_back(area);
-    }
-    for (std::size_t i = 0; i < positions.size(); ++i)
-      if (!(areas[i] > 0.0))
-        detail::invalid_parameter("particle " + std::to_string(i), positions[i].transpose(), "belongs to no cell");
-    ShellModel model(std::move(positions), std::move(normals), std::move(areas), std::move(centres),
-                     std::move(cell_normals), std::move(cell_areas), thickness, cells);
-    if (std::none_of(cells.begin(), cells.end(), [](const Cell& cell) { return cell.is_triangle(); }))
-      for (const Cell& cell : cells) model.quads_.push_back({cell[0], cell[1], cell[2], cell[3]});
-    return model;
+      for (std::size_t i = 0; i < positions.size(); ++i)
+        if (!(areas[i] > 0.0))
+          detail::invalid_parameter("particle " + std::to_string(i), positions[i].transpose(), "belongs to no cell");
+      ShellModel model(std::move(positions), std::move(normals), std::move(areas), std::move(centres),
+                       std::move(cell_normals), std::move(cell_areas), thickness, cells);
+      if (std::none_of(cells.begin(), cells.end(), [](const Cell& cell) { return cell.is_triangle(); }))
+        for (const Cell& cell : cells) model.quads_.push_back({cell[0], cell[1], cell[2], cell[3]});
+      return model;
     });
   }
 
