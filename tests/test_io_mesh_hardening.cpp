@@ -11,6 +11,7 @@
 #include <sphshell/io/gmsh_reader.hpp>
 #include <sphshell/kernel/cubic_spline.hpp>
 #include <sphshell/material/elastic.hpp>
+#include <sphshell/shell/spherical_cap_ogrid.hpp>
 #include <sphshell/solver.hpp>
 #include <sphshell/thickness/gauss.hpp>
 
@@ -360,6 +361,8 @@ TEST_CASE("Files and models too large for memory are refused with the estimate",
   // 1.6e9 particles fit int indices but no memory.
   check_message(error_of([&] { ShellModel::rectangular_plate(1.0, 1.0, 40000, 40000, 0.001); }),
                 {"1600000000 particles", "of memory", "available"});
+  check_message(error_of([&] { spherical_cap_ogrid(1.0, 0.5, 46338, 0.001); }),
+                {"spherical_cap_ogrid", "of memory", "available"});
 }
 
 // A Möbius strip has no consistent normal: turning elements cannot make the

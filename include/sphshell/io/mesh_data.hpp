@@ -322,8 +322,8 @@ inline ShellModel build_shell_model(MeshData& mesh, const std::string& file, dou
   if (mesh.elements.empty())
     mesh_error(mesh.describe(mesh.end) + " (its end)",
                "the file holds no 3-node triangular or 4-node quadrilateral shell element");
-  sphshell::detail::model_checks::require_model_memory("mesh file '" + file + "'", static_cast<double>(mesh.nodes.size()),
-                                             static_cast<double>(mesh.elements.size()));
+  sphshell::detail::model_checks::require_model_memory(
+      "mesh file '" + file + "'", static_cast<double>(mesh.nodes.size()), static_cast<double>(mesh.elements.size()));
   std::sort(mesh.elements.begin(), mesh.elements.end(),
             [](const MeshElement& a, const MeshElement& b) { return a.label < b.label; });
   for (std::size_t e = 1; e < mesh.elements.size(); ++e)
