@@ -363,16 +363,25 @@ TEST_CASE("Gmsh physical groups of points, curves and surfaces become node sets"
   CHECK(model.set_names().size() == 4);
 }
 
-TEST_CASE("Elements whose orientations flip are an Error naming both", "[io][mesh][errors]") {
+// Element 2 listed the other way round from element 1 (they run along the
+// edge 2-5 in the same direction): it is turned to agree, and the model is
+// the one of the strip written consistently.
+TEST_CASE("An element listed the other way round from its neighbour is turned to agree", "[io][mesh]") {
   const test_support::ScratchDirectory directory("flip");
   test_support::write_text(directory / "flip.msh",
                            gmsh_strip("$Elements\n1 2 1 2\n2 1 3 2\n1 1 2 5 4\n2 2 5 6 3\n$EndElements\n"));
-  check_message(error_of([&] { io::read_gmsh((directory / "flip.msh").string(), 0.01); }),
-                {"flip.msh", "element 1 (", "line 23", "element 2 (", "line 24", "between nodes 2 and 5",
-                 "same direction", "normals flip"});
+  test_support::write_text(directory / "strip.msh", gmsh_strip(strip_elements));
+  const ShellModel flipped = io::read_gmsh((directory / "flip.msh").string(), 0.01);
+  const ShellModel consistent = io::read_gmsh((directory / "strip.msh").string(), 0.01);
+  CHECK(flipped.turned_cells == std::vector<int>{1});
+  CHECK(consistent.turned_cells.empty());
+  CHECK(flipped.particle_normal == consistent.particle_normal);
+  CHECK(flipped.stress_point_normal == consistent.stress_point_normal);
+  CHECK(flipped.quads() == consistent.quads());
   test_support::write_text(directory / "flip.inp", abaqus_strip(strip_section, "1, 1, 2, 5, 4\n2, 2, 5, 6, 3\n"));
-  check_message(error_of([&] { io::read_abaqus((directory / "flip.inp").string()); }),
-                {"flip.inp", "element 1 (", "line 9", "element 2 (", "line 10", "normals flip"});
+  const ShellModel deck = io::read_abaqus((directory / "flip.inp").string());
+  CHECK(deck.turned_cells == std::vector<int>{1});
+  CHECK(deck.quads() == consistent.quads());
   // A third element on the edge 2-5: a junction (a stiffener).
   test_support::write_text(directory / "junction.inp",
                            abaqus_strip("*NODE\n7, 1, 0.5, 1\n*ELEMENT, TYPE=S3, ELSET=STRIP\n3, 2, 5, 7\n" +

@@ -3,7 +3,8 @@
 // (little-endian, 8-byte size_t, as 64-bit Gmsh writes it).
 //
 // Sections read: $MeshFormat, $PhysicalNames, $Entities, $Nodes, $Elements;
-// any other section ($Periodic, $NodeData, ...) is skipped whole.
+// any other section ($Periodic, $NodeData, ...) is skipped whole, but a name
+// within two letters of a known section's is an Error (a misspelling).
 // Elements: 3-node triangles (type 2) and 4-node quadrilaterals (type 3)
 // become the shell's cells. Points (type 15) and 2-node lines (type 1) only
 // carry node sets. Any other type (second-order, volume) is an Error naming it.
@@ -12,7 +13,9 @@
 // nodes of its triangles and quadrilaterals. Physical groups without a name
 // are not sets. A .msh file has no thickness: it is the reader's argument,
 // and ShellModel::set_thickness or set_stress_point_thickness change regions.
-// Particles, stress points and sets follow io/mesh_data.hpp's conventions.
+// Counts in the file are checked against the bytes left before anything is
+// reserved for them. Particles, stress points, sets, the checks of shapes and
+// coordinates and the memory estimate follow io/mesh_data.hpp's conventions.
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/io/mesh_data.hpp>
@@ -20,6 +23,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -28,6 +32,7 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -38,7 +43,9 @@ namespace detail {
 
 class GmshParser {
  public:
-  GmshParser(std::string path, std::string data) : path_(std::move(path)), data_(std::move(data)) {}
+  GmshParser(std::string path, std::string data) : path_(std::move(path)), data_(std::move(data)) {
+    if (starts_with_bom(data_)) position_ = 3;  // a UTF-8 byte order mark before $MeshFormat
+  }
 
   MeshData parse() {
     MeshData mesh;
@@ -71,17 +78,29 @@ class GmshParser {
         read_elements(mesh);
         elements = true;
       } else {
+        // Sections the format defines beyond the mesh are skipped; a name one
+        // or two letters from a known one is a misspelling (a lost $Nodes or
+        // $PhysicalNames would otherwise pass unseen).
+        static const std::vector<std::string> known = {
+            "MeshFormat", "PhysicalNames", "Entities", "PartitionedEntities", "Nodes", "Elements", "Periodic",
+            "GhostElements", "Parametrizations", "NodeData", "ElementData", "ElementNodeData",
+            "InterpolationScheme", "Comments"};
+        const std::string nearest = nearest_name(section, known, [](const std::string& name) { return name; });
+        if (section != nearest && edit_distance(section, nearest) <= kMisspelledSection)
+          fail_at(start, "unknown section $" + section + "; did you mean $" + nearest + "?");
         skip_section(section, start);
         continue;
       }
       expect_end(section);
     }
-    const std::string file = "mesh file '" + path_ + "'";
-    if (!format) mesh_error(file, "is empty (no $MeshFormat section)");
-    if (!nodes) mesh_error(file, "has no $Nodes section");
-    if (!elements) mesh_error(file, "has no $Elements section");
+    mesh.end = {0, data_.size()};
+    const std::string file = where(data_.size()) + " (its end)";
+    if (!format) mesh_error(file, "the file is empty (no $MeshFormat section)");
+    if (!nodes) mesh_error(file, "the file has no $Nodes section");
+    if (!elements) mesh_error(file, "the file has no $Elements section");
     if (names && !entities)
-      mesh_error(file, "has $PhysicalNames but no $Entities section, so its physical groups cannot be mapped to elements");
+      mesh_error(file, "the file has $PhysicalNames but no $Entities section, so its physical groups cannot be "
+                       "mapped to elements");
     collect_sets(mesh);
     return mesh;
   }
@@ -103,6 +122,8 @@ class GmshParser {
 
   static constexpr int kPoint = 15, kLine = 1, kTriangle = 2, kQuadrangle = 3;
   static constexpr int kExpectedSizeT = 8;
+  // An unknown section name this many edits or fewer from a known one is an Error.
+  static constexpr std::size_t kMisspelledSection = 2;
 
   // --- messages -----------------------------------------------------------
   std::string where(std::size_t position) const {
@@ -121,6 +142,13 @@ class GmshParser {
     mesh_error(where(position), problem);
   }
   [[noreturn]] void fail(const std::string& problem) const { fail_at(token_start_, problem); }
+
+  static std::string number_text(double value) {
+    std::ostringstream text;
+    text.precision(6);
+    text << value;
+    return text.str();
+  }
 
   // --- low-level reading ----------------------------------------------------
   static bool is_space(char character) {
@@ -257,6 +285,10 @@ class GmshParser {
       const std::string name = data_.substr(position_ + 1, close - position_ - 1);
       position_ = close + 1;
       if (name.empty()) fail("a physical name is empty");
+      const std::size_t control = find_control_byte(name);
+      if (control != std::string::npos)
+        fail("the physical name holds the byte " + byte_text(static_cast<unsigned char>(name[control])) +
+             ", a control character (a corrupted file?)");
       if (dimension < 0 || dimension > 3) fail("a physical group's dimension must be 0 to 3");
       if (tag > std::numeric_limits<int>::max() || tag < std::numeric_limits<int>::min())
         fail("a physical group's tag does not fit in an int");
@@ -293,7 +325,7 @@ class GmshParser {
   void read_nodes(MeshData& mesh) {
     begin_section_data("Nodes");
     const long long blocks = read_count("the number of node blocks", item_bytes(20));
-    const long long total = read_size("the number of nodes");
+    const long long total = read_count("the number of nodes", item_bytes(8));
     read_size("the smallest node tag");
     read_size("the largest node tag");
     long long counted = 0;
@@ -313,7 +345,13 @@ class GmshParser {
       const int extra = parametric ? dimension : 0;  // u, v, w after x, y, z
       for (std::size_t k = 0; k < tags.size(); ++k) {
         Vector3 x;
-        for (int c = 0; c < 3; ++c) x[c] = read_real("a node coordinate");
+        for (int c = 0; c < 3; ++c) {
+          x[c] = read_real("a node coordinate");
+          if (std::abs(x[c]) > largest_coordinate)
+            fail("coordinate " + std::to_string(c + 1) + " of node " + std::to_string(tags[k]) + " is " +
+                 number_text(x[c]) + ", beyond the limit of ±" + number_text(largest_coordinate) +
+                 " (a unit or format mistake?)");
+        }
         for (int c = 0; c < extra; ++c) read_real("a node's parametric coordinate");
         if (!mesh.nodes.emplace(tags[k], x).second)
           fail_at(tag_positions[k], "node " + std::to_string(tags[k]) + " is defined twice");
@@ -341,7 +379,7 @@ class GmshParser {
   void read_elements(MeshData& mesh) {
     begin_section_data("Elements");
     const long long blocks = read_count("the number of element blocks", item_bytes(20));
-    const long long total = read_size("the number of elements");
+    const long long total = read_count("the number of elements", item_bytes(8));
     read_size("the smallest element tag");
     read_size("the largest element tag");
     long long counted = 0;
@@ -436,11 +474,19 @@ class GmshParser {
   std::map<EntityKey, std::vector<NodeListElement>> node_lists_;
 };
 
+// The whole file, after checking that it is a regular file whose contents
+// and parsed form fit in memory (mesh_data.hpp).
 inline std::string read_whole_file(const std::string& path, const std::string& what) {
+  const std::uintmax_t size = require_regular_file(path, what);
+  require_memory("reading " + what + " '" + path + "' (" + std::to_string(size) + " bytes)",
+                 parsed_bytes_per_input_byte * static_cast<double>(size));
+  errno = 0;
   std::ifstream stream(path, std::ios::binary);
-  if (!stream) throw Error("sphshell: cannot open " + what + " '" + path + "'");
-  std::string data((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
-  if (stream.bad()) throw Error("sphshell: failed while reading " + what + " '" + path + "'");
+  if (!stream) throw Error("sphshell: cannot open " + what + " '" + path + "': " + system_reason(errno));
+  std::string data;
+  data.reserve(static_cast<std::size_t>(size));
+  data.assign(std::istreambuf_iterator<char>(stream), std::istreambuf_iterator<char>());
+  if (stream.bad()) throw Error("sphshell: failed while reading " + what + " '" + path + "': " + system_reason(errno));
   return data;
 }
 
@@ -450,9 +496,11 @@ inline std::string read_whole_file(const std::string& path, const std::string& w
 // particle and stress point with wall thickness d (m).
 inline ShellModel read_gmsh(const std::string& path, double thickness) {
   sphshell::detail::require_positive("thickness", thickness);
-  detail::GmshParser parser(path, detail::read_whole_file(path, "mesh file"));
-  detail::MeshData mesh = parser.parse();
-  return detail::build_shell_model(mesh, path, thickness);
+  return detail::guard_reading(path, [&] {
+    detail::GmshParser parser(path, detail::read_whole_file(path, "mesh file"));
+    detail::MeshData mesh = parser.parse();
+    return detail::build_shell_model(mesh, path, thickness);
+  });
 }
 
 }  // namespace sphshell::io

@@ -11,10 +11,27 @@
 //   naming a node of no shell element is an Error. Two sets of the same name
 //   (a node set and an element set of one region, as preprocessors often
 //   write) are kept once when they hold the same particles, else an Error.
+// - Elements listed the other way round from their neighbours (across shared
+//   edges) are turned to agree with the orientation most elements of their
+//   connected part have; ShellModel::turned_cells lists them (stress point
+//   indices). A one-sided surface (a Moebius strip) is an Error naming two
+//   elements that cannot agree.
 // - A particle shared by elements of different thickness takes their
 //   area-weighted mean (its mass then equals the shares of its elements').
 //   The model's thickness() is that of the element with the lowest label.
+// - The file must be a regular file (not a directory or a device); its size
+//   times parsed_bytes_per_input_byte must fit in the memory available before
+//   it is read. An allocation that fails anyway is an Error with the estimate.
+// - A UTF-8 byte order mark at the start of a file is skipped.
+// - Coordinates beyond ±largest_coordinate are refused (a unit or format
+//   mistake); so is every element whose shape the solver cannot use: corners
+//   that coincide or lie on one line, a corner of (nearly) 180° (more than
+//   straight_corner_degrees), a bow-tie quad, and an element whose normal
+//   points against the mean normal of the elements at one of its nodes (it
+//   folds back, or is attached at a single node with the opposite
+//   orientation). Each names the element, its file and line.
 
+#include <sphshell/approx/memory_estimate.hpp>
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/shell/model.hpp>
@@ -23,8 +40,13 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <cerrno>
 #include <cstdint>
+#include <cstring>
+#include <filesystem>
 #include <functional>
+#include <ios>
+#include <new>
 #include <map>
 #include <optional>
 #include <string>
@@ -63,10 +85,122 @@ struct MeshData {
   std::vector<MeshSet> sets;
   // Text for an origin, such as "mesh file 'plate.inp', line 12".
   std::function<std::string(const MeshOrigin&)> describe;
+  // The end of the (main) file, for what concerns the mesh as a whole.
+  MeshOrigin end;
 };
 
 [[noreturn]] inline void mesh_error(const std::string& where, const std::string& problem) {
   throw Error("sphshell: " + where + ": " + problem);
+}
+
+// Limits of what a mesh file may hold (see the conventions at the top).
+// A coordinate beyond a million kilometres (in metres; a thousand in mm) is
+// no shell's: a unit or format mistake, and its squares overflow.
+inline constexpr double largest_coordinate = 1e9;
+// A corner this close to straight makes a quad a triangle with a node on its
+// edge: its two corner triangles give no independent direction.
+inline constexpr double straight_corner_degrees = 179.0;
+// The reader's own structures per byte of a text mesh: the line records, the
+// node and element maps and their origins take up to about this many bytes
+// for each byte of a short node or element line.
+inline constexpr double parsed_bytes_per_input_byte = 16.0;
+
+// A UTF-8 byte order mark, which some editors put before the first line.
+inline constexpr char utf8_bom[] = "\xEF\xBB\xBF";
+inline bool starts_with_bom(const std::string& text) { return text.compare(0, 3, utf8_bom) == 0; }
+
+// The operating system's reason for the last failure (errno), for messages.
+inline std::string system_reason(int code) { return code != 0 ? std::strerror(code) : "unknown reason"; }
+
+// A path to read as a mesh: it must exist and be a regular file (a directory
+// or a device would fail half-way, or never end). An Error naming the path
+// and the reason otherwise.
+inline std::uintmax_t require_regular_file(const std::string& path, const std::string& what) {
+  std::error_code error;
+  const std::filesystem::file_status status = std::filesystem::status(path, error);
+  if (error) throw Error("sphshell: cannot open " + what + " '" + path + "': " + error.message());
+  const auto kind = status.type();
+  if (kind != std::filesystem::file_type::regular) {
+    const char* name = kind == std::filesystem::file_type::directory   ? "a directory"
+                       : kind == std::filesystem::file_type::character ? "a character device"
+                       : kind == std::filesystem::file_type::block     ? "a block device"
+                       : kind == std::filesystem::file_type::fifo      ? "a pipe"
+                       : kind == std::filesystem::file_type::socket    ? "a socket"
+                                                                       : "not a file";
+    throw Error("sphshell: cannot read " + what + " '" + path + "': it is " + name + ", not a regular file");
+  }
+  const std::uintmax_t size = std::filesystem::file_size(path, error);
+  if (error) throw Error("sphshell: cannot read " + what + " '" + path + "': " + error.message());
+  return size;
+}
+
+// The memory `what` needs against what the machine offers (approx/memory_estimate.hpp):
+// an Error with both figures, before anything is allocated.
+inline void require_memory(const std::string& what, double bytes) {
+  const double available = approx::available_memory();
+  if (bytes > available)
+    throw Error("sphshell: " + what + " needs about " + approx::format_bytes(bytes) + " of memory; " +
+                approx::format_bytes(available) +
+                " available (MemAvailable, the cgroup limit and ulimit -v)");
+}
+
+// Runs a public reader's work; an allocation or stream failure that gets
+// through the estimates becomes an Error naming the file and the estimate.
+template <class Work>
+auto guard_reading(const std::string& path, Work&& work) -> decltype(work()) {
+  try {
+    return work();
+  } catch (const std::bad_alloc&) {
+    std::error_code error;
+    const std::uintmax_t size = std::filesystem::file_size(path, error);
+    const double estimate = error ? 0.0 : parsed_bytes_per_input_byte * static_cast<double>(size);
+    throw Error("sphshell: out of memory reading mesh file '" + path + "' (std::bad_alloc; estimated " +
+                approx::format_bytes(estimate) + ", " + approx::format_bytes(approx::available_memory()) +
+                " available)");
+  } catch (const std::ios_base::failure& failure) {
+    throw Error("sphshell: failed while reading mesh file '" + path + "': " + failure.what());
+  }
+}
+
+// The edit distance between two names, for "did you mean" suggestions.
+inline std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+// The candidate nearest to `name` (compared by `key`), for a suggestion.
+template <class Key>
+std::string nearest_name(const std::string& name, const std::vector<std::string>& candidates, Key&& key) {
+  std::string best;
+  std::size_t best_distance = static_cast<std::size_t>(-1);
+  for (const std::string& candidate : candidates) {
+    const std::size_t distance = edit_distance(key(name), key(candidate));
+    if (distance < best_distance) best_distance = distance, best = candidate;
+  }
+  return best;
+}
+
+// A byte that has no place in a text mesh (a control character other than
+// tab and carriage return): a binary or corrupted file. Its index, or npos.
+inline std::size_t find_control_byte(const std::string& text) {
+  for (std::size_t k = 0; k < text.size(); ++k) {
+    const auto byte = static_cast<unsigned char>(text[k]);
+    if ((byte < 0x20 && byte != '\t' && byte != '\r' && byte != '\n') || byte == 0x7F) return k;
+  }
+  return std::string::npos;
+}
+inline std::string byte_text(unsigned char byte) {
+  static const char digits[] = "0123456789ABCDEF";
+  return std::string("0x") + digits[byte >> 4] + digits[byte & 15];
 }
 
 inline std::string trim(const std::string& text) {
@@ -99,24 +233,97 @@ inline bool parse_real(const std::string& text, double& value) {
   return result.ec == std::errc() && result.ptr == end && begin != end && std::isfinite(value);
 }
 
-// An element's area from its corners, as ShellModel::from_cells computes it,
-// so a degenerate element can be named here.
-inline double element_area(const MeshElement& element, const std::vector<Vector3>& corners) {
-  const Vector3 doubled = element.node_count == 3
-                              ? Vector3((corners[1] - corners[0]).cross(corners[2] - corners[0]))
-                              : Vector3((corners[2] - corners[0]).cross(corners[3] - corners[1]));
-  return 0.5 * doubled.norm();
+// What is wrong with an element's shape, completing "element L ...", or ""
+// when the solver can use it: coincident or collinear corners, a straight
+// (≈ 180°) corner, a bow-tie quad (the limits of shell/model_checks.hpp and
+// straight_corner_degrees).
+inline std::string element_shape_problem(const MeshElement& element, const std::vector<Vector3>& corners) {
+  const std::size_t n = element.node_count;
+  const auto node = [&](std::size_t k) { return std::to_string(element.nodes[k % n]); };
+  double longest_squared = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double length_squared = (corners[(k + 1) % n] - corners[k]).squaredNorm();
+    if (!(length_squared > 0.0))
+      return "has zero area: nodes " + node(k) + " and " + node(k + 1) + " are at the same place";
+    longest_squared = std::max(longest_squared, length_squared);
+  }
+  Vector3 largest_corner = Vector3::Zero();
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vector3 corner = (corners[(k + 1) % n] - corners[k]).cross(corners[(k + n - 1) % n] - corners[k]);
+    if (corner.norm() > largest_corner.norm()) largest_corner = corner;
+  }
+  const double fraction = sphshell::detail::model_checks::degenerate_area_fraction;
+  if (!(0.5 * largest_corner.norm() > fraction * longest_squared))
+    return "has zero area: its nodes are collinear (a degenerate element)";
+  const double straight = std::cos(straight_corner_degrees * 3.14159265358979323846 / 180.0);
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vector3 next = corners[(k + 1) % n] - corners[k], previous = corners[(k + n - 1) % n] - corners[k];
+    if (next.dot(previous) < straight * next.norm() * previous.norm())
+      return "has a straight corner at node " + node(k) + " (more than " +
+             std::to_string(static_cast<int>(straight_corner_degrees)) +
+             " degrees): a degenerate element; split it or move the node";
+  }
+  if (n == 3) return "";
+  const Vector3 doubled = (corners[2] - corners[0]).cross(corners[3] - corners[1]);
+  const bool diagonals_span = 0.5 * doubled.norm() > fraction * longest_squared;
+  const Vector3 axis = diagonals_span ? doubled.normalized() : largest_corner.normalized();
+  int reversed_turns = 0;
+  for (std::size_t k = 0; k < 4; ++k) {
+    const Vector3 next = corners[(k + 1) % 4] - corners[k], previous = corners[(k + 3) % 4] - corners[k];
+    if (next.cross(previous).dot(axis) < 0.0) ++reversed_turns;
+  }
+  if (reversed_turns >= 2 || !diagonals_span)
+    return "has crossing edges (a bow-tie): list its nodes " + node(0) + ", " + node(1) + ", " + node(2) + ", " +
+           node(3) + " in order around the element";
+  return "";
 }
 
 inline std::string element_name(const MeshData& mesh, const MeshElement& element) {
   return "element " + std::to_string(element.label) + " (" + mesh.describe(element.origin) + ")";
 }
 
+// Every element's normal agrees with the mean normal (area-weighted, as the
+// model's particle directors) at each of its nodes; one that points against
+// it folds back onto its neighbours, or meets them at that node alone with
+// its nodes in the opposite order: an Error naming it and an element it
+// opposes, before the model's own checks would name a particle instead.
+inline void check_no_fold(const MeshData& mesh, const std::vector<Cell>& cells, const std::vector<Vector3>& positions,
+                          const std::vector<long long>& node_of_particle) {
+  std::vector<Vector3> cell_normal(cells.size());
+  std::vector<Vector3> node_normal(positions.size(), Vector3::Zero());
+  for (std::size_t c = 0; c < cells.size(); ++c) {
+    const Cell& cell = cells[c];
+    const auto x = [&](std::size_t k) { return positions[static_cast<std::size_t>(cell[k])]; };
+    cell_normal[c] = cell.is_triangle() ? Vector3((x(1) - x(0)).cross(x(2) - x(0))) : Vector3((x(2) - x(0)).cross(x(3) - x(1)));
+    for (int corner : cell) node_normal[static_cast<std::size_t>(corner)] += cell_normal[c];
+  }
+  for (std::size_t c = 0; c < cells.size(); ++c)
+    for (int corner : cells[c]) {
+      if (cell_normal[c].dot(node_normal[static_cast<std::size_t>(corner)]) > 0.0) continue;
+      std::size_t opposed = c;  // the element at this node most opposite to c
+      double lowest = 0.0;
+      for (std::size_t d = 0; d < cells.size(); ++d) {
+        if (std::find(cells[d].begin(), cells[d].end(), corner) == cells[d].end()) continue;
+        const double cosine = cell_normal[c].normalized().dot(cell_normal[d].normalized());
+        if (cosine < lowest) lowest = cosine, opposed = d;
+      }
+      const std::string node = std::to_string(node_of_particle[static_cast<std::size_t>(corner)]);
+      mesh_error(mesh.describe(mesh.elements[c].origin),
+                 "element " + std::to_string(mesh.elements[c].label) + " points against the elements around node " +
+                     node + (opposed != c ? " (such as " + element_name(mesh, mesh.elements[opposed]) + ")" : "") +
+                     ": its normal is opposite theirs; it folds back onto them, or meets them at node " + node +
+                     " alone with its nodes listed in the opposite order (reverse them)");
+    }
+}
+
 // The mesh as a ShellModel (see the conventions at the top). `file` names the
 // mesh for messages that concern it as a whole.
 inline ShellModel build_shell_model(MeshData& mesh, const std::string& file, double default_thickness) {
   if (mesh.elements.empty())
-    mesh_error("mesh file '" + file + "'", "holds no 3-node triangular or 4-node quadrilateral shell element");
+    mesh_error(mesh.describe(mesh.end) + " (its end)",
+               "the file holds no 3-node triangular or 4-node quadrilateral shell element");
+  sphshell::detail::model_checks::require_model_memory(
+      "mesh file '" + file + "'", static_cast<double>(mesh.nodes.size()), static_cast<double>(mesh.elements.size()));
   std::sort(mesh.elements.begin(), mesh.elements.end(),
             [](const MeshElement& a, const MeshElement& b) { return a.label < b.label; });
   for (std::size_t e = 1; e < mesh.elements.size(); ++e)
@@ -155,13 +362,38 @@ inline ShellModel build_shell_model(MeshData& mesh, const std::string& file, dou
   for (const MeshElement& element : mesh.elements) {
     std::vector<Vector3> corners;
     for (std::size_t k = 0; k < element.node_count; ++k) corners.push_back(mesh.nodes.at(element.nodes[k]));
-    if (!(element_area(element, corners) > 0.0))
-      mesh_error(mesh.describe(element.origin), "element " + std::to_string(element.label) +
-                                                    " has zero area (its nodes are collinear or coincide)");
+    const std::string shape = element_shape_problem(element, corners);
+    if (!shape.empty())
+      mesh_error(mesh.describe(element.origin), "element " + std::to_string(element.label) + " " + shape);
     const auto p = [&](std::size_t k) { return particle_of.at(element.nodes[k]); };
     cells.push_back(element.node_count == 3 ? Cell(p(0), p(1), p(2)) : Cell(p(0), p(1), p(2), p(3)));
   }
-  if (const std::optional<CellEdgeProblem> problem = ShellModel::find_cell_edge_problem(cells)) {
+  // Elements listed the other way round from their neighbours are turned to
+  // agree with them (the orientation most elements of their part have);
+  // model.turned_cells lists them. Only a mesh with such a flip is searched.
+  std::vector<int> turned;
+  std::optional<CellEdgeProblem> edge_problem = ShellModel::find_cell_edge_problem(cells);
+  if (edge_problem && edge_problem->kind == CellEdgeProblem::Kind::flipped) {
+    const sphshell::detail::model_checks::Orientation orientation = sphshell::detail::model_checks::orient_cells(cells);
+    if (orientation.problem) {
+      const CellEdgeProblem& problem = *orientation.problem;
+      mesh_error(mesh.describe(mesh.elements[problem.second_cell].origin),
+                 element_name(mesh, mesh.elements[problem.first_cell]) + " and " +
+                     element_name(mesh, mesh.elements[problem.second_cell]) + " meet at the edge between nodes " +
+                     std::to_string(node_of_particle[problem.edge_start]) + " and " +
+                     std::to_string(node_of_particle[problem.edge_end]) +
+                     " with opposite orientations however the elements are turned: the surface is one-sided "
+                     "(a Moebius strip) and has no consistent normal");
+    }
+    for (int c : orientation.turned) {
+      cells[c] = sphshell::detail::model_checks::turned(cells[c]);
+      MeshElement& element = mesh.elements[c];
+      std::reverse(element.nodes.begin() + 1, element.nodes.begin() + static_cast<std::ptrdiff_t>(element.node_count));
+    }
+    turned = orientation.turned;
+    edge_problem = ShellModel::find_cell_edge_problem(cells);
+  }
+  if (const std::optional<CellEdgeProblem> problem = edge_problem) {
     const MeshElement& first = mesh.elements[problem->first_cell];
     const MeshElement& second = mesh.elements[problem->second_cell];
     const std::string edge = "the edge between nodes " + std::to_string(node_of_particle[problem->edge_start]) +
@@ -175,6 +407,7 @@ inline ShellModel build_shell_model(MeshData& mesh, const std::string& file, dou
                pair + " both lie on " + edge + " with a third element; a junction of three or more elements " +
                    "is not supported (a particle has one director)");
   }
+  check_no_fold(mesh, cells, positions, node_of_particle);
 
   std::vector<double> thickness(mesh.elements.size());
   for (std::size_t e = 0; e < mesh.elements.size(); ++e) {
@@ -185,6 +418,7 @@ inline ShellModel build_shell_model(MeshData& mesh, const std::string& file, dou
                  "element " + std::to_string(element.label) + " has no shell section (no thickness)");
   }
   ShellModel model = ShellModel::from_cells(std::move(positions), cells, thickness.front());
+  model.turned_cells = std::move(turned);
 
   // Particles: the area-weighted mean of their elements' thicknesses, exactly
   // the common value where all agree.

@@ -34,10 +34,11 @@ class Cell {
 };
 
 // Two cells that share an edge and run along it in the same direction (their
-// normals flip across it), or a third cell on an edge (a junction, which one
-// director per particle cannot represent).
+// normals flip across it), a third cell on an edge (a junction, which one
+// director per particle cannot represent), or two cells whose orientations
+// no turning of cells can make agree (a one-sided surface, a Möbius strip).
 struct CellEdgeProblem {
-  enum class Kind { flipped, junction };
+  enum class Kind { flipped, junction, unorientable };
   Kind kind;
   int first_cell;
   int second_cell;

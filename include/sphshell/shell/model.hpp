@@ -39,6 +39,13 @@ class ShellModel {
   std::vector<Vector3> stress_point_position;
   std::vector<Vector3> stress_point_normal;
   std::vector<double> stress_point_area;
+  // Cells (stress point indices, ascending) whose corner order the builder
+  // reversed to agree with their neighbours: from_quads turns a quad that
+  // runs clockwise about its own corners' normals when its neighbours across
+  // shared edges run the other way; the mesh readers turn elements listed
+  // the other way round from most of their part (io/mesh_data.hpp). Empty
+  // when none was turned.
+  std::vector<int> turned_cells;
 
   // General constructor: the user's own particles and stress points. Areas are
   // integration weights (m²); the two sets of areas should each cover the
@@ -52,58 +59,72 @@ class ShellModel {
 
   // Particles at the nodes of user quads, stress points at the quad centres
   // (positions and normals averaged), areas from the quads: each quad's area goes
-  // to its stress point and a quarter of it to each of its four particles.
+  // to its stress point and a quarter of it to each of its four particles. A
+  // quad listed clockwise about its corners' normals whose neighbours across
+  // shared edges run the other way is turned (turned_cells lists it).
   static ShellModel from_quads(std::vector<Vector3> positions, std::vector<Vector3> normals,
                                const std::vector<Quad>& quads, double thickness) {
-    detail::model_checks::check_sizes(positions, normals);
-    detail::model_checks::check_quads(positions, normals, quads);
-    std::vector<Vector3> centres;
-    std::vector<Vector3> centre_normals;
-    for (const Quad& quad : quads) {
-      Vector3 centre = Vector3::Zero();
-      Vector3 normal = Vector3::Zero();
-      for (int corner : quad) {
-        centre += positions[corner] / 4.0;
-        normal += normals[corner];
+    const double estimate = detail::model_checks::require_model_memory(
+        "ShellModel::from_quads", static_cast<double>(positions.size()), static_cast<double>(quads.size()));
+    return detail::model_checks::guard_building("ShellModel::from_quads", estimate, [&] {
+      detail::model_checks::check_sizes(positions, normals);
+      std::vector<int> turned;  // the overload below turns them again and keeps the note
+      detail::model_checks::check_quads(positions, normals, oriented_quads(positions, normals, quads, turned));
+      std::vector<Vector3> centres;
+      std::vector<Vector3> centre_normals;
+      for (const Quad& quad : quads) {
+        Vector3 centre = Vector3::Zero();
+        Vector3 normal = Vector3::Zero();
+        for (int corner : quad) {
+          centre += positions[corner] / 4.0;
+          normal += normals[corner];
+        }
+        centres.push_back(centre);
+        centre_normals.push_back(normal);
       }
-      centres.push_back(centre);
-      centre_normals.push_back(normal);
-    }
-    return from_quads(std::move(positions), std::move(normals), quads, std::move(centres),
-                      std::move(centre_normals), thickness);
+      return from_quads(std::move(positions), std::move(normals), quads, std::move(centres),
+                        std::move(centre_normals), thickness);
+    });
   }
 
   // As above with the stress points' positions and normals given (builders of
   // curved shells put them on the exact surface).
   static ShellModel from_quads(std::vector<Vector3> positions, std::vector<Vector3> normals,
-                               const std::vector<Quad>& quads,
+                               const std::vector<Quad>& given_quads,
                                std::vector<Vector3> stress_positions,
                                std::vector<Vector3> stress_normals, double thickness) {
-    detail::model_checks::check_sizes(positions, normals);
-    detail::model_checks::check_quads(positions, normals, quads);
-    if (stress_positions.size() != quads.size() || stress_normals.size() != quads.size())
-      detail::invalid_parameter("stress point count", stress_positions.size(),
-                                "must equal the number of quads (" + std::to_string(quads.size()) + ")");
-    std::vector<double> areas(positions.size(), 0.0);
-    std::vector<double> stress_areas;
-    stress_areas.reserve(quads.size());
-    for (const Quad& quad : quads) {
-      const Vector3 diagonal1 = positions[quad[2]] - positions[quad[0]];
-      const Vector3 diagonal2 = positions[quad[3]] - positions[quad[1]];
-      const double area = 0.5 * diagonal1.cross(diagonal2).norm();
-      stress_areas.push_back(area);
-      for (int corner : quad) areas[corner] += area / 4.0;
-    }
-    for (std::size_t i = 0; i < positions.size(); ++i)
-      if (!(areas[i] > 0.0))
-        detail::invalid_parameter("particle " + std::to_string(i), positions[i].transpose(),
-                                  "belongs to no quad: every particle must be a corner of a quad");
-    std::vector<Cell> cells(quads.begin(), quads.end());
-    ShellModel model(std::move(positions), std::move(normals), std::move(areas),
-                     std::move(stress_positions), std::move(stress_normals),
-                     std::move(stress_areas), thickness, std::move(cells));
-    model.quads_ = quads;
-    return model;
+    const double estimate = detail::model_checks::require_model_memory(
+        "ShellModel::from_quads", static_cast<double>(positions.size()), static_cast<double>(given_quads.size()));
+    return detail::model_checks::guard_building("ShellModel::from_quads", estimate, [&] {
+      detail::model_checks::check_sizes(positions, normals);
+      std::vector<int> turned;
+      const std::vector<Quad> quads = oriented_quads(positions, normals, given_quads, turned);
+      detail::model_checks::check_quads(positions, normals, quads);
+      if (stress_positions.size() != quads.size() || stress_normals.size() != quads.size())
+        detail::invalid_parameter("stress point count", stress_positions.size(),
+                                  "must equal the number of quads (" + std::to_string(quads.size()) + ")");
+      std::vector<double> areas(positions.size(), 0.0);
+      std::vector<double> stress_areas;
+      stress_areas.reserve(quads.size());
+      for (const Quad& quad : quads) {
+        const Vector3 diagonal1 = positions[quad[2]] - positions[quad[0]];
+        const Vector3 diagonal2 = positions[quad[3]] - positions[quad[1]];
+        const double area = 0.5 * diagonal1.cross(diagonal2).norm();
+        stress_areas.push_back(area);
+        for (int corner : quad) areas[corner] += area / 4.0;
+      }
+      for (std::size_t i = 0; i < positions.size(); ++i)
+        if (!(areas[i] > 0.0))
+          detail::invalid_parameter("particle " + std::to_string(i), positions[i].transpose(),
+                                    "belongs to no quad: every particle must be a corner of a quad");
+      std::vector<Cell> cells(quads.begin(), quads.end());
+      ShellModel model(std::move(positions), std::move(normals), std::move(areas),
+                       std::move(stress_positions), std::move(stress_normals),
+                       std::move(stress_areas), thickness, std::move(cells));
+      model.quads_ = quads;
+      model.turned_cells = std::move(turned);
+      return model;
+    });
   }
 
   // Particles at the nodes of a triangle, quadrilateral or mixed mesh, one
@@ -118,50 +139,54 @@ class ShellModel {
   // no cell is an Error. quads() is filled only when every cell is a quad.
   static ShellModel from_cells(std::vector<Vector3> positions, const std::vector<Cell>& cells,
                                double thickness) {
-    if (cells.empty()) detail::invalid_parameter("cell count", 0, "a shell needs cells");
-    detail::model_checks::check_finite("particle", "position", positions);
-    for (std::size_t c = 0; c < cells.size(); ++c) detail::model_checks::check_cell(cells[c], c, positions.size());
-    if (const std::optional<CellEdgeProblem> problem = detail::model_checks::find_cell_edge_problem(cells))
-      detail::invalid_parameter(
-          "cells", std::to_string(problem->first_cell) + " and " + std::to_string(problem->second_cell),
-          detail::model_checks::describe_edge_problem(*problem, "particles"));
-    std::vector<Vector3> normals(positions.size(), Vector3::Zero());
-    std::vector<double> areas(positions.size(), 0.0);
-    std::vector<Vector3> centres, cell_normals;
-    std::vector<double> cell_areas;
-    centres.reserve(cells.size());
-    cell_normals.reserve(cells.size());
-    cell_areas.reserve(cells.size());
-    for (std::size_t c = 0; c < cells.size(); ++c) {
-      const Cell& cell = cells[c];
-      const double corners = static_cast<double>(cell.size());
-      // Twice the area times the unit normal, for a planar cell exactly.
-      const Vector3 doubled_area =
-          cell.is_triangle() ? Vector3((positions[cell[1]] - positions[cell[0]])
-                                           .cross(positions[cell[2]] - positions[cell[0]]))
-                             : Vector3((positions[cell[2]] - positions[cell[0]])
-                                           .cross(positions[cell[3]] - positions[cell[1]]));
-      const double area = 0.5 * doubled_area.norm();
-      if (!(area > 0.0))
-        detail::invalid_parameter("cell " + std::to_string(c) + " area", area, "must be > 0 (degenerate cell)");
-      Vector3 centre = Vector3::Zero();
-      for (int corner : cell) {
-        centre += positions[corner] / corners;
-        areas[corner] += area / corners;
-        normals[corner] += doubled_area;
+    const double estimate = detail::model_checks::require_model_memory(
+        "ShellModel::from_cells", static_cast<double>(positions.size()), static_cast<double>(cells.size()));
+    return detail::model_checks::guard_building("ShellModel::from_cells", estimate, [&] {
+      if (cells.empty()) detail::invalid_parameter("cell count", 0, "a shell needs cells");
+      detail::model_checks::check_finite("particle", "position", positions);
+      for (std::size_t c = 0; c < cells.size(); ++c) detail::model_checks::check_cell(cells[c], c, positions.size());
+      if (const std::optional<CellEdgeProblem> problem = detail::model_checks::find_cell_edge_problem(cells))
+        detail::invalid_parameter(
+            "cells", std::to_string(problem->first_cell) + " and " + std::to_string(problem->second_cell),
+            detail::model_checks::describe_edge_problem(*problem, "particles"));
+      std::vector<Vector3> normals(positions.size(), Vector3::Zero());
+      std::vector<double> areas(positions.size(), 0.0);
+      std::vector<Vector3> centres, cell_normals;
+      std::vector<double> cell_areas;
+      centres.reserve(cells.size());
+      cell_normals.reserve(cells.size());
+      cell_areas.reserve(cells.size());
+      for (std::size_t c = 0; c < cells.size(); ++c) {
+        const Cell& cell = cells[c];
+        const double corners = static_cast<double>(cell.size());
+        // Twice the area times the unit normal, for a planar cell exactly.
+        const Vector3 doubled_area =
+            cell.is_triangle() ? Vector3((positions[cell[1]] - positions[cell[0]])
+                                             .cross(positions[cell[2]] - positions[cell[0]]))
+                               : Vector3((positions[cell[2]] - positions[cell[0]])
+                                             .cross(positions[cell[3]] - positions[cell[1]]));
+        const double area = 0.5 * doubled_area.norm();
+        if (!(area > 0.0))
+          detail::invalid_parameter("cell " + std::to_string(c) + " area", area, "must be > 0 (degenerate cell)");
+        Vector3 centre = Vector3::Zero();
+        for (int corner : cell) {
+          centre += positions[corner] / corners;
+          areas[corner] += area / corners;
+          normals[corner] += doubled_area;
+        }
+        centres.push_back(centre);
+        cell_normals.push_back(doubled_area);
+        cell_areas.push_back(area);
       }
-      centres.push_back(centre);
-      cell_normals.push_back(doubled_area);
-      cell_areas.push_back(area);
-    }
-    for (std::size_t i = 0; i < positions.size(); ++i)
-      if (!(areas[i] > 0.0))
-        detail::invalid_parameter("particle " + std::to_string(i), positions[i].transpose(), "belongs to no cell");
-    ShellModel model(std::move(positions), std::move(normals), std::move(areas), std::move(centres),
-                     std::move(cell_normals), std::move(cell_areas), thickness, cells);
-    if (std::none_of(cells.begin(), cells.end(), [](const Cell& cell) { return cell.is_triangle(); }))
-      for (const Cell& cell : cells) model.quads_.push_back({cell[0], cell[1], cell[2], cell[3]});
-    return model;
+      for (std::size_t i = 0; i < positions.size(); ++i)
+        if (!(areas[i] > 0.0))
+          detail::invalid_parameter("particle " + std::to_string(i), positions[i].transpose(), "belongs to no cell");
+      ShellModel model(std::move(positions), std::move(normals), std::move(areas), std::move(centres),
+                       std::move(cell_normals), std::move(cell_areas), thickness, cells);
+      if (std::none_of(cells.begin(), cells.end(), [](const Cell& cell) { return cell.is_triangle(); }))
+        for (const Cell& cell : cells) model.quads_.push_back({cell[0], cell[1], cell[2], cell[3]});
+      return model;
+    });
   }
 
   // The first orientation flip or junction among cells in the order given, or
@@ -350,6 +375,40 @@ class ShellModel {
 
  private:
   static constexpr double kPi = 3.14159265358979323846;
+
+  // The quads with those turned that run clockwise about all four of their
+  // corners' normals (an inverted quad) while propagation across shared edges
+  // from their neighbours turns them too (shell/model_checks.hpp
+  // orient_cells); `turned` gets their indices. Quads that agree with their
+  // normals are never touched, and without an inverted quad nothing is
+  // searched. A quad inverted with all its neighbours stays, for check_quads
+  // to refuse.
+  static std::vector<Quad> oriented_quads(const std::vector<Vector3>& positions, const std::vector<Vector3>& normals,
+                                          const std::vector<Quad>& quads, std::vector<int>& turned) {
+    const auto inverted = [&](const Quad& quad) {
+      for (int corner : quad)
+        if (corner < 0 || static_cast<std::size_t>(corner) >= positions.size()) return false;  // check_quads names it
+      const Vector3 axis = (positions[quad[2]] - positions[quad[0]]).cross(positions[quad[3]] - positions[quad[1]]);
+      for (int corner : quad)
+        if (!(normals[corner].dot(axis) < 0.0)) return false;
+      return true;
+    };
+    if (std::none_of(quads.begin(), quads.end(), inverted)) return quads;
+    for (const Quad& quad : quads)
+      for (std::size_t k = 0; k < 4; ++k)
+        for (std::size_t l = 0; l < k; ++l)
+          if (quad[k] == quad[l] || quad[k] < 0 || static_cast<std::size_t>(quad[k]) >= positions.size())
+            return quads;  // invalid corners: check_quads names them
+    const std::vector<Cell> cells(quads.begin(), quads.end());
+    const detail::model_checks::Orientation orientation = detail::model_checks::orient_cells(cells);
+    std::vector<Quad> result = quads;
+    for (int q : orientation.turned)
+      if (inverted(quads[q])) {
+        result[q] = {quads[q][0], quads[q][3], quads[q][2], quads[q][1]};
+        turned.push_back(q);
+      }
+    return result;
+  }
 
   // The constructors' common path; `cells` are the model's cells (empty for
   // the general constructor), known before the checks so that coincident

@@ -89,27 +89,33 @@ inline ShellModel ShellModel::spherical_cap(double radius, double half_angle, in
 
 template <class Surface>
 ShellModel ShellModel::structured(int nu, int nv, bool periodic_u, Surface&& surface, double thickness) {
-  std::vector<Vector3> positions, normals;
   const int columns = periodic_u ? nu : nu - 1;
-  auto u_of = [&](double i) { return i / columns; };
-  for (int j = 0; j < nv; ++j)
-    for (int i = 0; i < nu; ++i) {
-      auto point = surface(u_of(i), static_cast<double>(j) / (nv - 1));
-      positions.push_back(point.first);
-      normals.push_back(point.second);
-    }
-  std::vector<Quad> quads;
-  std::vector<Vector3> centres, centre_normals;
-  for (int j = 0; j + 1 < nv; ++j)
-    for (int i = 0; i < columns; ++i) {
-      const int next = (i + 1) % nu;
-      quads.push_back({j * nu + i, j * nu + next, (j + 1) * nu + next, (j + 1) * nu + i});
-      auto centre = surface(u_of(i + 0.5), (j + 0.5) / (nv - 1));
-      centres.push_back(centre.first);
-      centre_normals.push_back(centre.second);
-    }
-  return from_quads(std::move(positions), std::move(normals), quads, std::move(centres), std::move(centre_normals),
-                    thickness);
+  // Counted before anything is allocated: a grid too large is an Error with its size.
+  const double particles = static_cast<double>(nu) * nv, cells = static_cast<double>(columns) * (nv - 1);
+  const std::string grid = "the grid of " + std::to_string(nu) + " x " + std::to_string(nv) + " particles";
+  const double estimate = detail::model_checks::require_model_memory(grid, particles, cells);
+  return detail::model_checks::guard_building(grid, estimate, [&] {
+    std::vector<Vector3> positions, normals;
+    auto u_of = [&](double i) { return i / columns; };
+    for (int j = 0; j < nv; ++j)
+      for (int i = 0; i < nu; ++i) {
+        auto point = surface(u_of(i), static_cast<double>(j) / (nv - 1));
+        positions.push_back(point.first);
+        normals.push_back(point.second);
+      }
+    std::vector<Quad> quads;
+    std::vector<Vector3> centres, centre_normals;
+    for (int j = 0; j + 1 < nv; ++j)
+      for (int i = 0; i < columns; ++i) {
+        const int next = (i + 1) % nu;
+        quads.push_back({j * nu + i, j * nu + next, (j + 1) * nu + next, (j + 1) * nu + i});
+        auto centre = surface(u_of(i + 0.5), (j + 0.5) / (nv - 1));
+        centres.push_back(centre.first);
+        centre_normals.push_back(centre.second);
+      }
+    return from_quads(std::move(positions), std::move(normals), quads, std::move(centres), std::move(centre_normals),
+                      thickness);
+  });
 }
 
 }  // namespace sphshell

@@ -7,6 +7,7 @@
 // quad, particle or parameter, its value and the limit. The limits are named
 // so a message can state them.
 
+#include <sphshell/approx/memory_estimate.hpp>
 #include <sphshell/approx/neighbour_search.hpp>
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/statistics.hpp>
@@ -19,6 +20,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <new>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -269,6 +271,40 @@ inline void require_grid_size(const char* names, long long count) {
   if (count > static_cast<long long>(std::numeric_limits<int>::max()))
     detail::invalid_parameter(names, count, "must be at most 2^31 - 1 particles (the library's indices are int)");
 }
+// What building a model takes per particle and per cell (stress point), the
+// checks' temporary structures included: positions, normals, areas and
+// thicknesses (about 10 doubles each), the cell lists and neighbour grids of
+// the checks, the edge map of the orientation check and the cells themselves.
+inline constexpr double bytes_per_model_particle = 256;
+inline constexpr double bytes_per_model_cell = 256;
+// The memory a model of this size will take, checked before it is allocated:
+// an Error with the estimate and the memory available, never std::bad_alloc
+// after seconds of work.
+inline double require_model_memory(const std::string& what, double particles, double cells) {
+  const double needed = particles * bytes_per_model_particle + cells * bytes_per_model_cell;
+  const double available = approx::available_memory();
+  if (needed > available) {
+    std::ostringstream text;
+    text.precision(12);
+    text << "sphshell: " << what << ": a model of " << particles << " particles and " << cells
+         << " cells needs about " << approx::format_bytes(needed) << " of memory; "
+         << approx::format_bytes(available) << " available (MemAvailable, the cgroup limit and ulimit -v)";
+    throw Error(text.str());
+  }
+  return needed;
+}
+// Runs a builder's work; an allocation that fails anyway becomes an Error
+// naming the estimate.
+template <class Work>
+auto guard_building(const std::string& what, double estimate, Work&& work) -> decltype(work()) {
+  try {
+    return work();
+  } catch (const std::bad_alloc&) {
+    throw Error("sphshell: " + what + ": out of memory (std::bad_alloc; estimated " +
+                approx::format_bytes(estimate) + ", " + approx::format_bytes(approx::available_memory()) +
+                " available)");
+  }
+}
 inline void check_sizes(const std::vector<Vector3>& positions, const std::vector<Vector3>& normals) {
   if (normals.size() != positions.size())
     detail::invalid_parameter("normal count", normals.size(),
@@ -318,6 +354,80 @@ inline std::optional<CellEdgeProblem> find_cell_edge_problem(const std::vector<C
   return std::nullopt;
 }
 
+// A cell with its corners in the opposite order (the first corner kept):
+// the same cell seen from the other side.
+inline Cell turned(const Cell& cell) {
+  return cell.is_triangle() ? Cell(cell[0], cell[2], cell[1]) : Cell(cell[0], cell[3], cell[2], cell[1]);
+}
+
+// Consistent orientation by propagation across shared edges (two cells on an
+// edge must run along it in opposite directions): each connected part of the
+// mesh keeps the orientation most of its cells have as given (the lowest
+// cell's on a tie) and the others are turned. Returns the turned cells'
+// indices, ascending, or a problem: the first two cells that no turning makes
+// agree (a one-sided surface). Edges of three or more cells (junctions) are
+// not crossed; find_cell_edge_problem names them. Corners must be valid.
+struct Orientation {
+  std::vector<int> turned;
+  std::optional<CellEdgeProblem> problem;
+};
+inline Orientation orient_cells(const std::vector<Cell>& cells) {
+  struct EdgeUse {
+    int cell;
+    bool ascending;  // the cell runs from the lower to the higher index
+  };
+  std::unordered_map<std::uint64_t, std::vector<EdgeUse>> uses;
+  uses.reserve(2 * cells.size());
+  const auto key = [](int a, int b) {
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(std::min(a, b))) << 32) |
+           static_cast<std::uint32_t>(std::max(a, b));
+  };
+  for (std::size_t c = 0; c < cells.size(); ++c)
+    for (std::size_t k = 0; k < cells[c].size(); ++k) {
+      const int from = cells[c][k], to = cells[c][(k + 1) % cells[c].size()];
+      uses[key(from, to)].push_back({static_cast<int>(c), from < to});
+    }
+  Orientation result;
+  std::vector<signed char> turn(cells.size(), -1);  // -1: not reached yet
+  std::vector<int> part, queue;
+  for (std::size_t seed = 0; seed < cells.size(); ++seed) {
+    if (turn[seed] >= 0) continue;
+    part.clear();
+    queue.assign(1, static_cast<int>(seed));
+    turn[seed] = 0;
+    for (std::size_t next = 0; next < queue.size(); ++next) {
+      const int c = queue[next];
+      part.push_back(c);
+      const Cell& cell = cells[static_cast<std::size_t>(c)];
+      for (std::size_t k = 0; k < cell.size(); ++k) {
+        const int from = cell[k], to = cell[(k + 1) % cell.size()];
+        const std::vector<EdgeUse>& edge = uses.at(key(from, to));
+        if (edge.size() != 2) continue;
+        const EdgeUse& mine = edge[0].cell == c ? edge[0] : edge[1];
+        const EdgeUse& other = edge[0].cell == c ? edge[1] : edge[0];
+        if (other.cell == c) continue;
+        // Opposite directions after turning: turn[other] = turn[c] xor (same direction as given).
+        const signed char wanted = static_cast<signed char>(turn[static_cast<std::size_t>(c)] ^ (mine.ascending == other.ascending));
+        signed char& seen = turn[static_cast<std::size_t>(other.cell)];
+        if (seen < 0) {
+          seen = wanted;
+          queue.push_back(other.cell);
+        } else if (seen != wanted && !result.problem) {
+          result.problem = CellEdgeProblem{CellEdgeProblem::Kind::unorientable, std::min(c, other.cell),
+                                           std::max(c, other.cell), from, to};
+        }
+      }
+    }
+    std::size_t turned_count = 0;
+    for (int c : part) turned_count += turn[static_cast<std::size_t>(c)];
+    if (2 * turned_count > part.size())
+      for (int c : part) turn[static_cast<std::size_t>(c)] ^= 1;
+  }
+  for (std::size_t c = 0; c < cells.size(); ++c)
+    if (turn[c] == 1) result.turned.push_back(static_cast<int>(c));
+  return result;
+}
+
 // What went wrong, for a message; `corner_names` says what the edge's ends are
 // ("particles", "nodes").
 inline std::string describe_edge_problem(const CellEdgeProblem& problem, const std::string& corner_names) {
@@ -326,6 +436,9 @@ inline std::string describe_edge_problem(const CellEdgeProblem& problem, const s
   if (problem.kind == CellEdgeProblem::Kind::flipped)
     return "they run along " + edge +
            " in the same direction, so their normals flip there; reverse the corner order of one side";
+  if (problem.kind == CellEdgeProblem::Kind::unorientable)
+    return "they meet at " + edge + " with opposite orientations however the cells are turned: the surface " +
+           "is one-sided (a Möbius strip) and has no consistent normal";
   return "a third cell meets at " + edge + "; a junction of three or more cells is not supported";
 }
 

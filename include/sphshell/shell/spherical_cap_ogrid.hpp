@@ -165,25 +165,36 @@ inline Vector3 on_sphere(double radius, Plane p) {
 // centres (the centre of the four corners in the polar plane, on the sphere).
 inline ShellModel spherical_cap_ogrid(double radius, double half_angle, int m, double thickness,
                                       const OGridOptions& options = {}) {
-  const detail::ogrid::Layout g = detail::ogrid::layout(radius, half_angle, m, options);
-  std::vector<Vector3> positions, normals, centres, centre_normals;
-  for (const detail::ogrid::Plane& p : g.nodes) {
-    positions.push_back(detail::ogrid::on_sphere(radius, p));
-    normals.push_back(positions.back() / radius);
-  }
-  for (const Quad& q : g.quads) {
-    detail::ogrid::Plane centre{0.0, 0.0};
-    for (int corner : q) centre = centre + 0.25 * g.nodes[std::size_t(corner)];
-    centres.push_back(detail::ogrid::on_sphere(radius, centre));
-    centre_normals.push_back(centres.back() / radius);
-  }
-  ShellModel model = ShellModel::from_quads(positions, normals, g.quads, centres, centre_normals, thickness);
-  const double tolerance = 1e-9 * radius;
-  const double rim_height = radius * std::cos(half_angle);
-  const Vector3 apex = positions[std::size_t(g.apex)];
-  model.define_set("boundary", [&](const Vector3& x) { return x.z() < rim_height + tolerance; });
-  model.define_set("apex", [&](const Vector3& x) { return (x - apex).norm() < tolerance; });
-  return model;
+  // The block's (m + 1)² nodes and m² cells, counted before the layout is
+  // allocated (the rings around it add fewer); an allocation that fails
+  // anyway is an Error with this estimate.
+  const double block_nodes = (m + 1.0) * (m + 1.0), block_cells = 1.0 * m * m;
+  // (An m the layout refuses is named by it first.)
+  const bool countable = m >= 2 && m <= detail::ogrid::max_block_divisions;
+  const double estimate =
+      countable ? sphshell::detail::model_checks::require_model_memory("spherical_cap_ogrid", block_nodes, block_cells)
+                : 0.0;
+  return sphshell::detail::model_checks::guard_building("spherical_cap_ogrid", estimate, [&] {
+    const detail::ogrid::Layout g = detail::ogrid::layout(radius, half_angle, m, options);
+    std::vector<Vector3> positions, normals, centres, centre_normals;
+    for (const detail::ogrid::Plane& p : g.nodes) {
+      positions.push_back(detail::ogrid::on_sphere(radius, p));
+      normals.push_back(positions.back() / radius);
+    }
+    for (const Quad& q : g.quads) {
+      detail::ogrid::Plane centre{0.0, 0.0};
+      for (int corner : q) centre = centre + 0.25 * g.nodes[std::size_t(corner)];
+      centres.push_back(detail::ogrid::on_sphere(radius, centre));
+      centre_normals.push_back(centres.back() / radius);
+    }
+    ShellModel model = ShellModel::from_quads(positions, normals, g.quads, centres, centre_normals, thickness);
+    const double tolerance = 1e-9 * radius;
+    const double rim_height = radius * std::cos(half_angle);
+    const Vector3 apex = positions[std::size_t(g.apex)];
+    model.define_set("boundary", [&](const Vector3& x) { return x.z() < rim_height + tolerance; });
+    model.define_set("apex", [&](const Vector3& x) { return (x - apex).norm() < tolerance; });
+    return model;
+  });
 }
 
 // Shape figures of the O-grid cells on the sphere.
