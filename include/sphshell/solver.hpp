@@ -28,6 +28,7 @@
 #include <sphshell/shell/constraints.hpp>
 #include <sphshell/shell/loads.hpp>
 #include <sphshell/shell/model.hpp>
+#include <sphshell/shell/particle_selection.hpp>
 #include <sphshell/io/binary_stream.hpp>
 #include <sphshell/solver/checkpoint.hpp>
 #include <sphshell/solver/energy_ledger.hpp>
@@ -137,28 +138,29 @@ class Solver {
     throw Error("sphshell: out of memory building the solver (std::bad_alloc): " + solver::memory_estimate_text());
   }
 
-  // Boundary conditions on particle sets (shell/constraints.hpp).
-  void clamp(const ParticleSet& set) { constraints_.clamp(checked(set)); }
+  // Boundary conditions on particle sets, given by ids or by a model set's
+  // name (shell/particle_selection.hpp; shell/constraints.hpp).
+  void clamp(const ParticleSelection& set) { constraints_.clamp(checked(set)); }
   // Translations fixed, rotations free ("soft" simple support).
-  void simply_support(const ParticleSet& set) { constraints_.simply_support(checked(set)); }
+  void simply_support(const ParticleSelection& set) { constraints_.simply_support(checked(set)); }
   // Translations fixed and the director kept from tilting along the edge
   // ("hard" simple support of Mindlin plates): fixes rotation about n × t.
-  void simply_support_hard(const ParticleSet& set, const Vector3& edge_tangent) {
+  void simply_support_hard(const ParticleSelection& set, const Vector3& edge_tangent) {
     constraints_.simply_support_hard(checked(set), model_.particle_normal, edge_tangent);
   }
   // Mirror symmetry about a plane (given by its normal) through the particles:
   // no translation across the plane and no rotation tilting the director out of it.
-  void symmetry_plane(const ParticleSet& set, const Vector3& plane_normal) {
+  void symmetry_plane(const ParticleSelection& set, const Vector3& plane_normal) {
     constraints_.symmetry_plane(checked(set), model_.particle_normal, plane_normal);
   }
-  void fix_translation(const ParticleSet& set, const Vector3& direction) {
+  void fix_translation(const ParticleSelection& set, const Vector3& direction) {
     constraints_.fix_translation(checked(set), direction);
   }
-  void fix_rotation(const ParticleSet& set, const Vector3& axis) { constraints_.fix_rotation(checked(set), axis); }
+  void fix_rotation(const ParticleSelection& set, const Vector3& axis) { constraints_.fix_rotation(checked(set), axis); }
   // Prescribed displacement u(X, t) (a Vector3 from the reference position and
   // time) imposed on all three translations of the set.
   template <class DisplacementFunction>
-  void prescribe_displacement(const ParticleSet& set, DisplacementFunction displacement) {
+  void prescribe_displacement(const ParticleSelection& set, DisplacementFunction displacement) {
     static_assert(std::is_invocable_r_v<Vector3, DisplacementFunction, const Vector3&, double>,
                   "prescribe_displacement: the function must be callable as Vector3 u(const Vector3& X, double t)");
     for (int i : checked(set))
@@ -169,7 +171,7 @@ class Solver {
   }
   // Prescribed velocity v(X, t) imposed on all three translations of the set.
   template <class VelocityFunction>
-  void prescribe_velocity(const ParticleSet& set, VelocityFunction velocity) {
+  void prescribe_velocity(const ParticleSelection& set, VelocityFunction velocity) {
     static_assert(std::is_invocable_r_v<Vector3, VelocityFunction, const Vector3&, double>,
                   "prescribe_velocity: the function must be callable as Vector3 v(const Vector3& X, double t)");
     add_motion(set, std::make_unique<detail::PrescribedVelocity<VelocityFunction>>(std::move(velocity)));
@@ -177,14 +179,14 @@ class Solver {
 
   // Loads. Pressure p(X, t) in Pa (see loads.hpp for the sign convention).
   template <class PressureFunction>
-  void add_pressure(const ParticleSet& set, PressureFunction pressure,
+  void add_pressure(const ParticleSelection& set, PressureFunction pressure,
                     PressureDirection direction = PressureDirection::follower) {
     static_assert(std::is_invocable_r_v<double, PressureFunction, const Vector3&, double>,
                   "add_pressure: the pressure must be callable as double p(const Vector3& X, double t)");
     loads_.add(std::make_unique<detail::PressureLoad<PressureFunction>>(checked(set), std::move(pressure), direction));
   }
   template <class TimeFunction = time_function::Step>
-  void add_uniform_pressure(const ParticleSet& set, double pressure, TimeFunction time = {},
+  void add_uniform_pressure(const ParticleSelection& set, double pressure, TimeFunction time = {},
                             PressureDirection direction = PressureDirection::follower) {
     detail::require_finite("pressure", pressure);
     loads_.add(std::make_unique<detail::UniformPressureLoad<TimeFunction>>(checked(set), pressure, std::move(time),
@@ -192,20 +194,20 @@ class Solver {
   }
   // A force (N) on every particle of the set.
   template <class TimeFunction = time_function::Step>
-  void add_point_force(const ParticleSet& set, const Vector3& force, TimeFunction time = {}) {
+  void add_point_force(const ParticleSelection& set, const Vector3& force, TimeFunction time = {}) {
     if (!force.allFinite()) detail::invalid_parameter("point force", force.transpose(), "must be finite");
     loads_.add(std::make_unique<detail::PointForceLoad<TimeFunction>>(checked(set), force, std::move(time)));
   }
   // A moment (N·m) on every particle of the set; its part along the director
   // (drilling) does not act.
   template <class TimeFunction = time_function::Step>
-  void add_point_moment(const ParticleSet& set, const Vector3& moment, TimeFunction time = {}) {
+  void add_point_moment(const ParticleSelection& set, const Vector3& moment, TimeFunction time = {}) {
     if (!moment.allFinite()) detail::invalid_parameter("point moment", moment.transpose(), "must be finite");
     loads_.add(std::make_unique<detail::PointMomentLoad<TimeFunction>>(checked(set), moment, std::move(time)));
   }
   // Gravity (or any uniform acceleration field, m/s²) on the set's mass.
   template <class TimeFunction = time_function::Step>
-  void add_gravity(const ParticleSet& set, const Vector3& acceleration, TimeFunction time = {}) {
+  void add_gravity(const ParticleSelection& set, const Vector3& acceleration, TimeFunction time = {}) {
     if (!acceleration.allFinite())
       detail::invalid_parameter("gravity acceleration", acceleration.transpose(), "must be finite");
     loads_.add(std::make_unique<detail::GravityLoad<TimeFunction>>(checked(set), acceleration, std::move(time)));
@@ -610,7 +612,9 @@ class Solver {
   Parts fracture_parts() { return Parts{model_, particles_, points_, states_, assembler_, forces_}; }
 
   // A set's indices in range and each listed once (solver/run_checks.hpp).
-  ParticleSet checked(const ParticleSet& set) const { return solver::checked_set(set, model_.particle_count()); }
+  ParticleSet checked(const ParticleSelection& set) const {
+    return solver::checked_set(set.members(model_), model_.particle_count());
+  }
   void check_particle(int particle) const {
     if (particle < 0 || static_cast<std::size_t>(particle) >= particles_.size())
       detail::invalid_parameter("particle index", particle, "out of range");
@@ -621,7 +625,7 @@ class Solver {
     if (k < 0 || k >= output_points) detail::invalid_parameter("thickness output point", k, "out of range");
   }
   template <class Motion>
-  void add_motion(const ParticleSet& set, std::unique_ptr<Motion> motion) {
+  void add_motion(const ParticleSelection& set, std::unique_ptr<Motion> motion) {
     constraints_.add_motion(checked(set), std::move(motion), model_.particle_position, time_, time_step_);
   }
 

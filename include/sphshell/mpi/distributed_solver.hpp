@@ -60,6 +60,8 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <mutex>
+#include <exception>
 #include <optional>
 #include <random>
 #include <string>
@@ -85,6 +87,9 @@ class DistributedSolver {
   using MaterialParameters = typename Material::Parameters;
   using Points = solver::IntegrationPoints<Approx>;
   using States = solver::SectionStates<Rule, Material>;
+  // Whether save_checkpoint compiles for these policies (solver/checkpoint.hpp).
+  static constexpr bool can_checkpoint = solver::checkpoint::can_checkpoint<
+      Crack, Stepper, typename thickness::Section<Rule, Material>::State>();
 
   // Collective: every rank of comm passes the same model, parameters and
   // options. comm must outlive the solver.
@@ -99,58 +104,46 @@ class DistributedSolver {
   // Conditions (shell/constraints.hpp) on a set of global particle ids or on a
   // named set of the model. Every rank checks the whole set as the Solver
   // does (the same Error everywhere), then applies it to the members it owns.
-  void clamp(const ParticleSet& set) {
+  void clamp(const ParticleSelection& set) {
     on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
       checker_.clamp(global);
       constraints_.clamp(local);
     });
   }
-  void clamp(const std::string& set_name) { clamp(named(set_name)); }
-  void simply_support(const ParticleSet& set) {
+  void simply_support(const ParticleSelection& set) {
     on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
       checker_.simply_support(global);
       constraints_.simply_support(local);
     });
   }
-  void simply_support(const std::string& set_name) { simply_support(named(set_name)); }
-  void simply_support_hard(const ParticleSet& set, const Vector3& edge_tangent) {
+  void simply_support_hard(const ParticleSelection& set, const Vector3& edge_tangent) {
     on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
       checker_.simply_support_hard(global, model_.particle_normal, edge_tangent);
       constraints_.simply_support_hard(local, reference_normal_, edge_tangent);
     });
   }
-  void simply_support_hard(const std::string& set_name, const Vector3& edge_tangent) {
-    simply_support_hard(named(set_name), edge_tangent);
-  }
-  void symmetry_plane(const ParticleSet& set, const Vector3& plane_normal) {
+  void symmetry_plane(const ParticleSelection& set, const Vector3& plane_normal) {
     on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
       checker_.symmetry_plane(global, model_.particle_normal, plane_normal);
       constraints_.symmetry_plane(local, reference_normal_, plane_normal);
     });
   }
-  void symmetry_plane(const std::string& set_name, const Vector3& plane_normal) {
-    symmetry_plane(named(set_name), plane_normal);
-  }
-  void fix_translation(const ParticleSet& set, const Vector3& direction) {
+  void fix_translation(const ParticleSelection& set, const Vector3& direction) {
     on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
       checker_.fix_translation(global, direction);
       constraints_.fix_translation(local, direction);
     });
   }
-  void fix_translation(const std::string& set_name, const Vector3& direction) {
-    fix_translation(named(set_name), direction);
-  }
-  void fix_rotation(const ParticleSet& set, const Vector3& axis) {
+  void fix_rotation(const ParticleSelection& set, const Vector3& axis) {
     on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
       checker_.fix_rotation(global, axis);
       constraints_.fix_rotation(local, axis);
     });
   }
-  void fix_rotation(const std::string& set_name, const Vector3& axis) { fix_rotation(named(set_name), axis); }
   // Prescribed velocity v(X, t) on all three translations (the function is
   // copied, once for the check of the whole set).
   template <class VelocityFunction>
-  void prescribe_velocity(const ParticleSet& set, VelocityFunction velocity) {
+  void prescribe_velocity(const ParticleSelection& set, VelocityFunction velocity) {
     static_assert(std::is_invocable_r_v<Vector3, VelocityFunction, const Vector3&, double>,
                   "prescribe_velocity: the function must be callable as Vector3 v(const Vector3& X, double t)");
     on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
@@ -161,7 +154,7 @@ class DistributedSolver {
     });
   }
   template <class DisplacementFunction>
-  void prescribe_displacement(const ParticleSet& set, DisplacementFunction displacement) {
+  void prescribe_displacement(const ParticleSelection& set, DisplacementFunction displacement) {
     static_assert(std::is_invocable_r_v<Vector3, DisplacementFunction, const Vector3&, double>,
                   "prescribe_displacement: the function must be callable as Vector3 u(const Vector3& X, double t)");
     on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
@@ -177,8 +170,8 @@ class DistributedSolver {
           solver::check_prescribed_displacement_start(i, displacement(model_.particle_position[i], time_),
                                                       particles_.position[at] - reference_position_[at], time_,
                                                       steps_, model_.minimum_spacing());
-        } catch (const Error& error) {
-          failure = Failure{static_cast<long>(k), error.what()};
+        } catch (...) {
+          failure = failure_of_current_exception(comm_, static_cast<long>(k));
         }
       }
       agree(failure);
@@ -188,18 +181,9 @@ class DistributedSolver {
     });
   }
 
-  template <class VelocityFunction>
-  void prescribe_velocity(const std::string& set_name, VelocityFunction velocity) {
-    prescribe_velocity(named(set_name), std::move(velocity));
-  }
-  template <class DisplacementFunction>
-  void prescribe_displacement(const std::string& set_name, DisplacementFunction displacement) {
-    prescribe_displacement(named(set_name), std::move(displacement));
-  }
-
   // Loads on a set of global ids or a named set (shell/loads.hpp).
   template <class PressureFunction>
-  void add_pressure(const ParticleSet& set, PressureFunction pressure,
+  void add_pressure(const ParticleSelection& set, PressureFunction pressure,
                     PressureDirection direction = PressureDirection::follower) {
     static_assert(std::is_invocable_r_v<double, PressureFunction, const Vector3&, double>,
                   "add_pressure: the pressure must be callable as double p(const Vector3& X, double t)");
@@ -207,13 +191,8 @@ class DistributedSolver {
       loads_.add(std::make_unique<sphshell::detail::PressureLoad<PressureFunction>>(local, std::move(pressure), direction));
     });
   }
-  template <class PressureFunction>
-  void add_pressure(const std::string& set_name, PressureFunction pressure,
-                    PressureDirection direction = PressureDirection::follower) {
-    add_pressure(named(set_name), std::move(pressure), direction);
-  }
   template <class TimeFunction = time_function::Step>
-  void add_uniform_pressure(const ParticleSet& set, double pressure, TimeFunction time = {},
+  void add_uniform_pressure(const ParticleSelection& set, double pressure, TimeFunction time = {},
                             PressureDirection direction = PressureDirection::follower) {
     collectively(comm_, [&] {
       sphshell::detail::require_finite("pressure", pressure);
@@ -224,23 +203,14 @@ class DistributedSolver {
     });
   }
   template <class TimeFunction = time_function::Step>
-  void add_uniform_pressure(const std::string& set_name, double pressure, TimeFunction time = {},
-                            PressureDirection direction = PressureDirection::follower) {
-    add_uniform_pressure(named(set_name), pressure, time, direction);
-  }
-  template <class TimeFunction = time_function::Step>
-  void add_point_force(const ParticleSet& set, const Vector3& force, TimeFunction time = {}) {
+  void add_point_force(const ParticleSelection& set, const Vector3& force, TimeFunction time = {}) {
     on_set(set, [&](const ParticleSet&, const ParticleSet& local) {
       if (!force.allFinite()) sphshell::detail::invalid_parameter("point force", force.transpose(), "must be finite");
       loads_.add(std::make_unique<sphshell::detail::PointForceLoad<TimeFunction>>(local, force, time));
     });
   }
   template <class TimeFunction = time_function::Step>
-  void add_point_force(const std::string& set_name, const Vector3& force, TimeFunction time = {}) {
-    add_point_force(named(set_name), force, time);
-  }
-  template <class TimeFunction = time_function::Step>
-  void add_point_moment(const ParticleSet& set, const Vector3& moment, TimeFunction time = {}) {
+  void add_point_moment(const ParticleSelection& set, const Vector3& moment, TimeFunction time = {}) {
     on_set(set, [&](const ParticleSet&, const ParticleSet& local) {
       if (!moment.allFinite())
         sphshell::detail::invalid_parameter("point moment", moment.transpose(), "must be finite");
@@ -248,20 +218,12 @@ class DistributedSolver {
     });
   }
   template <class TimeFunction = time_function::Step>
-  void add_point_moment(const std::string& set_name, const Vector3& moment, TimeFunction time = {}) {
-    add_point_moment(named(set_name), moment, time);
-  }
-  template <class TimeFunction = time_function::Step>
-  void add_gravity(const ParticleSet& set, const Vector3& acceleration, TimeFunction time = {}) {
+  void add_gravity(const ParticleSelection& set, const Vector3& acceleration, TimeFunction time = {}) {
     on_set(set, [&](const ParticleSet&, const ParticleSet& local) {
       if (!acceleration.allFinite())
         sphshell::detail::invalid_parameter("gravity acceleration", acceleration.transpose(), "must be finite");
       loads_.add(std::make_unique<sphshell::detail::GravityLoad<TimeFunction>>(local, acceleration, time));
     });
-  }
-  template <class TimeFunction = time_function::Step>
-  void add_gravity(const std::string& set_name, const Vector3& acceleration, TimeFunction time = {}) {
-    add_gravity(named(set_name), acceleration, time);
   }
 
   // CSV history of one particle (global id; Solver::add_particle_probe's
@@ -341,8 +303,18 @@ class DistributedSolver {
   std::size_t fragment_count() const { return fracture_.fragment_count(); }
 
   // One step on every rank (collective). A step that stopped with an Error
-  // leaves a half-updated state: later steps refuse with that error.
-  void step() { latch_.run(steps_, [&] { advance(); }); }
+  // leaves a half-updated state: later steps refuse with that error. With
+  // periodic checkpoints (OutputOptions) every rank writes its file after
+  // the steps that are due; by wall-clock time, rank 0's clock decides for all.
+  void step() {
+    latch_.run(steps_, [&] { advance(); });
+    // Outside the latch: the state is whole, a failed write leaves the solver usable.
+    if constexpr (can_checkpoint)
+      if (checkpoint_due()) {
+        save_checkpoint(checkpoints_.path());
+        checkpoints_.written(steps_);
+      }
+  }
   // Checkpoints (collective). Each rank writes its own file, `path` + ".rank"
   // + its rank (the Solver's format, solver/checkpoint.hpp, replaced
   // atomically): its particles, forces, rows, section states and exact energy
@@ -443,6 +415,14 @@ class DistributedSolver {
                    error.what());
       throw;
     }
+    checkpoints_.written(steps_);
+  }
+
+  // Whether a periodic checkpoint is due after this step, alike on every rank.
+  bool checkpoint_due() const {
+    const bool due = checkpoints_.is_due(steps_);
+    if (!checkpoints_.by_clock()) return due;
+    return comm_.all_gather(static_cast<char>(due ? 1 : 0)).front() != 0;
   }
 
   // Steps until t_end, as Solver::run_until (collective).
@@ -548,6 +528,12 @@ class DistributedSolver {
       time_step_ = options_.safety_factor * stable_time_step_;
     }
     solver::check_damping(options_.damping, time_step_);
+    if (!can_checkpoint && checkpoints_.enabled())
+      sphshell::detail::invalid_parameter(
+          "checkpoint_path", options_.checkpoint_path,
+          "periodic checkpoints need policies that can be checkpointed: a material State that lists its fields "
+          "(for_each_field), a crack policy and a stepper with state that have save/load (see "
+          "solver/checkpoint.hpp); set checkpoint_every_steps and checkpoint_every_seconds to 0");
 
     // The decomposition and this rank's share.
     const DecompositionInput input = decomposition_input(model_, all_points);
@@ -580,6 +566,7 @@ class DistributedSolver {
     }
     particles_ = solver::ParticleState::at_rest(reference_position_, reference_normal_);
     particles_.ranges = {0, owned, owned, local};
+    constraints_.name_particles_by(std::vector<int>(layout_.owned.begin(), layout_.owned.end()));
     forces_ = solver::ParticleForces(local);
     assembler_.emplace(options_.nonlinear, *points_);
     fracture_.initialize(model_, all_points, layout_);
@@ -592,9 +579,9 @@ class DistributedSolver {
   // once), then handed with its owned members in local indices to `apply`.
   // Collective: an Error on any rank stops all with the same message.
   template <class Apply>
-  void on_set(const ParticleSet& set, Apply&& apply) {
+  void on_set(const ParticleSelection& set, Apply&& apply) {
     collectively(comm_, [&] {
-      const ParticleSet global = solver::checked_set(set, model_.particle_count());
+      const ParticleSet global = solver::checked_set(set.members(model_), model_.particle_count());
       ParticleSet local;
       for (int i : global) {
         const int k = layout_.local_of[static_cast<std::size_t>(i)];
@@ -602,12 +589,6 @@ class DistributedSolver {
       }
       apply(global, local);
     });
-  }
-  // A named set of the (replicated) model; an unknown name is an Error on every rank.
-  ParticleSet named(const std::string& set_name) const {
-    ParticleSet members;
-    collectively(comm_, [&] { members = model_.set(set_name); });
-    return members;
   }
 
   // This rank's rows of the whole model's.
@@ -967,8 +948,10 @@ class DistributedSolver {
                                 reference_area_,   inertia_.mass,       forces_.external,  forces_.external_moment};
     try {
       loads_.apply(at, context);
-    } catch (const Error&) {
-      // The serial message, with the lowest global id of a non-finite load here.
+    } catch (...) {
+      // A non-finite load: the serial message, with the lowest global id of
+      // one here. Anything else (a load function that threw, of any type)
+      // stops every rank with its own message.
       for (std::size_t i = 0; i < layout_.owned_count(); ++i)
         if (!forces_.external[i].allFinite() || !forces_.external_moment[i].allFinite()) {
           keep_first(failure, {key(Phase::loads, layout_.owned[i]),
@@ -976,25 +959,37 @@ class DistributedSolver {
                                                      std::to_string(layout_.owned[i]) +
                                                      " (a pressure, force or moment function returned NaN or "
                                                      "infinity)")});
-          break;
+          return;
         }
+      keep_first(failure, failure_of_current_exception(comm_, key(Phase::loads, 0)));
     }
   }
 
+  // The conditions on the owned particles; a failing one (a motion that is
+  // not finite: the serial message, global ids; a motion function that
+  // threw, of any type: its message) is kept for the agreement, keyed by its
+  // particle's global id.
   void impose_conditions(const StepTime& at, std::optional<Failure>& failure) {
-    try {
+    constraints_.prepare();
+    std::mutex mutex;
+    std::size_t failed = constraints_.particles().size();
+    std::exception_ptr error;
+    parallel::for_each_range(std::size_t{0}, layout_.owned_count(), [&](std::size_t first, std::size_t last) noexcept {
       constraints_.impose(at, reference_position_, time_step_, particles_.director, particles_.velocity,
-                          particles_.angular_velocity);
-    } catch (const Error&) {
-      for (std::size_t k = 0; k < constraints_.particles().size(); ++k) {
-        const int i = constraints_.particles()[k];
-        if (!particles_.velocity[i].allFinite()) {
-          const int id = layout_.owned[static_cast<std::size_t>(i)];
-          keep_first(failure, {key(Phase::motions, static_cast<std::size_t>(id)),
-                               unstable_text(at, "prescribed motion of particle " + std::to_string(id) +
-                                                     " is not finite")});
-        }
-      }
+                          particles_.angular_velocity, first, last, [&](std::size_t k, std::exception_ptr thrown) {
+                            std::lock_guard<std::mutex> lock(mutex);
+                            if (k < failed) {
+                              failed = k;
+                              error = std::move(thrown);
+                            }
+                          });
+    });
+    if (!error) return;
+    const auto particle = static_cast<std::size_t>(constraints_.particles()[failed]);
+    try {
+      std::rethrow_exception(error);
+    } catch (...) {
+      keep_first(failure, failure_of_current_exception(comm_, key(Phase::motions, layout_.owned[particle])));
     }
   }
 
@@ -1036,6 +1031,8 @@ class DistributedSolver {
       assembler_->compute(now(), particles_, *points_, *states_, forces_);
     } catch (const Error& error) {
       failure = Failure{static_cast<long>(global_point_[assembler_->failed_point()]), error.what()};
+    } catch (...) {
+      failure = failure_of_current_exception(comm_, 0);
     }
     agree(failure);
     ledger_->book_internal_work(assembler_->work_increments(), point_owned_);
@@ -1070,6 +1067,7 @@ class DistributedSolver {
   CommunicationCounters counters_;
   DistributedFrames frames_;
   solver::ProgressReporter progress_{options_.monitoring()};
+  solver::checkpoint::Schedule checkpoints_{options_.output()};
   std::vector<DistributedProbe> probes_;
   double next_probe_time_ = 0.0;
   // As the Solver's: below this the reference and current directors are parallel.

@@ -212,6 +212,9 @@ class Constraints {
 
   bool empty() const { return particles_.empty(); }
   const std::vector<int>& particles() const { return particles_; }
+  // The ids its step messages name the particles by (a distributed run's
+  // global ids of its local particles); the indices themselves by default.
+  void name_particles_by(std::vector<int> ids) { particle_ids_ = std::move(ids); }
   const ParticleConstraint& at(std::size_t k) const { return entries_[k]; }
 
  private:
@@ -224,7 +227,9 @@ class Constraints {
     for (const PrescribedMotion* motion : constraint.motions)
       prescribed += motion->velocity(i, reference_position[i], at.time, time_step);
     if (!prescribed.allFinite())
-      fail_unstable(at, "prescribed motion of particle " + std::to_string(i) + " is not finite");
+      fail_unstable(at, "prescribed motion of particle " +
+                            std::to_string(particle_ids_.empty() ? i : particle_ids_[static_cast<std::size_t>(i)]) +
+                            " is not finite");
     velocity[i] = constraint.free_translation * velocity[i] +
                   (Matrix3::Identity() - constraint.free_translation) * prescribed;
     // Project onto the free rotations and the plane normal to the director at
@@ -289,6 +294,7 @@ class Constraints {
   std::vector<ParticleConstraint> entries_;
   std::vector<std::size_t> by_particle_;  // entries_' indices by particle (prepare())
   std::unordered_map<int, std::size_t> index_;
+  std::vector<int> particle_ids_;
   std::vector<std::unique_ptr<PrescribedMotion>> owned_;
 };
 
