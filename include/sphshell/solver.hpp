@@ -660,7 +660,7 @@ class Solver {
   // directors for the force pass's gathers (InternalForceAssembler::pack).
   // The parts one after the other took nine parallel regions, each costing
   // two threads more than the part's work on the paper's plate
-  // (docs/performance.md, twelfth round). Serial loads (user pressure
+  // (docs/performance.md). Serial loads (user pressure
   // functions, detail::Load::serial) are applied before the pass.
   // Failures are reported as the parts would one after the other: a
   // non-finite load (the lowest particle), then a failing condition (the

@@ -60,8 +60,8 @@ namespace solver {
 // formed on the thread that steps that chunk, while its velocities are in
 // that core's cache. Done in a pass of their own on the calling thread, they
 // pulled half of the particles' velocities to that core every step, and the
-// stepper's next writes had to take them back (docs/performance.md, fifth
-// round). Call prepare() before a pass.
+// stepper's next writes had to take them back (docs/performance.md).
+// Call prepare() before a pass.
 class ParticleEnergyTerms {
  public:
   // Particles per partial sum in book_chunk(): fixed, not per thread, so that
