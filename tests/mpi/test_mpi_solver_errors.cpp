@@ -15,7 +15,10 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -122,10 +125,15 @@ TEST_CASE("Periodic checkpoints of a distributed run: a run stopped mid-way rest
   SolverOptions options = steel_options();
   auto pressure = [](const Vector3& x, double t) { return pressure_value * (1.0 + x.x()) * (1.0 + 1e4 * t); };
 
+  const int centre = plate().set("centre").front();
+  const int stress_point = static_cast<int>(plate().stress_point_count() / 2);
+  {
   // The reference: no checkpoints, no interruption.
   Distributed reference(comm, plate(), steel, options);
   reference.clamp("boundary");
   reference.add_pressure(reference.model().all_particles(), pressure);
+  reference.add_particle_probe(folder + "/reference_particle.csv", centre);
+  reference.add_stress_point_probe(folder + "/reference_stress_point.csv", stress_point);
   for (long n = 0; n < total_steps; ++n) reference.step();
 
   // The same run with a checkpoint every 10 steps, stopped in step 36 by an
@@ -139,6 +147,8 @@ TEST_CASE("Periodic checkpoints of a distributed run: a run stopped mid-way rest
     if (t > failing_time && comm.rank() == thrower) throw std::runtime_error("killed mid-run");
     return pressure(x, t);
   });
+  stopped.add_particle_probe(folder + "/particle.csv", centre);
+  stopped.add_stress_point_probe(folder + "/stress_point.csv", stress_point);
   const std::string message = error_of([&] {
     for (long n = 0; n < total_steps; ++n) stopped.step();
   });
@@ -150,6 +160,9 @@ TEST_CASE("Periodic checkpoints of a distributed run: a run stopped mid-way rest
   restarted.clamp("boundary");
   restarted.add_pressure(restarted.model().all_particles(), pressure);
   restarted.load_checkpoint(options.checkpoint_path);
+  // The probes' files continue from the checkpoint's rows.
+  restarted.add_particle_probe(folder + "/particle.csv", centre);
+  restarted.add_stress_point_probe(folder + "/stress_point.csv", stress_point);
   CHECK(restarted.steps() == 30);
   while (restarted.steps() < total_steps) restarted.step();
   CHECK(mpi_test::differing_components(restarted.positions(), reference.positions()) == 0);
@@ -159,6 +172,19 @@ TEST_CASE("Periodic checkpoints of a distributed run: a run stopped mid-way rest
   CHECK(a.kinetic == b.kinetic);
   CHECK(a.external_work == b.external_work);
   CHECK(b.kinetic > 0.0);  // the plate moved: equal zeros would prove nothing
+  }
+  // The probe files (closed with their solvers) hold the uninterrupted run's rows.
+  comm.all_gather(0);
+  if (comm.is_root()) {
+    auto text = [](const std::string& path) {
+      std::ifstream in(path, std::ios::binary);
+      return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    };
+    const std::string particle = text(folder + "/particle.csv"), point = text(folder + "/stress_point.csv");
+    CHECK(std::count(particle.begin(), particle.end(), '\n') == total_steps + 2);  // header, t = 0, every step
+    CHECK(particle == text(folder + "/reference_particle.csv"));
+    CHECK(point == text(folder + "/reference_stress_point.csv"));
+  }
   comm.all_gather(0);
   if (comm.is_root()) std::filesystem::remove_all(folder);
 }

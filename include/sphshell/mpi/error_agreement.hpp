@@ -15,6 +15,7 @@
 // Cost when nothing failed: one MPI_Allreduce of a (long, int) pair.
 
 #include <sphshell/core/error.hpp>
+#include <sphshell/domain/domain.hpp>
 #include <sphshell/mpi/communicator.hpp>
 
 #include <mpi.h>
@@ -28,10 +29,7 @@
 namespace sphshell::mpi {
 
 // A failure on one rank: its ordering key and the message the run stops with.
-struct Failure {
-  long key = 0;
-  std::string message;
-};
+using Failure = domain::Failure;
 
 // Collective. Throws Error(message of the agreed failure) on every rank when
 // any rank passed a failure; returns on every rank otherwise.

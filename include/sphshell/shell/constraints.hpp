@@ -170,23 +170,13 @@ class Constraints {
   // the angular velocity onto the free rotations normal to the director.
   // The position update always spans time_step (also on the half-step
   // start-up of the velocities), so the imposed velocity does too.
-  // On failure (a prescribed motion that is not finite, or whose function
-  // throws) the error of the lowest failing condition, in the order they
-  // were added, is thrown after the others are imposed.
-  void impose(const StepTime& at, const std::vector<Vector3>& reference_position, double time_step,
-              const std::vector<Vector3>& director, std::vector<Vector3>& velocity,
-              std::vector<Vector3>& angular_velocity) const {
-    parallel::for_each(std::size_t{0}, particles_.size(), [&](std::size_t k) {
-      impose_one(k, at, reference_position, time_step, director, velocity, angular_velocity);
-    });
-  }
-
-  // The same for the conditions of particles [first, last) only, for a pass
-  // that steps the particles in chunks (Solver::advance_particles): call
-  // prepare() once after the last condition was added and before such
-  // passes. A failing condition k (its place in the order they were added)
-  // is handed to failed(k, error) and the others are imposed; failed must
-  // not throw.
+  // Only the conditions of particles [first, last), for the particle pass
+  // that steps them in chunks (solver/particle_pass.hpp): call prepare()
+  // once after the last condition was added and before such passes. A
+  // failing condition k (its place in the order they were added: a
+  // prescribed motion that is not finite, or whose function throws) is
+  // handed to failed(k, error) and the others are imposed; failed must not
+  // throw.
   void prepare() {
     if (by_particle_.size() == entries_.size()) return;
     by_particle_.resize(entries_.size());

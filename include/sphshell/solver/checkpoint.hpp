@@ -381,6 +381,20 @@ inline io::BinaryReader read_file(const std::string& path, const std::array<std:
   return io::BinaryReader(std::move(file), name, payload_begin);
 }
 
+// One section of a checkpoint: its name, then what body() writes or reads.
+template <class Writer, class Body>
+void write_section(Writer& out, const char (&name)[5], Body&& body) {
+  out.begin_section(name);
+  body();
+  out.end_section();
+}
+template <class Reader, class Body>
+void read_section(Reader& in, const char (&name)[5], Body&& body) {
+  in.open_section(name);
+  body();
+  in.close_section();
+}
+
 // When the run writes its periodic checkpoints (OutputOptions): every N steps
 // and/or every T seconds of wall-clock time. The clock only schedules the
 // writes; nothing of it reaches the state.
