@@ -28,14 +28,17 @@
 #include <sphshell/shell/constraints.hpp>
 #include <sphshell/shell/loads.hpp>
 #include <sphshell/shell/model.hpp>
+#include <sphshell/shell/particle_selection.hpp>
 #include <sphshell/io/binary_stream.hpp>
 #include <sphshell/solver/checkpoint.hpp>
+#include <sphshell/solver/conditions_and_loads.hpp>
 #include <sphshell/solver/energy_ledger.hpp>
 #include <sphshell/solver/fracture.hpp>
 #include <sphshell/solver/integration_points.hpp>
 #include <sphshell/solver/internal_forces.hpp>
 #include <sphshell/solver/options.hpp>
 #include <sphshell/solver/output.hpp>
+#include <sphshell/solver/particle_pass.hpp>
 #include <sphshell/solver/particles.hpp>
 #include <sphshell/solver/progress.hpp>
 #include <sphshell/solver/run_checks.hpp>
@@ -68,7 +71,7 @@ namespace sphshell {
 
 template <class Approx, class Rule, class Material, class Crack = crack::None,
           class Stepper = stepper::CentralDifference>
-class Solver {
+class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, Crack, Stepper>> {
   // Each family's check names the member a policy lacks; the message here says
   // which parameter it was.
   static_assert(approx::check_approximation<Approx>(),
@@ -135,80 +138,6 @@ class Solver {
   } catch (const std::bad_alloc&) {
     // Members are gone here; the estimate check_memory made is kept for the message.
     throw Error("sphshell: out of memory building the solver (std::bad_alloc): " + solver::memory_estimate_text());
-  }
-
-  // Boundary conditions on particle sets (shell/constraints.hpp).
-  void clamp(const ParticleSet& set) { constraints_.clamp(checked(set)); }
-  // Translations fixed, rotations free ("soft" simple support).
-  void simply_support(const ParticleSet& set) { constraints_.simply_support(checked(set)); }
-  // Translations fixed and the director kept from tilting along the edge
-  // ("hard" simple support of Mindlin plates): fixes rotation about n × t.
-  void simply_support_hard(const ParticleSet& set, const Vector3& edge_tangent) {
-    constraints_.simply_support_hard(checked(set), model_.particle_normal, edge_tangent);
-  }
-  // Mirror symmetry about a plane (given by its normal) through the particles:
-  // no translation across the plane and no rotation tilting the director out of it.
-  void symmetry_plane(const ParticleSet& set, const Vector3& plane_normal) {
-    constraints_.symmetry_plane(checked(set), model_.particle_normal, plane_normal);
-  }
-  void fix_translation(const ParticleSet& set, const Vector3& direction) {
-    constraints_.fix_translation(checked(set), direction);
-  }
-  void fix_rotation(const ParticleSet& set, const Vector3& axis) { constraints_.fix_rotation(checked(set), axis); }
-  // Prescribed displacement u(X, t) (a Vector3 from the reference position and
-  // time) imposed on all three translations of the set.
-  template <class DisplacementFunction>
-  void prescribe_displacement(const ParticleSet& set, DisplacementFunction displacement) {
-    static_assert(std::is_invocable_r_v<Vector3, DisplacementFunction, const Vector3&, double>,
-                  "prescribe_displacement: the function must be callable as Vector3 u(const Vector3& X, double t)");
-    for (int i : checked(set))
-      solver::check_prescribed_displacement_start(i, displacement(model_.particle_position[i], time_),
-                                                  particles_.position[i] - model_.particle_position[i], time_, steps_,
-                                                  model_.minimum_spacing());
-    add_motion(set, std::make_unique<detail::PrescribedDisplacement<DisplacementFunction>>(std::move(displacement)));
-  }
-  // Prescribed velocity v(X, t) imposed on all three translations of the set.
-  template <class VelocityFunction>
-  void prescribe_velocity(const ParticleSet& set, VelocityFunction velocity) {
-    static_assert(std::is_invocable_r_v<Vector3, VelocityFunction, const Vector3&, double>,
-                  "prescribe_velocity: the function must be callable as Vector3 v(const Vector3& X, double t)");
-    add_motion(set, std::make_unique<detail::PrescribedVelocity<VelocityFunction>>(std::move(velocity)));
-  }
-
-  // Loads. Pressure p(X, t) in Pa (see loads.hpp for the sign convention).
-  template <class PressureFunction>
-  void add_pressure(const ParticleSet& set, PressureFunction pressure,
-                    PressureDirection direction = PressureDirection::follower) {
-    static_assert(std::is_invocable_r_v<double, PressureFunction, const Vector3&, double>,
-                  "add_pressure: the pressure must be callable as double p(const Vector3& X, double t)");
-    loads_.add(std::make_unique<detail::PressureLoad<PressureFunction>>(checked(set), std::move(pressure), direction));
-  }
-  template <class TimeFunction = time_function::Step>
-  void add_uniform_pressure(const ParticleSet& set, double pressure, TimeFunction time = {},
-                            PressureDirection direction = PressureDirection::follower) {
-    detail::require_finite("pressure", pressure);
-    loads_.add(std::make_unique<detail::UniformPressureLoad<TimeFunction>>(checked(set), pressure, std::move(time),
-                                                                           direction));
-  }
-  // A force (N) on every particle of the set.
-  template <class TimeFunction = time_function::Step>
-  void add_point_force(const ParticleSet& set, const Vector3& force, TimeFunction time = {}) {
-    if (!force.allFinite()) detail::invalid_parameter("point force", force.transpose(), "must be finite");
-    loads_.add(std::make_unique<detail::PointForceLoad<TimeFunction>>(checked(set), force, std::move(time)));
-  }
-  // A moment (N·m) on every particle of the set; its part along the director
-  // (drilling) does not act.
-  template <class TimeFunction = time_function::Step>
-  void add_point_moment(const ParticleSet& set, const Vector3& moment, TimeFunction time = {}) {
-    if (!moment.allFinite()) detail::invalid_parameter("point moment", moment.transpose(), "must be finite");
-    loads_.add(std::make_unique<detail::PointMomentLoad<TimeFunction>>(checked(set), moment, std::move(time)));
-  }
-  // Gravity (or any uniform acceleration field, m/s²) on the set's mass.
-  template <class TimeFunction = time_function::Step>
-  void add_gravity(const ParticleSet& set, const Vector3& acceleration, TimeFunction time = {}) {
-    if (!acceleration.allFinite())
-      detail::invalid_parameter("gravity acceleration", acceleration.transpose(), "must be finite");
-    loads_.add(std::make_unique<detail::GravityLoad<TimeFunction>>(checked(set), acceleration, std::move(time)));
   }
 
   // CSV time history of one particle: t, displacement, velocity, rotation.
@@ -278,31 +207,18 @@ class Solver {
   // The file is replaced atomically (a kill while writing leaves the previous
   // one whole).
   void save_checkpoint(const std::string& path) const {
+    using solver::checkpoint::write_section;
     io::BinaryWriter out;
-    out.begin_section("IDNT");
-    out(identity());
-    out.end_section();
-    out.begin_section("TIME");
-    out(start_time_, static_cast<std::int64_t>(steps_), time_step_, time_, forces_current_, latch_.message());
-    out.end_section();
-    out.begin_section("PART");
-    particles_.save(out);
-    out.end_section();
-    out.begin_section("FORC");
-    forces_.save(out);
-    out.end_section();
-    out.begin_section("PNTS");
-    points_.save(out, model_.particle_position, model_.particle_normal);
-    out.end_section();
-    out.begin_section("SECT");
-    states_.save(out);
-    out.end_section();
-    out.begin_section("FRAC");
-    fracture_.save(out);
-    out.end_section();
-    out.begin_section("ENRG");
-    ledger_.save(out);
-    out.end_section();
+    write_section(out, "IDNT", [&] { out(identity()); });
+    write_section(out, "TIME", [&] {
+      out(start_time_, static_cast<std::int64_t>(steps_), time_step_, time_, forces_current_, latch_.message());
+    });
+    write_section(out, "PART", [&] { particles_.save(out); });
+    write_section(out, "FORC", [&] { forces_.save(out); });
+    write_section(out, "PNTS", [&] { points_.save(out, model_.particle_position, model_.particle_normal); });
+    write_section(out, "SECT", [&] { states_.save(out); });
+    write_section(out, "FRAC", [&] { fracture_.save(out); });
+    write_section(out, "ENRG", [&] { ledger_.save(out); });
     out.begin_section("STEP");
     if constexpr (!std::is_empty_v<Stepper>) {
       static_assert(solver::checkpoint::has_save_load<Stepper>::value,
@@ -311,9 +227,7 @@ class Solver {
       stepper_.save(out);
     }
     out.end_section();
-    out.begin_section("OUTP");
-    output_.save(out);
-    out.end_section();
+    write_section(out, "OUTP", [&] { output_.save(out); });
     solver::checkpoint::write_file(path, policies(), out);
   }
 
@@ -327,11 +241,10 @@ class Solver {
   // checkpoint recorded. An Error after the file was accepted leaves the
   // solver stopped (step() refuses).
   void load_checkpoint(const std::string& path) {
+    using solver::checkpoint::read_section;
     io::BinaryReader in = solver::checkpoint::read_file(path, policies());
     solver::checkpoint::Identity file;
-    in.open_section("IDNT");
-    in(file);
-    in.close_section();
+    read_section(in, "IDNT", [&] { in(file); });
     solver::checkpoint::check_identity(file, identity(), path);
     try {
       // Rows a crack rebuilt here since construction go back to the model's.
@@ -342,36 +255,18 @@ class Solver {
       std::int64_t steps = 0;
       // The identity matched this solver's time step; the steps must have been taken with it.
       const double identity_time_step = time_step_;
-      in.open_section("TIME");
-      in(start_time_, steps, time_step_, time_, forces_current_, latch_.message());
-      in.close_section();
+      read_section(in, "TIME", [&] { in(start_time_, steps, time_step_, time_, forces_current_, latch_.message()); });
       steps_ = static_cast<long>(steps);
       solver::checkpoint::check_time_step(in, time_step_, identity_time_step);
       solver::checkpoint::check_time_of_steps(in, start_time_, steps_, time_step_, time_);
-      in.open_section("PART");
-      particles_.load(in);
-      in.close_section();
-      in.open_section("FORC");
-      forces_.load(in);
-      in.close_section();
-      in.open_section("PNTS");
-      points_.load(in, model_.particle_count());
-      in.close_section();
-      in.open_section("SECT");
-      states_.load(in);
-      in.close_section();
-      in.open_section("FRAC");
-      fracture_.load(in);
-      in.close_section();
-      in.open_section("ENRG");
-      ledger_.load(in);
-      in.close_section();
-      in.open_section("STEP");
-      if constexpr (!std::is_empty_v<Stepper>) stepper_.load(in);
-      in.close_section();
-      in.open_section("OUTP");
-      output_.load(in, *this);
-      in.close_section();
+      read_section(in, "PART", [&] { particles_.load(in); });
+      read_section(in, "FORC", [&] { forces_.load(in); });
+      read_section(in, "PNTS", [&] { points_.load(in, model_.particle_count()); });
+      read_section(in, "SECT", [&] { states_.load(in); });
+      read_section(in, "FRAC", [&] { fracture_.load(in); });
+      read_section(in, "ENRG", [&] { ledger_.load(in); });
+      read_section(in, "STEP", [&] { if constexpr (!std::is_empty_v<Stepper>) stepper_.load(in); });
+      read_section(in, "OUTP", [&] { output_.load(in, *this); });
       if (!in.at_end()) in.fail("there are bytes after its last section");
     } catch (const Error& error) {
       latch_.close(std::string("sphshell: loading a checkpoint failed part-way, so this solver's state is mixed and "
@@ -431,9 +326,7 @@ class Solver {
     output_.finish(*this);
     progress_.end_run();
   }
-  void run_until(double t_end) {
-    run_until(t_end, [](const Solver&) {});
-  }
+  void run_until(double t_end) { run_until(t_end, [](const Solver&) {}); }
 
   // Static equilibrium under the loads evaluated at parameters.load_time and
   // scaled by each load factor in turn (solver/static_solution.hpp; docs/method.md,
@@ -505,12 +398,7 @@ class Solver {
   // Rotation vector taking the reference director to the current one.
   Vector3 rotation(int particle) const {
     check_particle(particle);
-    const Vector3& from = model_.particle_normal[particle];
-    const Vector3& to = particles_.director[particle];
-    const Vector3 axis = from.cross(to);
-    const double sine = axis.norm();
-    if (sine < negligible_rotation_sine) return Vector3::Zero();
-    return axis / sine * std::atan2(sine, from.dot(to));
+    return solver::rotation_vector(model_.particle_normal[particle], particles_.director[particle]);
   }
   const std::vector<double>& masses() const { return inertia_.mass; }
   const std::vector<double>& rotary_inertias() const { return inertia_.rotary_inertia; }
@@ -587,9 +475,6 @@ class Solver {
   using Output = solver::SolverOutput<output_points>;
   using Parts = solver::FractureParts<Approx, Rule, Material>;
 
-  // Below this the reference and current directors are parallel (no rotation).
-  static constexpr double negligible_rotation_sine = 1e-300;
-
   StepTime now() const { return {steps_, time_}; }
 
   static std::array<std::string, 5> policies() {
@@ -610,7 +495,9 @@ class Solver {
   Parts fracture_parts() { return Parts{model_, particles_, points_, states_, assembler_, forces_}; }
 
   // A set's indices in range and each listed once (solver/run_checks.hpp).
-  ParticleSet checked(const ParticleSet& set) const { return solver::checked_set(set, model_.particle_count()); }
+  ParticleSet checked(const ParticleSelection& set) const {
+    return solver::checked_set(set.members(model_), model_.particle_count());
+  }
   void check_particle(int particle) const {
     if (particle < 0 || static_cast<std::size_t>(particle) >= particles_.size())
       detail::invalid_parameter("particle index", particle, "out of range");
@@ -620,10 +507,24 @@ class Solver {
       detail::invalid_parameter("stress point index", stress_point, "out of range");
     if (k < 0 || k >= output_points) detail::invalid_parameter("thickness output point", k, "out of range");
   }
-  template <class Motion>
-  void add_motion(const ParticleSet& set, std::unique_ptr<Motion> motion) {
-    constraints_.add_motion(checked(set), std::move(motion), model_.particle_position, time_, time_step_);
+  // The conditions and loads (solver/conditions_and_loads.hpp) on the checked set.
+  friend class solver::ConditionsAndLoads<Solver>;
+  template <class Add>
+  void add_conditions(const ParticleSelection& set, Add&& add) {
+    add(constraints_, checked(set), model_.particle_position, model_.particle_normal);
   }
+  template <class Make>
+  void add_load(const ParticleSelection& set, Make&& make) {
+    loads_.add(make(checked(set)));
+  }
+  template <class Displacement>
+  void check_displacement_start(const ParticleSelection& set, const Displacement& displacement) const {
+    for (int i : checked(set))
+      solver::check_prescribed_displacement_start(i, displacement(model_.particle_position[i], time_),
+                                                  particles_.position[i] - model_.particle_position[i], time_, steps_,
+                                                  model_.minimum_spacing());
+  }
+
 
   void apply_loads(const StepTime& at) {
     detail::LoadContext context = load_context_at(at.time);
@@ -647,69 +548,20 @@ class Solver {
     forces_current_ = true;
   }
 
-  // The particles' part of a step, in one parallel pass over the energy
-  // books' chunks of particles (ParticleEnergyTerms::sum_chunk), each chunk on
-  // one thread, while its data is in that core's cache: its loads, the copy of
-  // v^{n−½}, the stepper's velocity update, the copy of the free velocities,
-  // the kinematic conditions, its energy terms, the configuration update, a
-  // look for non-finite values, and the packing of its positions and
-  // directors for the force pass's gathers (InternalForceAssembler::pack).
-  // The parts one after the other took nine parallel regions, each costing
-  // two threads more than the part's work on the paper's plate
-  // (docs/performance.md, twelfth round). Serial loads (user pressure
-  // functions, detail::Load::serial) are applied before the pass.
-  // Failures are reported as the parts would one after the other: a
-  // non-finite load (the lowest particle), then a failing condition (the
-  // first in the order they were added); the lowest particle with a
-  // non-finite position, director or velocity is returned (particle count if
-  // none) for advance() to report at the step's end time.
+  // The particles' part of a step (solver/particle_pass.hpp); the lowest
+  // particle with a non-finite state is returned (particle count if none)
+  // for advance() to report at the step's end time.
   std::size_t advance_particles(const stepper::StepContext& context) {
     const bool loads_in_pass = loads_.applies_in_chunks();
-    if (loads_in_pass) {
-      loads_.start_step(context.at.time);
-    } else {
-      apply_loads(context.at);
-    }
-    detail::LoadContext load_context = load_context_at(context.at.time);
-    constraints_.prepare();
-    ledger_.start_step(particles_);
-    assembler_.start_packing(particles_.size());
-    const std::size_t count = particles_.size();
-    std::atomic<std::size_t> load_failure{count}, state_failure{count};
-    std::mutex condition_mutex;
-    std::size_t failed_condition = constraints_.particles().size();
-    std::exception_ptr condition_error;
-    parallel::for_each_task(ledger_.chunk_count(particles_), [&](std::size_t chunk) noexcept {
-      const auto [first, last] = solver::EnergyLedger::particle_chunk(particles_, chunk);
-      if (loads_in_pass) {
-        const std::size_t i = loads_.apply_range(load_context, first, last);
-        if (i < last) parallel::keep_lowest(load_failure, i);
-      }
-      ledger_.remember_velocities(particles_, first, last);
-      stepper_.advance_velocities(context, particles_, inertia_, forces_, first, last);
-      ledger_.remember_free_velocities(particles_, first, last);
-      constraints_.impose(context.at, model_.particle_position, time_step_, particles_.director, particles_.velocity,
-                          particles_.angular_velocity, first, last, [&](std::size_t k, std::exception_ptr error) {
-                            std::lock_guard<std::mutex> lock(condition_mutex);
-                            if (k < failed_condition) {
-                              failed_condition = k;
-                              condition_error = std::move(error);
-                            }
-                          });
-      ledger_.book_chunk(context, particles_, inertia_, forces_, chunk);
-      stepper_.advance_configuration(context, particles_, first, last);
-      for (std::size_t i = first; i < last; ++i)
-        if (!all_finite(particles_.position[i], particles_.director[i], particles_.velocity[i],
-                        particles_.angular_velocity[i])) {
-          parallel::keep_lowest(state_failure, i);
-          break;
-        }
-      assembler_.pack(particles_, first, last);
-    });
-    if (load_failure.load() < count) ExternalLoads::fail_non_finite(context.at, load_failure.load());
-    if (condition_error) std::rethrow_exception(condition_error);
+    if (!loads_in_pass) apply_loads(context.at);
+    solver::ParticlePass<solver::EnergyLedger, Stepper> pass{
+        loads_,    load_context_at(context.at.time), constraints_, model_.particle_position, time_step_, ledger_,
+        stepper_,  particles_, inertia_, forces_, &assembler_};
+    const solver::ParticlePassFailures failed = pass.run(context, loads_in_pass);
+    if (failed.load < particles_.size()) ExternalLoads::fail_non_finite(context.at, failed.load);
+    if (failed.condition_error) std::rethrow_exception(failed.condition_error);
     ledger_.finish_step();  // a failed step's terms never reach the books
-    return state_failure.load();
+    return failed.state;
   }
 
   [[noreturn]] void fail_non_finite_state(std::size_t i) const {

@@ -104,10 +104,10 @@ void compare_runs(const std::string& label, const ShellModel& model, const typen
 ShellModel plate() { return ShellModel::rectangular_plate(0.5, 0.5, 21, 21, 0.01); }
 constexpr double steel_E = 210e9, steel_nu = 0.3, steel_yield = 250e6, steel_Ep = 1e9;
 
-// The serial Solver takes sets of ids; the distributed one also takes names.
+// Both solvers take sets of ids or set names.
 template <class Material>
 void clamped_pressure(Serial<Material>& solver, double pressure) {
-  solver.clamp(solver.model().set("boundary"));
+  solver.clamp("boundary");
   solver.add_uniform_pressure(solver.model().all_particles(), pressure);
 }
 template <class Material>
@@ -455,4 +455,45 @@ TEST_CASE("Distributed prescribed motions added mid-run: the serial run, and the
   }
   REQUIRE(!serial_message.empty());
   CHECK(message == serial_message);
+}
+
+TEST_CASE("Distributed stress queries and run observer: the serial Solver's values", "[mpi][solver]") {
+  const mpi::Communicator comm;
+  SolverOptions options;
+  options.density = 7850.0;
+  const ShellModel model = plate();
+  Serial<material::Elastic> serial(model, {steel_E, steel_nu}, options);
+  Distributed<material::Elastic> distributed(comm, model, {steel_E, steel_nu}, options);
+  clamped_pressure(serial, 5e5);
+  clamped_pressure(distributed, 5e5);
+  const double end = 30.0 * serial.time_step();  // 30 steps: the run stops within half a step of it
+  long serial_calls = 0, calls = 0;
+  serial.run_until(end, [&](const Serial<material::Elastic>&) { ++serial_calls; });
+  distributed.run_until(end, [&](const Distributed<material::Elastic>& solver) {
+    ++calls;
+    CHECK(solver.steps() == calls);
+  });
+  CHECK(calls == 30);
+  CHECK(calls == serial_calls);
+  std::size_t differing = 0;
+  double largest_moment = 0.0;
+  for (std::size_t q = 0; q < model.stress_point_count(); ++q) {
+    const int p = static_cast<int>(q);
+    const StressVoigt n = distributed.membrane_force(p), m = distributed.bending_moment(p);
+    for (int c = 0; c < 3; ++c) {
+      differing += std::memcmp(&n[c], &serial.membrane_force(p)[c], sizeof(double)) != 0;
+      differing += std::memcmp(&m[c], &serial.bending_moment(p)[c], sizeof(double)) != 0;
+    }
+    for (int k = 0; k < 3; ++k) {
+      const double s = distributed.equivalent_stress(p, k), reference = serial.equivalent_stress(p, k);
+      differing += std::memcmp(&s, &reference, sizeof(double)) != 0;
+    }
+    CHECK(distributed.is_removed(p) == serial.is_removed(p));
+    largest_moment = std::max(largest_moment, m.norm());
+  }
+  CHECK(differing == 0);
+  CHECK(largest_moment > 0.0);  // the plate bends: equal zeros would prove nothing
+  CHECK_THROWS_WITH(distributed.membrane_force(static_cast<int>(model.stress_point_count())),
+                    Catch::Contains("stress point index"));
+  CHECK_THROWS_WITH(distributed.equivalent_stress(0, 3), Catch::Contains("thickness output point"));
 }

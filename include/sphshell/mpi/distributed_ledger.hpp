@@ -63,15 +63,30 @@ class DistributedLedger {
       : monitoring_(monitoring),
         round_off_energy_(youngs_modulus * volume * solver::EnergyLedger::round_off_strain_squared) {}
 
-  void remember_velocities(const solver::ParticleState& state) { terms_.remember_velocities(state); }
-  void remember_free_velocities(const solver::ParticleState& state) { terms_.remember_free_velocities(state); }
-
-  // The serial ledger's terms (solver::ParticleEnergyTerms), owned particles only.
-  void book_step(const stepper::StepContext& context, const solver::ParticleState& state,
-                 const solver::Inertia& inertia, const solver::ParticleForces& forces) {
-    terms_.compute(context, state, inertia, forces, state.ranges.owned_begin, state.ranges.owned_end);
+  // The serial ledger's chunk interface (solver::EnergyLedger, for the
+  // particle pass, solver/particle_pass.hpp) over the owned particles; the
+  // terms are added exactly in finish_step().
+  void start_step(const solver::ParticleState& state) {
+    owned_begin_ = state.ranges.owned_begin;
+    owned_end_ = state.ranges.owned_end;
+    terms_.prepare(owned_begin_, owned_end_);
+  }
+  std::size_t chunk_count(const solver::ParticleState& state) const {
+    return solver::ParticleEnergyTerms::chunk_count(state.ranges.owned_begin, state.ranges.owned_end);
+  }
+  void remember_velocities(const solver::ParticleState& state, std::size_t first, std::size_t last) {
+    terms_.remember_velocities(state, first, last);
+  }
+  void remember_free_velocities(const solver::ParticleState& state, std::size_t first, std::size_t last) {
+    terms_.remember_free_velocities(state, first, last);
+  }
+  void book_chunk(const stepper::StepContext& context, const solver::ParticleState& state,
+                  const solver::Inertia& inertia, const solver::ParticleForces& forces, std::size_t chunk) {
+    terms_.book_chunk(context, state, inertia, forces, owned_begin_, owned_end_, chunk);
+  }
+  void finish_step() {
     kinetic_ = ExactSum();
-    for (std::size_t i = state.ranges.owned_begin; i < state.ranges.owned_end; ++i) {
+    for (std::size_t i = owned_begin_; i < owned_end_; ++i) {
       external_work_.add(terms_.external()[i]);
       damping_work_.add(terms_.damping()[i]);
       kinetic_.add(terms_.kinetic()[i]);
@@ -148,6 +163,7 @@ class DistributedLedger {
   MonitoringOptions monitoring_;
   double round_off_energy_;
   ExactSum internal_, previous_internal_, external_work_, damping_work_, kinetic_;
+  std::size_t owned_begin_ = 0, owned_end_ = 0;
   solver::ParticleEnergyTerms terms_;
 };
 

@@ -20,13 +20,15 @@
 // velocities, are bitwise those of the serial Solver for any rank count and
 // any thread count.
 //
-// The step is the Solver's script with two agreement points
-// (mpi/error_agreement.hpp): loads → velocities → conditions → books →
-// configuration → finite-state check ★ agreement (a load, a prescribed motion
-// or a particle that is not finite; global ids) → halo exchange → internal
-// forces ★ agreement (the failing point's global index) → fracture → books →
-// balance check (reduced books, decided alike on every rank). An Error on any rank
-// therefore stops every rank with the same message.
+// The step is the Solver's script with two agreement points (the domain
+// part, mpi/domain.hpp): the Solver's particle pass over the owned particles
+// (solver/particle_pass.hpp: loads, velocities, conditions, books,
+// configuration, finite-state check) ★ agreement (a load, a prescribed motion
+// or a particle that is not finite, global ids; or any exception a user's
+// function threw) → halo exchange → internal forces ★ agreement (the failing
+// point's global index) → fracture → books → balance check (reduced books,
+// decided alike on every rank). An exception on any rank therefore stops
+// every rank with the same message.
 //
 // Particles, sets, loads and conditions are addressed by global ids or by the
 // model's set names; a rank applies them to the members it owns. Cracks grow
@@ -41,6 +43,7 @@
 #include <sphshell/material/material.hpp>
 #include <sphshell/mpi/communicator.hpp>
 #include <sphshell/mpi/distributed_fracture.hpp>
+#include <sphshell/mpi/domain.hpp>
 #include <sphshell/mpi/distributed_ledger.hpp>
 #include <sphshell/mpi/distributed_output.hpp>
 #include <sphshell/mpi/error_agreement.hpp>
@@ -51,6 +54,8 @@
 #include <sphshell/io/binary_stream.hpp>
 #include <sphshell/solver.hpp>
 #include <sphshell/solver/checkpoint.hpp>
+#include <sphshell/solver/conditions_and_loads.hpp>
+#include <sphshell/solver/particle_pass.hpp>
 
 #include <array>
 #include <chrono>
@@ -60,6 +65,8 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <mutex>
+#include <exception>
 #include <optional>
 #include <random>
 #include <string>
@@ -69,212 +76,36 @@
 
 namespace sphshell::mpi {
 
-// What a rank measured of its own steps (the bench, docs/distributed.md).
-struct CommunicationCounters {
-  long exchanges = 0;                // halo exchanges
-  std::size_t bytes_sent = 0;        // by this rank, all exchanges
-  double exchange_seconds = 0.0;     // wall time inside the halo exchange
-  double agreement_seconds = 0.0;    // wall time inside agreement points and reductions
-  double communication_cpu_seconds = 0.0;  // process CPU time inside both (MPI polls while it waits)
-};
-
 template <class Approx, class Rule, class Material, class Crack = crack::None,
           class Stepper = stepper::CentralDifference>
-class DistributedSolver {
+class DistributedSolver
+    : public solver::ConditionsAndLoads<DistributedSolver<Approx, Rule, Material, Crack, Stepper>> {
  public:
   using MaterialParameters = typename Material::Parameters;
   using Points = solver::IntegrationPoints<Approx>;
   using States = solver::SectionStates<Rule, Material>;
+  // Whether save_checkpoint compiles for these policies (solver/checkpoint.hpp).
+  static constexpr bool can_checkpoint = solver::checkpoint::can_checkpoint<
+      Crack, Stepper, typename thickness::Section<Rule, Material>::State>();
 
   // Collective: every rank of comm passes the same model, parameters and
   // options. comm must outlive the solver.
   DistributedSolver(const Communicator& comm, ShellModel model, const MaterialParameters& parameters,
                     SolverOptions options = {}, const PartitionWeights& weights = {})
-      : comm_(comm), model_(std::move(model)), law_(parameters), options_(std::move(options)) {
-    collectively(comm_, [&] { set_up(weights); });
-    halo_ = HaloPlan(comm_, layout_);
-    frames_ = DistributedFrames(comm_, options_.output(), Crack::enabled);
-  }
-
-  // Conditions (shell/constraints.hpp) on a set of global particle ids or on a
-  // named set of the model. Every rank checks the whole set as the Solver
-  // does (the same Error everywhere), then applies it to the members it owns.
-  void clamp(const ParticleSet& set) {
-    on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
-      checker_.clamp(global);
-      constraints_.clamp(local);
-    });
-  }
-  void clamp(const std::string& set_name) { clamp(named(set_name)); }
-  void simply_support(const ParticleSet& set) {
-    on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
-      checker_.simply_support(global);
-      constraints_.simply_support(local);
-    });
-  }
-  void simply_support(const std::string& set_name) { simply_support(named(set_name)); }
-  void simply_support_hard(const ParticleSet& set, const Vector3& edge_tangent) {
-    on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
-      checker_.simply_support_hard(global, model_.particle_normal, edge_tangent);
-      constraints_.simply_support_hard(local, reference_normal_, edge_tangent);
-    });
-  }
-  void simply_support_hard(const std::string& set_name, const Vector3& edge_tangent) {
-    simply_support_hard(named(set_name), edge_tangent);
-  }
-  void symmetry_plane(const ParticleSet& set, const Vector3& plane_normal) {
-    on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
-      checker_.symmetry_plane(global, model_.particle_normal, plane_normal);
-      constraints_.symmetry_plane(local, reference_normal_, plane_normal);
-    });
-  }
-  void symmetry_plane(const std::string& set_name, const Vector3& plane_normal) {
-    symmetry_plane(named(set_name), plane_normal);
-  }
-  void fix_translation(const ParticleSet& set, const Vector3& direction) {
-    on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
-      checker_.fix_translation(global, direction);
-      constraints_.fix_translation(local, direction);
-    });
-  }
-  void fix_translation(const std::string& set_name, const Vector3& direction) {
-    fix_translation(named(set_name), direction);
-  }
-  void fix_rotation(const ParticleSet& set, const Vector3& axis) {
-    on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
-      checker_.fix_rotation(global, axis);
-      constraints_.fix_rotation(local, axis);
-    });
-  }
-  void fix_rotation(const std::string& set_name, const Vector3& axis) { fix_rotation(named(set_name), axis); }
-  // Prescribed velocity v(X, t) on all three translations (the function is
-  // copied, once for the check of the whole set).
-  template <class VelocityFunction>
-  void prescribe_velocity(const ParticleSet& set, VelocityFunction velocity) {
-    static_assert(std::is_invocable_r_v<Vector3, VelocityFunction, const Vector3&, double>,
-                  "prescribe_velocity: the function must be callable as Vector3 v(const Vector3& X, double t)");
-    on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
-      checker_.add_motion(global, std::make_unique<sphshell::detail::PrescribedVelocity<VelocityFunction>>(velocity),
-                          model_.particle_position, time_, time_step_);
-      constraints_.add_motion(local, std::make_unique<sphshell::detail::PrescribedVelocity<VelocityFunction>>(velocity),
-                              reference_position_, time_, time_step_);
-    });
-  }
-  template <class DisplacementFunction>
-  void prescribe_displacement(const ParticleSet& set, DisplacementFunction displacement) {
-    static_assert(std::is_invocable_r_v<Vector3, DisplacementFunction, const Vector3&, double>,
-                  "prescribe_displacement: the function must be callable as Vector3 u(const Vector3& X, double t)");
-    on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
-      // The Solver's check (solver::check_prescribed_displacement_start), by
-      // the owner of each particle; the failure first in the set's order
-      // wins, as in the serial loop.
-      std::optional<Failure> failure;
-      for (std::size_t k = 0; k < global.size() && !failure; ++k) {
-        const int i = global[k];
-        if (!owns(i)) continue;
-        const auto at = static_cast<std::size_t>(layout_.local_of[static_cast<std::size_t>(i)]);
-        try {
-          solver::check_prescribed_displacement_start(i, displacement(model_.particle_position[i], time_),
-                                                      particles_.position[at] - reference_position_[at], time_,
-                                                      steps_, model_.minimum_spacing());
-        } catch (const Error& error) {
-          failure = Failure{static_cast<long>(k), error.what()};
-        }
-      }
-      agree(failure);
-      using Motion = sphshell::detail::PrescribedDisplacement<DisplacementFunction>;
-      checker_.add_motion(global, std::make_unique<Motion>(displacement), model_.particle_position, time_, time_step_);
-      constraints_.add_motion(local, std::make_unique<Motion>(displacement), reference_position_, time_, time_step_);
-    });
-  }
-
-  template <class VelocityFunction>
-  void prescribe_velocity(const std::string& set_name, VelocityFunction velocity) {
-    prescribe_velocity(named(set_name), std::move(velocity));
-  }
-  template <class DisplacementFunction>
-  void prescribe_displacement(const std::string& set_name, DisplacementFunction displacement) {
-    prescribe_displacement(named(set_name), std::move(displacement));
-  }
-
-  // Loads on a set of global ids or a named set (shell/loads.hpp).
-  template <class PressureFunction>
-  void add_pressure(const ParticleSet& set, PressureFunction pressure,
-                    PressureDirection direction = PressureDirection::follower) {
-    static_assert(std::is_invocable_r_v<double, PressureFunction, const Vector3&, double>,
-                  "add_pressure: the pressure must be callable as double p(const Vector3& X, double t)");
-    on_set(set, [&](const ParticleSet&, const ParticleSet& local) {
-      loads_.add(std::make_unique<sphshell::detail::PressureLoad<PressureFunction>>(local, std::move(pressure), direction));
-    });
-  }
-  template <class PressureFunction>
-  void add_pressure(const std::string& set_name, PressureFunction pressure,
-                    PressureDirection direction = PressureDirection::follower) {
-    add_pressure(named(set_name), std::move(pressure), direction);
-  }
-  template <class TimeFunction = time_function::Step>
-  void add_uniform_pressure(const ParticleSet& set, double pressure, TimeFunction time = {},
-                            PressureDirection direction = PressureDirection::follower) {
-    collectively(comm_, [&] {
-      sphshell::detail::require_finite("pressure", pressure);
-      sphshell::detail::check_time_function(time);
-    });
-    on_set(set, [&](const ParticleSet&, const ParticleSet& local) {
-      loads_.add(std::make_unique<sphshell::detail::UniformPressureLoad<TimeFunction>>(local, pressure, time, direction));
-    });
-  }
-  template <class TimeFunction = time_function::Step>
-  void add_uniform_pressure(const std::string& set_name, double pressure, TimeFunction time = {},
-                            PressureDirection direction = PressureDirection::follower) {
-    add_uniform_pressure(named(set_name), pressure, time, direction);
-  }
-  template <class TimeFunction = time_function::Step>
-  void add_point_force(const ParticleSet& set, const Vector3& force, TimeFunction time = {}) {
-    on_set(set, [&](const ParticleSet&, const ParticleSet& local) {
-      if (!force.allFinite()) sphshell::detail::invalid_parameter("point force", force.transpose(), "must be finite");
-      loads_.add(std::make_unique<sphshell::detail::PointForceLoad<TimeFunction>>(local, force, time));
-    });
-  }
-  template <class TimeFunction = time_function::Step>
-  void add_point_force(const std::string& set_name, const Vector3& force, TimeFunction time = {}) {
-    add_point_force(named(set_name), force, time);
-  }
-  template <class TimeFunction = time_function::Step>
-  void add_point_moment(const ParticleSet& set, const Vector3& moment, TimeFunction time = {}) {
-    on_set(set, [&](const ParticleSet&, const ParticleSet& local) {
-      if (!moment.allFinite())
-        sphshell::detail::invalid_parameter("point moment", moment.transpose(), "must be finite");
-      loads_.add(std::make_unique<sphshell::detail::PointMomentLoad<TimeFunction>>(local, moment, time));
-    });
-  }
-  template <class TimeFunction = time_function::Step>
-  void add_point_moment(const std::string& set_name, const Vector3& moment, TimeFunction time = {}) {
-    add_point_moment(named(set_name), moment, time);
-  }
-  template <class TimeFunction = time_function::Step>
-  void add_gravity(const ParticleSet& set, const Vector3& acceleration, TimeFunction time = {}) {
-    on_set(set, [&](const ParticleSet&, const ParticleSet& local) {
-      if (!acceleration.allFinite())
-        sphshell::detail::invalid_parameter("gravity acceleration", acceleration.transpose(), "must be finite");
-      loads_.add(std::make_unique<sphshell::detail::GravityLoad<TimeFunction>>(local, acceleration, time));
-    });
-  }
-  template <class TimeFunction = time_function::Step>
-  void add_gravity(const std::string& set_name, const Vector3& acceleration, TimeFunction time = {}) {
-    add_gravity(named(set_name), acceleration, time);
+      : domain_(comm), model_(std::move(model)), law_(parameters), options_(std::move(options)) {
+    domain_.collectively([&] { set_up(weights); });
+    domain_.plan_halo();
+    frames_ = DistributedFrames(domain_.communicator(), options_.output(), Crack::enabled);
   }
 
   // CSV history of one particle (global id; Solver::add_particle_probe's
   // columns and schedule), written by the rank that owns it. Collective.
   void add_particle_probe(const std::string& csv_path, int particle) {
-    collectively(comm_, [&] {
+    domain_.collectively([&] {
       solver::checked_set({particle}, model_.particle_count());
       require_new_probe_file(csv_path);
       DistributedProbe probe{DistributedProbe::Kind::particle, particle, csv_path, nullptr};
-      if (owns(particle)) {
-        probe.file = std::make_unique<io::CsvProbe>(csv_path, solver::ParticleProbe{particle}.columns());
-        write_probe_row(probe);
-      }
+      if (owns(particle)) open_probe(probe, solver::ParticleProbe{particle}.columns());
       probes_.push_back(std::move(probe));
     });
   }
@@ -283,17 +114,16 @@ class DistributedSolver {
   // and damage at each thickness output point), written by the rank that
   // owns the stress point. Collective.
   void add_stress_point_probe(const std::string& csv_path, int stress_point) {
-    collectively(comm_, [&] {
+    domain_.collectively([&] {
       if (stress_point < 0 || static_cast<std::size_t>(stress_point) >= model_.stress_point_count())
         sphshell::detail::invalid_parameter("stress point index", stress_point, "out of range");
       require_new_probe_file(csv_path);
       DistributedProbe probe{DistributedProbe::Kind::stress_point, stress_point, csv_path, nullptr};
-      const std::vector<std::size_t>& rows = layout_.computed[solver::index_of(solver::PointGroup::stress_points)];
+      const std::vector<std::size_t>& rows = layout().computed[solver::index_of(solver::PointGroup::stress_points)];
       for (std::size_t k : owned_stress_rows())
         if (rows[k] == static_cast<std::size_t>(stress_point)) {
           probe.local_point = points_->point(solver::PointGroup::stress_points, k);
-          probe.file = std::make_unique<io::CsvProbe>(csv_path, stress_probe(stress_point).columns());
-          write_probe_row(probe);
+          open_probe(probe, stress_probe(stress_point).columns());
         }
       probes_.push_back(std::move(probe));
     });
@@ -305,20 +135,20 @@ class DistributedSolver {
     FramePiece piece;
     piece.time = time_;
     const bool deformed = options_.frame_coordinates == FrameCoordinates::deformed;
-    for (std::size_t i = 0; i < layout_.owned_count(); ++i) {
+    for (std::size_t i = 0; i < layout().owned_count(); ++i) {
       piece.points.push_back(deformed ? particles_.position[i] : reference_position_[i]);
-      piece.global_id.push_back(layout_.owned[i]);
+      piece.global_id.push_back(layout().owned[i]);
       piece.displacement.push_back(particles_.position[i] - reference_position_[i]);
       piece.velocity.push_back(particles_.velocity[i]);
       piece.director.push_back(particles_.director[i]);
-      if constexpr (Crack::enabled) piece.fragment.push_back(fragment_flag(layout_.owned[i]));
+      if constexpr (Crack::enabled) piece.fragment.push_back(fragment_flag(layout().owned[i]));
     }
     const io::VtuGrid stress_points = stress_point_piece();
     if constexpr (Crack::enabled) {
       const io::VtuGrid cracks = crack_frame();
-      frames_.write(comm_, piece, stress_points, &cracks, steps_);
+      frames_.write(domain_.communicator(), piece, stress_points, &cracks, steps_);
     } else {
-      frames_.write(comm_, piece, stress_points, nullptr, steps_);
+      frames_.write(domain_.communicator(), piece, stress_points, nullptr, steps_);
     }
   }
 
@@ -341,8 +171,18 @@ class DistributedSolver {
   std::size_t fragment_count() const { return fracture_.fragment_count(); }
 
   // One step on every rank (collective). A step that stopped with an Error
-  // leaves a half-updated state: later steps refuse with that error.
-  void step() { latch_.run(steps_, [&] { advance(); }); }
+  // leaves a half-updated state: later steps refuse with that error. With
+  // periodic checkpoints (OutputOptions) every rank writes its file after
+  // the steps that are due; by wall-clock time, rank 0's clock decides for all.
+  void step() {
+    latch_.run(steps_, [&] { advance(); });
+    // Outside the latch: the state is whole, a failed write leaves the solver usable.
+    if constexpr (can_checkpoint)
+      if (checkpoint_due()) {
+        save_checkpoint(checkpoints_.path());
+        checkpoints_.written(steps_);
+      }
+  }
   // Checkpoints (collective). Each rank writes its own file, `path` + ".rank"
   // + its rank (the Solver's format, solver/checkpoint.hpp, replaced
   // atomically): its particles, forces, rows, section states and exact energy
@@ -354,36 +194,32 @@ class DistributedSolver {
   // model, material or options (nothing loaded: the solver stays usable), or
   // files of different saves, or a damaged file (the solver then refuses to
   // step). Conditions and loads stay as the loading solver has them; add
-  // probes after loading (their files start at the restart).
-  std::string checkpoint_file(const std::string& path) const { return path + ".rank" + std::to_string(comm_.rank()); }
+  // probes after loading: a probe on a file the checkpoint recorded continues
+  // it from the checkpoint's rows (an Error if the file changed since).
+  std::string checkpoint_file(const std::string& path) const { return domain_.checkpoint_file(path); }
 
   void save_checkpoint(const std::string& path) const {
     std::uint64_t stamp = 0;
-    if (comm_.is_root())
+    if (domain_.is_root())
       stamp = static_cast<std::uint64_t>(std::random_device{}()) << 32 ^
               static_cast<std::uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count());
-    stamp = comm_.all_gather(stamp).front();
-    collectively(comm_, [&] {
+    stamp = domain_.communicator().all_gather(stamp).front();
+    domain_.collectively([&] {
+      using solver::checkpoint::write_section;
       io::BinaryWriter out;
-      out.begin_section("IDNT");
-      out(identity());
-      out.end_section();
-      out.begin_section("TIME");
-      out(stamp, start_time_, static_cast<std::int64_t>(steps_), time_step_, time_, forces_current_, latch_.message());
-      out.end_section();
-      out.begin_section("PART");
-      particles_.save(out);
-      out.end_section();
-      out.begin_section("FORC");
-      forces_.save(out);
-      out.end_section();
+      write_section(out, "IDNT", [&] { out(identity()); });
+      write_section(out, "TIME", [&] {
+        out(stamp, start_time_, static_cast<std::int64_t>(steps_), time_step_, time_, forces_current_, latch_.message());
+      });
+      write_section(out, "PART", [&] { particles_.save(out); });
+      write_section(out, "FORC", [&] { forces_.save(out); });
       out.begin_section("PNTS");
       {
         // The local particles' reference positions and normals (a nonlinear
         // run's rows gather their reference gradients from them).
-        std::vector<Vector3> reference_positions(layout_.local_count()), reference_normals(layout_.local_count());
-        for (std::size_t k = 0; k < layout_.local_count(); ++k) {
-          const auto i = static_cast<std::size_t>(layout_.global_of(k));
+        std::vector<Vector3> reference_positions(layout().local_count()), reference_normals(layout().local_count());
+        for (std::size_t k = 0; k < layout().local_count(); ++k) {
+          const auto i = static_cast<std::size_t>(layout().global_of(k));
           reference_positions[k] = model_.particle_position[i];
           reference_normals[k] = model_.particle_normal[i];
         }
@@ -391,21 +227,23 @@ class DistributedSolver {
       }
       if constexpr (Crack::enabled) all_points_->save(out, model_.particle_position, model_.particle_normal);
       out.end_section();
-      out.begin_section("SECT");
-      states_->save(out);
-      out.end_section();
-      out.begin_section("FRAC");
-      fracture_.save(out);
-      out.end_section();
-      out.begin_section("ENRG");
-      ledger_->save(out);
-      out.end_section();
-      out.begin_section("STEP");
-      if constexpr (!std::is_empty_v<Stepper>) stepper_.save(out);
-      out.end_section();
+      write_section(out, "SECT", [&] { states_->save(out); });
+      write_section(out, "FRAC", [&] { fracture_.save(out); });
+      write_section(out, "ENRG", [&] { ledger_->save(out); });
+      write_section(out, "STEP", [&] { if constexpr (!std::is_empty_v<Stepper>) stepper_.save(out); });
       out.begin_section("OUTP");
       frames_.save(out);
       out(next_probe_time_);
+      // The owned probes' files, for probes added after a restart to continue them.
+      std::uint64_t open_files = 0;
+      for (const DistributedProbe& probe : probes_) open_files += probe.file ? 1 : 0;
+      out(open_files);
+      for (const DistributedProbe& probe : probes_)
+        if (probe.file) {
+          const io::CsvProbe::Resume written = probe.file->written();
+          out(probe.path, static_cast<std::uint32_t>(probe.kind), static_cast<std::int64_t>(probe.index),
+              written.bytes, written.hash);
+        }
       out.end_section();
       solver::checkpoint::write_file(checkpoint_file(path), policies(), out);
     });
@@ -415,7 +253,7 @@ class DistributedSolver {
     const std::string file_path = checkpoint_file(path);
     // 1. Each rank's file and its identity; nothing changes yet.
     std::optional<io::BinaryReader> reader;
-    collectively(comm_, [&] {
+    domain_.collectively([&] {
       if (!probes_.empty())
         throw Error("sphshell: load_checkpoint: " + std::to_string(probes_.size()) +
                     " probe(s) were added before it; a distributed run adds its probes after loading a checkpoint");
@@ -429,9 +267,9 @@ class DistributedSolver {
     // 2. The state; a failure from here on leaves every rank stopped.
     std::uint64_t stamp = 0;
     try {
-      collectively(comm_, [&] { load_state(*reader, stamp); });
-      const std::vector<std::uint64_t> stamps = comm_.all_gather(stamp);
-      const std::vector<std::int64_t> steps = comm_.all_gather(static_cast<std::int64_t>(steps_));
+      domain_.collectively([&] { load_state(*reader, stamp); });
+      const std::vector<std::uint64_t> stamps = domain_.communicator().all_gather(stamp);
+      const std::vector<std::int64_t> steps = domain_.communicator().all_gather(static_cast<std::int64_t>(steps_));
       for (std::size_t r = 1; r < stamps.size(); ++r)
         if (stamps[r] != stamps[0])
           throw Error("sphshell: checkpoint files '" + path + ".rank0' (step " + std::to_string(steps[0]) + ") and '" +
@@ -443,17 +281,77 @@ class DistributedSolver {
                    error.what());
       throw;
     }
+    checkpoints_.written(steps_);
+  }
+
+  // Whether a periodic checkpoint is due after this step, alike on every rank.
+  bool checkpoint_due() const {
+    const bool due = checkpoints_.is_due(steps_);
+    return checkpoints_.by_clock() ? domain_.first_process_decides(due) : due;
   }
 
   // Steps until t_end, as Solver::run_until (collective).
-  void run_until(double t_end) {
-    collectively(comm_, [&] {
+  // observer(*this) is called after every step, on every rank (it may call
+  // the collective queries).
+  template <class Observer>
+  void run_until(double t_end, Observer&& observer) {
+    domain_.collectively([&] {
       solver::check_run_end(t_end, solver::RunPosition{time_, time_step_, steps_}, options_.max_steps_per_run);
     });
     progress_.start_run(now(), t_end);
-    while (time_ < t_end - 0.5 * time_step_) step();
+    while (time_ < t_end - 0.5 * time_step_) {
+      step();
+      observer(*this);
+    }
     if (frames_.writes_on_schedule() && frames_.last_frame_step() != steps_) write_frame();
     progress_.end_run();
+  }
+  void run_until(double t_end) { run_until(t_end, [](const DistributedSolver&) {}); }
+
+  // Stress queries (Solver's), by global stress point, the same on every rank:
+  // the owner's values are gathered (collective; for checks and small runs).
+  double integral_point_quantity(solver::IntegralPointQuantity quantity, int stress_point, int k) const {
+    domain_.collectively([&] {
+      check_stress_point(stress_point);
+      if (k < 0 || k >= output_points) sphshell::detail::invalid_parameter("thickness output point", k, "out of range");
+    });
+    return owner_values(stress_point, [&](std::size_t p) {
+      return std::array<double, 3>{states_->quantity(quantity, p, k), 0.0, 0.0};
+    })[0];
+  }
+  double equivalent_stress(int stress_point, int k) const {
+    return integral_point_quantity(solver::IntegralPointQuantity::equivalent_stress, stress_point, k);
+  }
+  double equivalent_plastic_strain(int stress_point, int k) const {
+    return integral_point_quantity(solver::IntegralPointQuantity::equivalent_plastic_strain, stress_point, k);
+  }
+  double damage(int stress_point, int k) const {
+    return integral_point_quantity(solver::IntegralPointQuantity::damage, stress_point, k);
+  }
+  // Membrane forces (N/m) and moments (N·m/m), Voigt (xx, yy, xy) in the stress
+  // point's reference tangent frame.
+  StressVoigt membrane_force(int stress_point) const {
+    domain_.collectively([&] { check_stress_point(stress_point); });
+    const std::array<double, 3> n = owner_values(stress_point, [&](std::size_t p) {
+      const StressVoigt& value = states_->membrane_force(p);
+      return std::array<double, 3>{value[0], value[1], value[2]};
+    });
+    return StressVoigt(n[0], n[1], n[2]);
+  }
+  StressVoigt bending_moment(int stress_point) const {
+    domain_.collectively([&] { check_stress_point(stress_point); });
+    const std::array<double, 3> m = owner_values(stress_point, [&](std::size_t p) {
+      const StressVoigt& value = states_->bending_moment(p);
+      return std::array<double, 3>{value[0], value[1], value[2]};
+    });
+    return StressVoigt(m[0], m[1], m[2]);
+  }
+  // Whether a stress point has left the integration (damaged or on a pre-crack).
+  bool is_removed(int stress_point) const {
+    domain_.collectively([&] { check_stress_point(stress_point); });
+    return owner_values(stress_point, [&](std::size_t p) {
+             return std::array<double, 3>{states_->active(p) ? 0.0 : 1.0, 0.0, 0.0};
+           })[0] != 0.0;
   }
 
   double time() const { return time_; }
@@ -462,20 +360,20 @@ class DistributedSolver {
   double stable_time_step() const { return stable_time_step_; }
   const ShellModel& model() const { return model_; }
   const SolverOptions& options() const { return options_; }
-  const Communicator& communicator() const { return comm_; }
-  const RankLayout& layout() const { return layout_; }
-  const HaloPlan& halo() const { return halo_; }
-  const CommunicationCounters& counters() const { return counters_; }
+  const Communicator& communicator() const { return domain_.communicator(); }
+  const RankLayout& layout() const { return domain_.layout(); }
+  const HaloPlan& halo() const { return domain_.halo(); }
+  const CommunicationCounters& counters() const { return domain_.counters(); }
 
   // This rank's particles in the local numbering (owned [0, owned), then ghosts).
   const solver::ParticleState& local_particles() const { return particles_; }
   const solver::ParticleForces& local_forces() const { return forces_; }
   int global_id(std::size_t local) const {
-    if (local >= layout_.local_count())
+    if (local >= layout().local_count())
       sphshell::detail::invalid_parameter("local particle index", local,
                                           "must be below this rank's local_count() = " +
-                                              std::to_string(layout_.local_count()));
-    return layout_.global_of(local);
+                                              std::to_string(layout().local_count()));
+    return layout().global_of(local);
   }
 
   // The owned values of a per-particle field, in global order on every rank
@@ -483,21 +381,21 @@ class DistributedSolver {
   std::vector<Vector3> gathered(const std::vector<Vector3>& local_field) const {
     // Checked on every rank together, so that a short field on one rank is
     // an Error on all of them, not a rank left waiting in the gather.
-    collectively(comm_, [&] {
-      if (local_field.size() < layout_.owned_count())
+    domain_.collectively([&] {
+      if (local_field.size() < layout().owned_count())
         sphshell::detail::invalid_parameter("local field size", local_field.size(),
-                                            "must cover this rank's " + std::to_string(layout_.owned_count()) +
+                                            "must cover this rank's " + std::to_string(layout().owned_count()) +
                                                 " owned particles (local numbering: owned, then ghosts)");
     });
     struct Entry {
       std::int64_t id;
       double value[3];
     };
-    std::vector<Entry> mine(layout_.owned_count());
+    std::vector<Entry> mine(layout().owned_count());
     for (std::size_t i = 0; i < mine.size(); ++i)
-      mine[i] = {layout_.owned[i], {local_field[i].x(), local_field[i].y(), local_field[i].z()}};
+      mine[i] = {layout().owned[i], {local_field[i].x(), local_field[i].y(), local_field[i].z()}};
     std::vector<Vector3> all(model_.particle_count(), Vector3::Zero());
-    for (const Entry& entry : comm_.all_gather_v(mine))
+    for (const Entry& entry : domain_.communicator().all_gather_v(mine))
       all[static_cast<std::size_t>(entry.id)] = Vector3(entry.value[0], entry.value[1], entry.value[2]);
     return all;
   }
@@ -508,15 +406,12 @@ class DistributedSolver {
 
   // The energy books over all ranks (collective).
   EnergyReport energy() {
-    const auto started = std::chrono::steady_clock::now();
-    const std::clock_t cpu = std::clock();
+    const Domain::Timer timer(domain_);
     ExactSum elastic;
     for (std::size_t p = 0; p < states_->size(); ++p)
       if (point_owned_[p] && states_->active(p))
         elastic.add(states_->stored_energy(p, points_->membrane_bending_weight(p), points_->shear_weight(p)));
-    const EnergyReport report = ledger_->report(comm_, elastic, fracture_.released_energy());
-    count_agreement(started, cpu);
-    return report;
+    return ledger_->report(domain_.communicator(), elastic, fracture_.released_energy());
   }
 
  private:
@@ -525,12 +420,8 @@ class DistributedSolver {
   // on another rank, as in the serial step.
   enum class Phase : long { loads = 0, motions = 1, configuration = 2 };
 
-  static double seconds_since(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  }
-
   void set_up(const PartitionWeights& weights) {
-    detail::check_parts(comm_.size(), model_.particle_count());  // before rows that a tiny model cannot build
+    detail::check_parts(domain_.size(), model_.particle_count());  // before rows that a tiny model cannot build
     validate(options_);
     using SectionState = typename thickness::Section<Rule, Material>::State;
     solver::check_memory<SectionState>(model_, options_);
@@ -548,30 +439,36 @@ class DistributedSolver {
       time_step_ = options_.safety_factor * stable_time_step_;
     }
     solver::check_damping(options_.damping, time_step_);
+    if (!can_checkpoint && checkpoints_.enabled())
+      sphshell::detail::invalid_parameter(
+          "checkpoint_path", options_.checkpoint_path,
+          "periodic checkpoints need policies that can be checkpointed: a material State that lists its fields "
+          "(for_each_field), a crack policy and a stepper with state that have save/load (see "
+          "solver/checkpoint.hpp); set checkpoint_every_steps and checkpoint_every_seconds to 0");
 
     // The decomposition and this rank's share.
     const DecompositionInput input = decomposition_input(model_, all_points);
-    partition_ = partition(input, comm_.size(), weights);
-    layout_ = rank_layout(input, partition_, comm_.rank());
+    partition_ = partition(input, domain_.size(), weights);
+    domain_.set_layout(rank_layout(input, partition_, domain_.rank()));
     model_point_count_ = all_points.size();
     model_slot_count_ = all_points.slot_count();
     points_.emplace(local_points(all_points));
     std::vector<std::size_t> computed_points;
     for (solver::PointGroup group : solver::point_groups) {
       const std::size_t g = solver::index_of(group);
-      for (std::size_t k = 0; k < layout_.computed[g].size(); ++k) {
-        computed_points.push_back(all_points.point(group, layout_.computed[g][k]));
-        point_owned_.push_back(layout_.computed_is_owned[g][k]);
+      for (std::size_t k = 0; k < layout().computed[g].size(); ++k) {
+        computed_points.push_back(all_points.point(group, layout().computed[g][k]));
+        point_owned_.push_back(layout().computed_is_owned[g][k]);
       }
     }
     global_point_ = computed_points;
     states_.emplace(all_states.subset(computed_points));
 
     // Particles in the local numbering.
-    const std::size_t local = layout_.local_count(), owned = layout_.owned_count();
+    const std::size_t local = layout().local_count(), owned = layout().owned_count();
     const solver::Inertia all_inertia = solver::Inertia::lumped(model_, options_.density, options_.rotary_inertia_scale);
     for (std::size_t k = 0; k < local; ++k) {
-      const auto i = static_cast<std::size_t>(layout_.global_of(k));
+      const auto i = static_cast<std::size_t>(layout().global_of(k));
       reference_position_.push_back(model_.particle_position[i]);
       reference_normal_.push_back(model_.particle_normal[i]);
       reference_area_.push_back(model_.particle_area[i]);
@@ -580,9 +477,10 @@ class DistributedSolver {
     }
     particles_ = solver::ParticleState::at_rest(reference_position_, reference_normal_);
     particles_.ranges = {0, owned, owned, local};
+    constraints_.name_particles_by(std::vector<int>(layout().owned.begin(), layout().owned.end()));
     forces_ = solver::ParticleForces(local);
     assembler_.emplace(options_.nonlinear, *points_);
-    fracture_.initialize(model_, all_points, layout_);
+    fracture_.initialize(model_, all_points, layout());
     // Crack rebuilds run on the whole model's rows (fracture): kept only then.
     if constexpr (Crack::enabled) all_points_.emplace(all_points);
     ledger_.emplace(options_.monitoring(), law_.youngs_modulus(), solver::shell_volume(model_));
@@ -592,27 +490,58 @@ class DistributedSolver {
   // once), then handed with its owned members in local indices to `apply`.
   // Collective: an Error on any rank stops all with the same message.
   template <class Apply>
-  void on_set(const ParticleSet& set, Apply&& apply) {
-    collectively(comm_, [&] {
-      const ParticleSet global = solver::checked_set(set, model_.particle_count());
+  void on_set(const ParticleSelection& set, Apply&& apply) {
+    domain_.collectively([&] {
+      const ParticleSet global = solver::checked_set(set.members(model_), model_.particle_count());
       ParticleSet local;
       for (int i : global) {
-        const int k = layout_.local_of[static_cast<std::size_t>(i)];
-        if (k >= 0 && static_cast<std::size_t>(k) < layout_.owned_count()) local.push_back(k);
+        const int k = layout().local_of[static_cast<std::size_t>(i)];
+        if (k >= 0 && static_cast<std::size_t>(k) < layout().owned_count()) local.push_back(k);
       }
       apply(global, local);
     });
   }
-  // A named set of the (replicated) model; an unknown name is an Error on every rank.
-  ParticleSet named(const std::string& set_name) const {
-    ParticleSet members;
-    collectively(comm_, [&] { members = model_.set(set_name); });
-    return members;
+
+  // The conditions and loads (solver/conditions_and_loads.hpp): every rank
+  // checks the whole set as the Solver does (the same Error everywhere), then
+  // applies it to the members it owns.
+  friend class solver::ConditionsAndLoads<DistributedSolver>;
+  template <class Add>
+  void add_conditions(const ParticleSelection& set, Add&& add) {
+    on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
+      add(checker_, global, model_.particle_position, model_.particle_normal);
+      add(constraints_, local, reference_position_, reference_normal_);
+    });
+  }
+  template <class Make>
+  void add_load(const ParticleSelection& set, Make&& make) {
+    on_set(set, [&](const ParticleSet&, const ParticleSet& local) { loads_.add(make(local)); });
+  }
+  // The Solver's check, by the owner of each particle; the failure first in
+  // the set's order wins, as in the serial loop.
+  template <class Displacement>
+  void check_displacement_start(const ParticleSelection& set, const Displacement& displacement) {
+    on_set(set, [&](const ParticleSet& global, const ParticleSet&) {
+      std::optional<Failure> failure;
+      for (std::size_t k = 0; k < global.size() && !failure; ++k) {
+        const int i = global[k];
+        if (!owns(i)) continue;
+        const auto at = static_cast<std::size_t>(layout().local_of[static_cast<std::size_t>(i)]);
+        try {
+          solver::check_prescribed_displacement_start(i, displacement(model_.particle_position[i], time_),
+                                                      particles_.position[at] - reference_position_[at], time_,
+                                                      steps_, model_.minimum_spacing());
+        } catch (...) {
+          failure = domain_.failure_of_current_exception(static_cast<long>(k));
+        }
+      }
+      agree(failure);
+    });
   }
 
   // This rank's rows of the whole model's.
   Points local_points(const Points& all_points) const {
-    return all_points.subset(layout_.computed, layout_.local_of, layout_.local_count());
+    return all_points.subset(layout().computed, layout().local_of, layout().local_count());
   }
 
   static std::array<std::string, 5> policies() {
@@ -622,8 +551,8 @@ class DistributedSolver {
   // the Solver's identity (the whole model's counts) and the rank count and rank.
   solver::checkpoint::Identity identity() const {
     solver::checkpoint::Identity id;
-    id.counts = {{"rank count", static_cast<std::uint64_t>(comm_.size())},
-                 {"rank", static_cast<std::uint64_t>(comm_.rank())},
+    id.counts = {{"rank count", static_cast<std::uint64_t>(domain_.size())},
+                 {"rank", static_cast<std::uint64_t>(domain_.rank())},
                  {"particle count", static_cast<std::uint64_t>(model_.particle_count())},
                  {"stress point count", static_cast<std::uint64_t>(model_.stress_point_count())},
                  {"integration point count", static_cast<std::uint64_t>(model_point_count_)},
@@ -636,6 +565,7 @@ class DistributedSolver {
 
   // The sections after IDNT (load_checkpoint).
   void load_state(io::BinaryReader& in, std::uint64_t& stamp) {
+    using solver::checkpoint::read_section;
     // Rows a crack rebuilt here since construction go back to the model's.
     bool rebuilt = points_->any_rebuilt();
     if constexpr (Crack::enabled) rebuilt = rebuilt || all_points_->any_rebuilt();
@@ -649,37 +579,38 @@ class DistributedSolver {
     std::int64_t steps = 0;
     // The identity matched this solver's time step; the steps must have been taken with it.
     const double identity_time_step = time_step_;
-    in.open_section("TIME");
-    in(stamp, start_time_, steps, time_step_, time_, forces_current_, latch_.message());
-    in.close_section();
+    read_section(in, "TIME", [&] {
+      in(stamp, start_time_, steps, time_step_, time_, forces_current_, latch_.message());
+    });
     steps_ = static_cast<long>(steps);
     solver::checkpoint::check_time_step(in, time_step_, identity_time_step);
     solver::checkpoint::check_time_of_steps(in, start_time_, steps_, time_step_, time_);
-    in.open_section("PART");
-    particles_.load(in);
-    in.close_section();
-    in.open_section("FORC");
-    forces_.load(in);
-    in.close_section();
+    read_section(in, "PART", [&] { particles_.load(in); });
+    read_section(in, "FORC", [&] { forces_.load(in); });
     in.open_section("PNTS");
-    points_->load(in, layout_.local_count());
+    points_->load(in, layout().local_count());
     if constexpr (Crack::enabled) all_points_->load(in, model_.particle_count());
     in.close_section();
-    in.open_section("SECT");
-    states_->load(in);
-    in.close_section();
-    in.open_section("FRAC");
-    fracture_.load(in);
-    in.close_section();
-    in.open_section("ENRG");
-    ledger_->load(in);
-    in.close_section();
-    in.open_section("STEP");
-    if constexpr (!std::is_empty_v<Stepper>) stepper_.load(in);
-    in.close_section();
+    read_section(in, "SECT", [&] { states_->load(in); });
+    read_section(in, "FRAC", [&] { fracture_.load(in); });
+    read_section(in, "ENRG", [&] { ledger_->load(in); });
+    read_section(in, "STEP", [&] { if constexpr (!std::is_empty_v<Stepper>) stepper_.load(in); });
     in.open_section("OUTP");
     frames_.load(in);
     in(next_probe_time_);
+    std::uint64_t open_files = 0;
+    in(open_files);
+    restored_probes_.clear();
+    for (std::uint64_t n = 0; n < open_files; ++n) {
+      RestoredProbe record;
+      std::uint32_t kind = 0;
+      std::int64_t index = 0;
+      in(record.path, kind, index, record.written.bytes, record.written.hash);
+      if (kind > 1) in.fail("a probe of unknown kind " + std::to_string(kind));
+      record.kind = static_cast<DistributedProbe::Kind>(kind);
+      record.index = static_cast<int>(index);
+      restored_probes_.push_back(std::move(record));
+    }
     in.close_section();
     if (!in.at_end()) in.fail("there are bytes after its last section");
   }
@@ -687,7 +618,7 @@ class DistributedSolver {
   StepTime now() const { return {steps_, time_}; }
   using FractureParts = DistributedFractureParts<Approx, Rule, Material>;
   FractureParts fracture_parts() {
-    return FractureParts{comm_,      model_,     layout_, particles_, *all_points_, *points_,
+    return FractureParts{domain_.communicator(),      model_,     layout(), particles_, *all_points_, *points_,
                          *states_,   *assembler_, forces_, point_owned_};
   }
 
@@ -700,34 +631,39 @@ class DistributedSolver {
     const stepper::StepContext context{now(), time_step_, stepper_.velocity_step(steps_, time_step_),
                                        options_.damping};
     std::optional<Failure> failure;
-    apply_loads(context.at, failure);
-    ledger_->remember_velocities(particles_);
-    parallel::for_each_range(particles_.ranges.owned_begin, particles_.ranges.owned_end,
-                             [&](std::size_t first, std::size_t last) noexcept {
-                               stepper_.advance_velocities(context, particles_, inertia_, forces_, first, last);
-                             });
-    ledger_->remember_free_velocities(particles_);
-    impose_conditions(context.at, failure);
-    ledger_->book_step(context, particles_, inertia_, forces_);
-    parallel::for_each_range(particles_.ranges.owned_begin, particles_.ranges.owned_end,
-                             [&](std::size_t first, std::size_t last) noexcept {
-                               stepper_.advance_configuration(context, particles_, first, last);
-                             });
+    const bool loads_in_pass = loads_.applies_in_chunks();
+    if (!loads_in_pass) apply_loads(context.at, failure);
+    // The Solver's particle pass over the owned particles; the ghosts'
+    // positions and directors come from the halo exchange, which packs them all.
+    solver::ParticlePass<DistributedLedger, Stepper> pass{
+        loads_,     load_context(context.at.time), constraints_, reference_position_, time_step_, *ledger_,
+        stepper_,   particles_, inertia_, forces_, nullptr};
+    const solver::ParticlePassFailures failed = pass.run(context, loads_in_pass);
+    if (failed.load < layout().owned_count()) keep_first(failure, non_finite_load(context.at, failed.load));
+    if (failed.condition_error) {
+      const auto particle = static_cast<std::size_t>(constraints_.particles()[failed.condition]);
+      try {
+        std::rethrow_exception(failed.condition_error);
+      } catch (...) {
+        keep_first(failure, domain_.failure_of_current_exception(key(Phase::motions, layout().owned[particle])));
+      }
+    }
+    ledger_->finish_step();
     ++steps_;
     time_ = start_time_ + static_cast<double>(steps_) * time_step_;  // t = t0 + n Δt, as the Solver
     forces_current_ = false;
-    check_configuration(failure);
+    if (failed.state < layout().owned_count()) keep_first(failure, non_finite_state(failed.state));
     agree(failure);
     compute_internal_forces();
     if constexpr (Crack::enabled) fracture_.update(fracture_parts());
     if (solver::EnergyLedger::is_check_step(steps_)) {
       const EnergyReport report = energy();
-      ledger_->check_balance(comm_, now(), report, [&](std::size_t i) { return layout_.global_of(i); });
+      ledger_->check_balance(domain_.communicator(), now(), report, [&](std::size_t i) { return layout().global_of(i); });
     }
     // The Solver's progress line, from the reduced books, written by rank 0.
     if (progress_.is_due(steps_)) {
       const EnergyReport report = energy();
-      if (comm_.is_root()) progress_.write(now(), report);
+      if (domain_.is_root()) progress_.write(now(), report);
     }
     write_scheduled();
   }
@@ -756,20 +692,14 @@ class DistributedSolver {
       const Vector3& operator[](int global) const { return local[static_cast<std::size_t>(local_of[global])]; }
     };
     double time() const { return solver.time_; }
-    Field velocities() const { return {solver.particles_.velocity, solver.layout_.local_of}; }
+    Field velocities() const { return {solver.particles_.velocity, solver.layout().local_of}; }
     Vector3 displacement(int global) const {
-      const auto i = static_cast<std::size_t>(solver.layout_.local_of[global]);
+      const auto i = static_cast<std::size_t>(solver.layout().local_of[global]);
       return solver.particles_.position[i] - solver.reference_position_[i];
     }
-    // Solver::rotation: the rotation vector taking the reference director to the current one.
     Vector3 rotation(int global) const {
-      const auto i = static_cast<std::size_t>(solver.layout_.local_of[global]);
-      const Vector3& from = solver.reference_normal_[i];
-      const Vector3& to = solver.particles_.director[i];
-      const Vector3 axis = from.cross(to);
-      const double sine = axis.norm();
-      if (sine < negligible_rotation_sine) return Vector3::Zero();
-      return axis / sine * std::atan2(sine, from.dot(to));
+      const auto i = static_cast<std::size_t>(solver.layout().local_of[global]);
+      return solver::rotation_vector(solver.reference_normal_[i], solver.particles_.director[i]);
     }
   };
   // The current position of local stress-point row k, interpolated from the
@@ -785,8 +715,8 @@ class DistributedSolver {
   std::vector<std::size_t> owned_stress_rows() const {
     const std::size_t g = solver::index_of(solver::PointGroup::stress_points);
     std::vector<std::size_t> rows;
-    for (std::size_t k = 0; k < layout_.computed[g].size(); ++k)
-      if (layout_.computed_is_owned[g][k]) rows.push_back(k);
+    for (std::size_t k = 0; k < layout().computed[g].size(); ++k)
+      if (layout().computed_is_owned[g][k]) rows.push_back(k);
     return rows;
   }
 
@@ -804,7 +734,7 @@ class DistributedSolver {
     for (std::size_t k : owned_stress_rows()) {
       const std::size_t p = points_->point(solver::PointGroup::stress_points, k);
       if (!states_->active(p)) continue;
-      const auto q = layout_.computed[g][k];
+      const auto q = layout().computed[g][k];
       const Vector3 current = stress_point_position(k), reference = model_.stress_point_position[q];
       grid.cells.add_vertex(static_cast<int>(grid.points.size()));
       grid.points.push_back(deformed ? current : reference);
@@ -866,7 +796,7 @@ class DistributedSolver {
     }
     const std::size_t g = solver::index_of(solver::PointGroup::stress_points);
     for (std::size_t k : owned_stress_rows()) {
-      const int point = crack.crack_point_of_stress_point(static_cast<int>(layout_.computed[g][k]));
+      const int point = crack.crack_point_of_stress_point(static_cast<int>(layout().computed[g][k]));
       if (point < 0) continue;
       const Vector3 x = stress_point_position(k);
       mine.push_back({point, {x.x(), x.y(), x.z()}});
@@ -875,12 +805,12 @@ class DistributedSolver {
       if (from_stress_point[k]) continue;
       const int nearest = model_.nearest_particle(reference[k]);
       if (!owns(nearest)) continue;
-      const auto i = static_cast<std::size_t>(layout_.local_of[static_cast<std::size_t>(nearest)]);
+      const auto i = static_cast<std::size_t>(layout().local_of[static_cast<std::size_t>(nearest)]);
       const Vector3 x = reference[k] + (particles_.position[i] - reference_position_[i]);
       mine.push_back({static_cast<std::int64_t>(k), {x.x(), x.y(), x.z()}});
     }
     std::vector<Vector3> current(reference.size(), Vector3::Zero());
-    for (const Placed& placed : comm_.all_gather_v(mine))
+    for (const Placed& placed : domain_.communicator().all_gather_v(mine))
       current[static_cast<std::size_t>(placed.point)] =
           Vector3(placed.position[0], placed.position[1], placed.position[2]);
     const bool deformed = options_.frame_coordinates == FrameCoordinates::deformed;
@@ -927,33 +857,43 @@ class DistributedSolver {
       probe.file->write_row(
           solver::StressPointProbe<output_points>(probe.index).row(StressPointView{*this, probe.local_point}));
   }
+  // The owner's file of a new probe: the file a loaded checkpoint recorded
+  // for the same probe continues from the checkpoint's rows; else a new
+  // file starts with the row of now.
+  void open_probe(DistributedProbe& probe, std::vector<std::string> columns) {
+    for (auto record = restored_probes_.begin(); record != restored_probes_.end(); ++record)
+      if (record->path == probe.path && record->kind == probe.kind && record->index == probe.index) {
+        probe.file = std::make_unique<io::CsvProbe>(probe.path, std::move(columns), record->written);
+        restored_probes_.erase(record);
+        return;
+      }
+    probe.file = std::make_unique<io::CsvProbe>(probe.path, std::move(columns));
+    write_probe_row(probe);
+  }
   void require_new_probe_file(const std::string& csv_path) const {
     for (const DistributedProbe& probe : probes_)
       if (probe.path == csv_path)
         throw Error("sphshell: probe file '" + csv_path + "' is already the file of another probe; give each probe "
                     "a file of its own");
   }
-  bool owns(int global) const {
-    const int k = layout_.local_of[static_cast<std::size_t>(global)];
-    return k >= 0 && static_cast<std::size_t>(k) < layout_.owned_count();
+  bool owns(int global) const { return domain_.owns(global); }
+  void check_stress_point(int stress_point) const {
+    if (stress_point < 0 || static_cast<std::size_t>(stress_point) >= model_.stress_point_count())
+      sphshell::detail::invalid_parameter("stress point index", stress_point, "out of range");
+  }
+  // value(local point) of the rank that owns the stress point, on every rank.
+  template <class Value>
+  std::array<double, 3> owner_values(int stress_point, Value&& value) const {
+    const std::size_t g = solver::index_of(solver::PointGroup::stress_points);
+    std::vector<std::array<double, 3>> mine;
+    for (std::size_t k : owned_stress_rows())
+      if (layout().computed[g][k] == static_cast<std::size_t>(stress_point))
+        mine.push_back(value(points_->point(solver::PointGroup::stress_points, k)));
+    return domain_.communicator().all_gather_v(mine).front();
   }
   double fragment_flag(int global) const { return fracture_.is_fragment(static_cast<std::size_t>(global)) ? 1 : 0; }
 
-  void agree(const std::optional<Failure>& failure) {
-    const auto started = std::chrono::steady_clock::now();
-    const std::clock_t cpu = std::clock();
-    try {
-      agree_on_failure(comm_, failure);
-    } catch (...) {
-      count_agreement(started, cpu);
-      throw;
-    }
-    count_agreement(started, cpu);
-  }
-  void count_agreement(std::chrono::steady_clock::time_point started, std::clock_t cpu) {
-    counters_.agreement_seconds += seconds_since(started);
-    counters_.communication_cpu_seconds += static_cast<double>(std::clock() - cpu) / CLOCKS_PER_SEC;
-  }
+  void agree(const std::optional<Failure>& failure) const { domain_.agree(failure); }
   long key(Phase phase, std::size_t global) const {
     return static_cast<long>(phase) * static_cast<long>(model_.particle_count() + 1) + static_cast<long>(global);
   }
@@ -962,54 +902,40 @@ class DistributedSolver {
     if (!kept || candidate.key < kept->key) kept = std::move(candidate);
   }
 
+  sphshell::detail::LoadContext load_context(double time) {
+    return {time,           reference_position_, reference_normal_, particles_.director,
+            reference_area_, inertia_.mass,       forces_.external,  forces_.external_moment};
+  }
+  // The serial loads (a user's pressure function), before the particle pass.
   void apply_loads(const StepTime& at, std::optional<Failure>& failure) {
-    sphshell::detail::LoadContext context{at.time,           reference_position_, reference_normal_, particles_.director,
-                                reference_area_,   inertia_.mass,       forces_.external,  forces_.external_moment};
+    sphshell::detail::LoadContext context = load_context(at.time);
     try {
       loads_.apply(at, context);
-    } catch (const Error&) {
-      // The serial message, with the lowest global id of a non-finite load here.
-      for (std::size_t i = 0; i < layout_.owned_count(); ++i)
+    } catch (...) {
+      // A non-finite load: the serial message, with the lowest global id of
+      // one here. Anything else (a load function that threw, of any type)
+      // stops every rank with its own message.
+      for (std::size_t i = 0; i < layout().owned_count(); ++i)
         if (!forces_.external[i].allFinite() || !forces_.external_moment[i].allFinite()) {
-          keep_first(failure, {key(Phase::loads, layout_.owned[i]),
-                               unstable_text(at, "non-finite external load at particle " +
-                                                     std::to_string(layout_.owned[i]) +
-                                                     " (a pressure, force or moment function returned NaN or "
-                                                     "infinity)")});
-          break;
+          keep_first(failure, non_finite_load(at, i));
+          return;
         }
+      keep_first(failure, domain_.failure_of_current_exception(key(Phase::loads, 0)));
     }
   }
-
-  void impose_conditions(const StepTime& at, std::optional<Failure>& failure) {
-    try {
-      constraints_.impose(at, reference_position_, time_step_, particles_.director, particles_.velocity,
-                          particles_.angular_velocity);
-    } catch (const Error&) {
-      for (std::size_t k = 0; k < constraints_.particles().size(); ++k) {
-        const int i = constraints_.particles()[k];
-        if (!particles_.velocity[i].allFinite()) {
-          const int id = layout_.owned[static_cast<std::size_t>(i)];
-          keep_first(failure, {key(Phase::motions, static_cast<std::size_t>(id)),
-                               unstable_text(at, "prescribed motion of particle " + std::to_string(id) +
-                                                     " is not finite")});
-        }
-      }
-    }
+  Failure non_finite_load(const StepTime& at, std::size_t i) const {
+    const int id = layout().owned[i];
+    return {key(Phase::loads, static_cast<std::size_t>(id)),
+            unstable_text(at, "non-finite external load at particle " + std::to_string(id) +
+                                  " (a pressure, force or moment function returned NaN or infinity)")};
   }
-
-  void check_configuration(std::optional<Failure>& failure) const {
-    for (std::size_t i = 0; i < layout_.owned_count(); ++i)
-      if (!all_finite(particles_.position[i], particles_.director[i], particles_.velocity[i],
-                      particles_.angular_velocity[i])) {
-        keep_first(failure,
-                   {key(Phase::configuration, layout_.owned[i]),
-                    unstable_text(now(), "non-finite state at particle " + std::to_string(layout_.owned[i]) +
-                                             " (external force " + solver::number_text(forces_.external[i].norm()) +
-                                             " N, internal force " + solver::number_text(forces_.internal[i].norm()) +
-                                             " N)")});
-        return;
-      }
+  // The Solver's message at the step's end time, with the global id.
+  Failure non_finite_state(std::size_t i) const {
+    const int id = layout().owned[i];
+    return {key(Phase::configuration, static_cast<std::size_t>(id)),
+            unstable_text(now(), "non-finite state at particle " + std::to_string(id) + " (external force " +
+                                     solver::number_text(forces_.external[i].norm()) + " N, internal force " +
+                                     solver::number_text(forces_.internal[i].norm()) + " N)")};
   }
 
   static std::string unstable_text(const StepTime& at, const std::string& what) {
@@ -1024,32 +950,25 @@ class DistributedSolver {
   // Halo exchange, then the internal forces of every computed point; a
   // failing point stops every rank with its global index.
   void compute_internal_forces() {
-    const auto started = std::chrono::steady_clock::now();
-    const std::clock_t cpu = std::clock();
-    exchange_.exchange(comm_, halo_, {&particles_.position, &particles_.director});
-    counters_.exchange_seconds += seconds_since(started);
-    counters_.communication_cpu_seconds += static_cast<double>(std::clock() - cpu) / CLOCKS_PER_SEC;
-    ++counters_.exchanges;
-    counters_.bytes_sent += halo_.bytes_sent(2);
+    domain_.exchange({&particles_.position, &particles_.director});
     std::optional<Failure> failure;
     try {
       assembler_->compute(now(), particles_, *points_, *states_, forces_);
     } catch (const Error& error) {
       failure = Failure{static_cast<long>(global_point_[assembler_->failed_point()]), error.what()};
+    } catch (...) {
+      failure = domain_.failure_of_current_exception(0);
     }
     agree(failure);
     ledger_->book_internal_work(assembler_->work_increments(), point_owned_);
     forces_current_ = true;
   }
 
-  const Communicator& comm_;
+  Domain domain_;  // this rank's share, the halo and the agreement on failures
   ShellModel model_;
   Material law_;
   SolverOptions options_;
   Partition partition_;
-  RankLayout layout_;
-  HaloPlan halo_;
-  HaloExchange exchange_;
   std::vector<Vector3> reference_position_, reference_normal_;
   std::vector<double> reference_area_;
   solver::ParticleState particles_;
@@ -1067,13 +986,18 @@ class DistributedSolver {
   sphshell::detail::Constraints constraints_;  // owned particles, local indices
   sphshell::detail::Constraints checker_;      // the whole sets, global ids: the Solver's checks and messages
   ExternalLoads loads_;
-  CommunicationCounters counters_;
   DistributedFrames frames_;
   solver::ProgressReporter progress_{options_.monitoring()};
+  solver::checkpoint::Schedule checkpoints_{options_.output()};
   std::vector<DistributedProbe> probes_;
+  struct RestoredProbe {
+    std::string path;
+    DistributedProbe::Kind kind = DistributedProbe::Kind::particle;
+    int index = 0;
+    io::CsvProbe::Resume written;
+  };
+  std::vector<RestoredProbe> restored_probes_;  // recorded by a loaded checkpoint, not added again yet
   double next_probe_time_ = 0.0;
-  // As the Solver's: below this the reference and current directors are parallel.
-  static constexpr double negligible_rotation_sine = 1e-300;
   // As the serial output's probe schedule (solver/output.hpp).
   static constexpr double probe_schedule_tolerance = 1e-9;
   std::size_t model_point_count_ = 0, model_slot_count_ = 0;  // the whole model's (checkpoint identity)

@@ -15,6 +15,7 @@
 // Cost when nothing failed: one MPI_Allreduce of a (long, int) pair.
 
 #include <sphshell/core/error.hpp>
+#include <sphshell/domain/domain.hpp>
 #include <sphshell/mpi/communicator.hpp>
 
 #include <mpi.h>
@@ -28,10 +29,7 @@
 namespace sphshell::mpi {
 
 // A failure on one rank: its ordering key and the message the run stops with.
-struct Failure {
-  long key = 0;
-  std::string message;
-};
+using Failure = domain::Failure;
 
 // Collective. Throws Error(message of the agreed failure) on every rank when
 // any rank passed a failure; returns on every rank otherwise.
@@ -50,19 +48,33 @@ inline void agree_on_failure(const Communicator& comm, const std::optional<Failu
   throw Error(message);
 }
 
+// The failure an exception being handled makes on this rank (call inside a
+// catch block): an Error keeps its message; any other exception is named as
+// such with its rank, so that every rank stops with a message that says
+// where it came from.
+inline Failure failure_of_current_exception(const Communicator& comm, long key) {
+  const std::string where = "sphshell: exception on rank " + std::to_string(comm.rank()) + ": ";
+  try {
+    throw;
+  } catch (const Error& error) {
+    return Failure{key, error.what()};
+  } catch (const std::exception& error) {
+    return Failure{key, where + error.what()};
+  } catch (...) {
+    return Failure{key, where + "an exception that is not a std::exception"};
+  }
+}
+
 // Runs body() on every rank and agrees on its outcome: an exception it throws
-// becomes this rank's failure with key key_of_unkeyed (an Error keeps its
-// message; other exceptions are named as such). Collective.
+// (of any type) becomes this rank's failure with key key_of_unkeyed.
+// Collective.
 template <class Body>
 void collectively(const Communicator& comm, Body&& body, long key_of_unkeyed = 0) {
   std::optional<Failure> failure;
   try {
     std::forward<Body>(body)();
-  } catch (const Error& error) {
-    failure = Failure{key_of_unkeyed, error.what()};
-  } catch (const std::exception& error) {
-    failure = Failure{key_of_unkeyed, std::string("sphshell: exception on rank ") + std::to_string(comm.rank()) +
-                                          ": " + error.what()};
+  } catch (...) {
+    failure = failure_of_current_exception(comm, key_of_unkeyed);
   }
   agree_on_failure(comm, failure);
 }

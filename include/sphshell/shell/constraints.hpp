@@ -170,23 +170,13 @@ class Constraints {
   // the angular velocity onto the free rotations normal to the director.
   // The position update always spans time_step (also on the half-step
   // start-up of the velocities), so the imposed velocity does too.
-  // On failure (a prescribed motion that is not finite, or whose function
-  // throws) the error of the lowest failing condition, in the order they
-  // were added, is thrown after the others are imposed.
-  void impose(const StepTime& at, const std::vector<Vector3>& reference_position, double time_step,
-              const std::vector<Vector3>& director, std::vector<Vector3>& velocity,
-              std::vector<Vector3>& angular_velocity) const {
-    parallel::for_each(std::size_t{0}, particles_.size(), [&](std::size_t k) {
-      impose_one(k, at, reference_position, time_step, director, velocity, angular_velocity);
-    });
-  }
-
-  // The same for the conditions of particles [first, last) only, for a pass
-  // that steps the particles in chunks (Solver::advance_particles): call
-  // prepare() once after the last condition was added and before such
-  // passes. A failing condition k (its place in the order they were added)
-  // is handed to failed(k, error) and the others are imposed; failed must
-  // not throw.
+  // Only the conditions of particles [first, last), for the particle pass
+  // that steps them in chunks (solver/particle_pass.hpp): call prepare()
+  // once after the last condition was added and before such passes. A
+  // failing condition k (its place in the order they were added: a
+  // prescribed motion that is not finite, or whose function throws) is
+  // handed to failed(k, error) and the others are imposed; failed must not
+  // throw.
   void prepare() {
     if (by_particle_.size() == entries_.size()) return;
     by_particle_.resize(entries_.size());
@@ -212,6 +202,9 @@ class Constraints {
 
   bool empty() const { return particles_.empty(); }
   const std::vector<int>& particles() const { return particles_; }
+  // The ids its step messages name the particles by (a distributed run's
+  // global ids of its local particles); the indices themselves by default.
+  void name_particles_by(std::vector<int> ids) { particle_ids_ = std::move(ids); }
   const ParticleConstraint& at(std::size_t k) const { return entries_[k]; }
 
  private:
@@ -224,7 +217,9 @@ class Constraints {
     for (const PrescribedMotion* motion : constraint.motions)
       prescribed += motion->velocity(i, reference_position[i], at.time, time_step);
     if (!prescribed.allFinite())
-      fail_unstable(at, "prescribed motion of particle " + std::to_string(i) + " is not finite");
+      fail_unstable(at, "prescribed motion of particle " +
+                            std::to_string(particle_ids_.empty() ? i : particle_ids_[static_cast<std::size_t>(i)]) +
+                            " is not finite");
     velocity[i] = constraint.free_translation * velocity[i] +
                   (Matrix3::Identity() - constraint.free_translation) * prescribed;
     // Project onto the free rotations and the plane normal to the director at
@@ -289,6 +284,7 @@ class Constraints {
   std::vector<ParticleConstraint> entries_;
   std::vector<std::size_t> by_particle_;  // entries_' indices by particle (prepare())
   std::unordered_map<int, std::size_t> index_;
+  std::vector<int> particle_ids_;
   std::vector<std::unique_ptr<PrescribedMotion>> owned_;
 };
 

@@ -67,11 +67,11 @@ class AssemblySchedule {
   // follow each group's arrays through memory: once the model outgrows the
   // cache (a 401×401 plate), runs of 512 rows took about 0.92 of the time per
   // step of runs of 64; runs of 4096 were slower again, the particles' sums
-  // waiting too long for their points (docs/performance.md, fourth round).
+  // waiting too long for their points (docs/performance.md).
   static constexpr std::size_t max_rows_per_run = 512;
   // Runs per segment, at least, when several threads share the pass, so that
   // the segments can be cut to about equal sizes; but never shorter than 64
-  // rows, the length all the thread measurements before the fourth round used.
+  // rows, the length of the earlier thread measurements (docs/performance.md).
   static constexpr std::size_t min_runs_per_segment = 8;
   static constexpr std::size_t min_rows_per_run = 64;
   // Segments per thread when several threads share the pass. More segments
@@ -81,7 +81,7 @@ class AssemblySchedule {
   // two per thread measured best (eight: 94 % of the paper's plate straddled).
   // Summed in bands (band()), mostly right after their points on the thread
   // that integrated them, eight per thread took about 0.93 of the time of two
-  // summed after the pass, four about 0.95 (docs/performance.md, fifth round).
+  // summed after the pass, four about 0.95 (docs/performance.md).
   static constexpr std::size_t segments_per_thread = 8;
   // Every run starts at a multiple of PointChunks::rows, so each chunk of a
   // sum over the points lies in one run and is summed by the thread that

@@ -231,6 +231,19 @@ inline std::vector<NamedValue> result_options(const SolverOptions& options, doub
 // thing that differs, with both values.
 inline void check_identity(const Identity& file, const Identity& here, const std::string& path) {
   const std::string lead = "sphshell: checkpoint '" + path + "' is of another ";
+  // A distributed run's identity starts with its rank count; a serial one's does not.
+  auto rank_count = [](const Identity& id) -> long {
+    return !id.counts.empty() && id.counts.front().name == "rank count" ? static_cast<long>(id.counts.front().value)
+                                                                       : -1;
+  };
+  const long file_ranks = rank_count(file), here_ranks = rank_count(here);
+  if (file_ranks >= 0 && here_ranks < 0)
+    throw Error("sphshell: checkpoint '" + path + "' is one rank's file of a distributed checkpoint (written by a "
+                "distributed solver on " + std::to_string(file_ranks) + " ranks); a serial Solver loads only a "
+                "serial Solver's checkpoint: restart the run distributed on " + std::to_string(file_ranks) + " ranks");
+  if (file_ranks < 0 && here_ranks >= 0)
+    throw Error("sphshell: checkpoint '" + path + "' is a serial Solver's checkpoint; a distributed solver loads "
+                "only the files of a distributed one (one per rank): restart the run with the serial Solver");
   auto compare_counts = [&](const std::vector<NamedCount>& a, const std::vector<NamedCount>& b, const char* kind,
                             bool show_values) {
     for (std::size_t k = 0; k < b.size(); ++k) {
@@ -299,7 +312,18 @@ inline void write_file(const std::string& path, const std::array<std::string, 5>
 inline io::BinaryReader read_file(const std::string& path, const std::array<std::string, 5>& policies) {
   const std::string name = "checkpoint '" + path + "'";
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error("sphshell: cannot open " + name + " for reading");
+  if (!in) {
+    // The two kinds of run name their files differently: say so when the other kind's file is there.
+    if (std::ifstream(path + ".rank0"))
+      throw Error("sphshell: cannot open " + name + " for reading; '" + path + ".rank0' is there: '" + path +
+                  "' names a distributed checkpoint (one file per rank), which a serial Solver does not load");
+    static constexpr const char rank_suffix[] = ".rank";
+    const std::size_t suffix = path.rfind(rank_suffix);
+    if (suffix != std::string::npos && std::ifstream(path.substr(0, suffix)))
+      throw Error("sphshell: cannot open " + name + " for reading; '" + path.substr(0, suffix) + "' is there: it "
+                  "is a serial Solver's checkpoint, which a distributed solver does not load");
+    throw Error("sphshell: cannot open " + name + " for reading");
+  }
   // The magic first: a large file of another kind is named as such before it is read whole.
   std::string bytes(sizeof magic, '\0');
   in.read(bytes.data(), static_cast<std::streamsize>(sizeof magic));
@@ -357,6 +381,20 @@ inline io::BinaryReader read_file(const std::string& path, const std::array<std:
   return io::BinaryReader(std::move(file), name, payload_begin);
 }
 
+// One section of a checkpoint: its name, then what body() writes or reads.
+template <class Writer, class Body>
+void write_section(Writer& out, const char (&name)[5], Body&& body) {
+  out.begin_section(name);
+  body();
+  out.end_section();
+}
+template <class Reader, class Body>
+void read_section(Reader& in, const char (&name)[5], Body&& body) {
+  in.open_section(name);
+  body();
+  in.close_section();
+}
+
 // When the run writes its periodic checkpoints (OutputOptions): every N steps
 // and/or every T seconds of wall-clock time. The clock only schedules the
 // writes; nothing of it reaches the state.
@@ -380,6 +418,9 @@ class Schedule {
   }
   const std::string& path() const { return path_; }
   bool enabled() const { return !path_.empty() && (every_steps_ > 0 || every_seconds_ > 0.0); }
+  // Whether the wall clock can make a checkpoint due (a distributed run then
+  // lets one rank's clock decide for all).
+  bool by_clock() const { return !path_.empty() && every_seconds_ > 0.0; }
 
  private:
   using Clock = std::chrono::steady_clock;

@@ -60,8 +60,8 @@ namespace solver {
 // formed on the thread that steps that chunk, while its velocities are in
 // that core's cache. Done in a pass of their own on the calling thread, they
 // pulled half of the particles' velocities to that core every step, and the
-// stepper's next writes had to take them back (docs/performance.md, fifth
-// round). Call prepare() before a pass.
+// stepper's next writes had to take them back (docs/performance.md).
+// Call prepare() before a pass.
 class ParticleEnergyTerms {
  public:
   // Particles per partial sum in book_chunk(): fixed, not per thread, so that
@@ -90,29 +90,6 @@ class ParticleEnergyTerms {
   void remember_free_velocities(const ParticleState& state, std::size_t first, std::size_t last) {
     for (std::size_t i = first; i < last; ++i) free_velocity_[i] = state.velocity[i];
   }
-  // The same for every particle, in parallel passes (the MPI ledger).
-  void remember_velocities(const ParticleState& state) {
-    size_velocities(state.velocity.size());
-    parallel::for_each_range(std::size_t{0}, state.velocity.size(),
-                             [&](std::size_t first, std::size_t last) noexcept {
-                               remember_velocities(state, first, last);
-                             });
-  }
-  void remember_free_velocities(const ParticleState& state) {
-    parallel::for_each_range(std::size_t{0}, state.velocity.size(),
-                             [&](std::size_t first, std::size_t last) noexcept {
-                               remember_free_velocities(state, first, last);
-                             });
-  }
-
-  // The terms of particles [begin, end) (the terms' arrays are sized to end), in a parallel pass.
-  void compute(const stepper::StepContext& context, const ParticleState& state, const Inertia& inertia,
-               const ParticleForces& forces, std::size_t begin, std::size_t end) {
-    size_terms(end);
-    parallel::for_each(begin, end,
-                       [&](std::size_t i) noexcept { compute_particle(i, context, state, inertia, forces); });
-  }
-
   // The sums over particles [begin, end) of the three terms.
   struct Sums {
     double external = 0.0, damping = 0.0, kinetic = 0.0;

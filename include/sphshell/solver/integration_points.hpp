@@ -288,7 +288,7 @@ class IntegrationPoints {
   // neighbour's position and director are read as one 6-vector, so that each
   // of ∂Φ/∂X1, ∂Φ/∂X2 scales both at once (a1 with n1, a2 with n2): three
   // SSE2 pairs instead of a pair and a single for each 3-vector, 4-6 % of the
-  // paper plate's step (docs/performance.md, fourth round). Every component's sum is the
+  // paper plate's step (docs/performance.md). Every component's sum is the
   // same, in the same order.
   shell::SurfaceGradients gather(PointGroup group, std::size_t row, const std::vector<PackedKinematics>& packed) const {
     const approx::ShapeFunctions& sf = shape(group);

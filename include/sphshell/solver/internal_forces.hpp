@@ -16,7 +16,7 @@
 // its points is done, while those points' forces and shape functions are
 // still in the cache. Done as two separate passes, the sum read them back
 // from memory once the model outgrew the cache (a 401×401 plate's step cost
-// 1.6 times a 51×51 plate's per particle; docs/performance.md, third round). A particle's
+// 1.6 times a 51×51 plate's per particle; docs/performance.md). A particle's
 // sum is the same whenever it is formed, so results do not change. The points'
 // work is summed in the same pass, chunk by chunk (PointChunks), after the run
 // that integrated the chunk's points.
@@ -156,7 +156,7 @@ class InternalForceAssembler {
   // chunks' sums in chunk order, so the sum is the same for any thread count.
   // A pass over the points in index order would move a quarter of them to the
   // other core and back on two threads (README, "Thread counts"); added on the
-  // calling thread, half of them (docs/performance.md, eleventh round). Before
+  // calling thread, half of them (docs/performance.md). Before
   // the first compute(), or after the points' force entries or the thread
   // count changed, each chunk is a task of its own (same sums, any thread).
   // value must not throw.

@@ -13,6 +13,8 @@
 #include <cstddef>
 #include <vector>
 
+#include <cmath>
+
 namespace sphshell::solver {
 
 // Index ranges of the owned and the ghost particles.
@@ -120,5 +122,16 @@ struct ParticleForces {
     in.read_exact(external_moment, "external moments");
   }
 };
+
+// The rotation vector taking the unit vector `from` (a reference director)
+// to the unit vector `to` (the current one): zero when they are parallel.
+inline Vector3 rotation_vector(const Vector3& from, const Vector3& to) {
+  // Below this sine the directors are parallel (no rotation).
+  constexpr double negligible_rotation_sine = 1e-300;
+  const Vector3 axis = from.cross(to);
+  const double sine = axis.norm();
+  if (sine < negligible_rotation_sine) return Vector3::Zero();
+  return axis / sine * std::atan2(sine, from.dot(to));
+}
 
 }  // namespace sphshell::solver
