@@ -21,12 +21,12 @@
 // 50 µs by default) and then sleeps until there is work. OpenMP's default
 // spin-waiting holds a core for far longer, so on a machine that runs any
 // other CPU-bound process two threads were several times slower than one
-// (README, "Threads"); OpenMP's spin time is fixed at program start by an
+// (docs/performance.md, "Threads"); OpenMP's spin time is fixed at program start by an
 // environment variable, which a library must not impose on its users.
 // Each thread has its own contiguous block of a loop's indices, the same block
 // in every loop of the same size: a point's data then stays in the cache of
 // the core that wrote it in the step before (handing the indices out in turn,
-// task by task, made two threads slower than one, README "Thread counts").
+// task by task, made two threads slower than one, docs/performance.md, "Threads").
 // A block is split into small tasks; a thread that has finished its own block
 // takes the tasks left in the others', so a thread that the operating system
 // holds back leaves most of its share to the others.
@@ -93,7 +93,7 @@ inline std::atomic<std::int64_t>& spin_nanoseconds() {
 // waiting for that core (a shared machine), the spinning thread would
 // otherwise take time slices from it and from this program's own working
 // thread (two threads took 1.20-1.31 of one thread's time with a busy
-// process beside them, 1.05-1.07 with the yield; README "Thread counts"); on
+// process beside them, 1.05-1.07 with the yield; docs/performance.md, "Threads"); on
 // an idle core the yield returns at once.
 template <class Ready>
 bool spin_until(Ready&& ready) {

@@ -4,7 +4,7 @@
 // way the corners of a square grid mapped onto a disc are
 // (ShellModel::spherical_cap: interior angles up to ≈ 175° near the rim's four
 // corners, which also force a small stable step). Use this builder for curved
-// caps whose response must converge (docs/method.md, README "Validation").
+// caps whose response must converge (docs/method.md, docs/validation.md).
 //
 // The grid is drawn in the cap's geodesic polar plane — plane radius ρ = R θ
 // (θ the polar angle), azimuth φ — and mapped onto the exact sphere:

@@ -155,7 +155,7 @@ class InternalForceAssembler {
   // compute(), whose core's cache then still holds their data, then the
   // chunks' sums in chunk order, so the sum is the same for any thread count.
   // A pass over the points in index order would move a quarter of them to the
-  // other core and back on two threads (README, "Thread counts"); added on the
+  // other core and back on two threads (docs/performance.md, "Threads"); added on the
   // calling thread, half of them (docs/performance.md). Before
   // the first compute(), or after the points' force entries or the thread
   // count changed, each chunk is a task of its own (same sums, any thread).

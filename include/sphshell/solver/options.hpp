@@ -61,7 +61,7 @@ struct PhysicsOptions {
 // 0.01, the former default, to control the checkerboard deflection mode.
 // Fracture runs whose crack path matters want a small share such as 0.02:
 // only stress points become crack points (see the method document and the
-// README's measurements).
+// docs/validation.md).
 struct ParticleIntegrationOptions {
   double particle_integration_share = 0.5;
   double particle_shear_weight = 0.0;

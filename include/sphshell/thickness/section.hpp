@@ -21,7 +21,7 @@
 // (last-bit differences). The batched one pays for gathering the states into lanes, scattering them back
 // and returning every lane when one yields, which the vector units repay only
 // when they are wide: by default it is taken with AVX-512 and not otherwise
-// (README, Performance). Define SPHSHELL_BATCHED_SECTIONS to 1 or 0 before
+// (docs/performance.md, "Batched material updates"). Define SPHSHELL_BATCHED_SECTIONS to 1 or 0 before
 // including to force either path.
 #ifndef SPHSHELL_BATCHED_SECTIONS
 #if defined(__AVX512F__)
