@@ -1,6 +1,6 @@
 // Static solutions against the hand-tuned damped explicit runs they replace
-// (project issue 11: "at least 10x faster at the same accuracy"), both
-// measured in one run:
+// (the static solve should be at least 10x faster at the same accuracy),
+// both measured in one run:
 //  - clamped_plate_*: the clamped square plate of tests/test_solver_plate.cpp
 //    (L = 1 m, L/d = 50, 21 x 21 particles, Gauss<2>, q = 1 kPa, linear),
 //    against Mindlin's w D/(q L^4) = 0.0012754;
