@@ -11,7 +11,7 @@
 //    resident set while the solver was built, over its particles.
 //  - rule_cost_ratio: Global against Gauss<5> on the same plate (51², J2,
 //    1 MPa) once it is plastic (from 1 ms on), alternating chunks of 10 steps;
-//    `ratio` is Global's time over Gauss<5>'s (the target: ≤ 1).
+//    `ratio` is Global's time over Gauss<5>'s (the target: ≤ 1).
 #include <sphshell/sphshell.hpp>
 
 #include <benchmark/benchmark.h>

@@ -6,7 +6,7 @@
 //    cracks grow (1.55–1.85 ms), crack::LineSegments against crack::None,
 //    each alone and, in fracture_cost_ratio, both advanced in alternating
 //    chunks of steps so that a change of machine load hits both alike (the
-//    counter `ratio` is the issue's ≤ 1.3 target).
+//    counter `ratio`, to stay ≤ 1.3).
 // Run single-threaded (OMP_NUM_THREADS=1) for per-step figures.
 #include <sphshell/sphshell.hpp>
 

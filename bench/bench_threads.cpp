@@ -8,7 +8,7 @@
 // 1 thread and one on 2 (the order swapped every round), so a change of the
 // machine's load hits both alike. The counter `ratio` is the median over the
 // rounds of (2-thread chunk time) / (1-thread chunk time): below 1 the second
-// thread helps, 1.1 is the limit under load. `load1` is the 1-minute
+// thread helps, 1.1 is the limit allowed under load. `load1` is the 1-minute
 // load average when the benchmark started. `steal` is the share of the
 // machine's CPU time that its hypervisor gave to other guests while the
 // rounds ran (Linux /proc/stat; −1 where it cannot be read): a virtual
