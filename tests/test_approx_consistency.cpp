@@ -269,6 +269,7 @@ TEST_CASE("Builds are identical for any number of OpenMP threads", "[approx]") {
   CHECK(serial.neighbour == parallel.neighbour);
   CHECK(serial.value == parallel.value);
 #else
-  SUCCEED("built without OpenMP");
+  // Not a pass: tests/CMakeLists.txt has ctest report this case as skipped.
+  WARN("SKIPPED: built without OpenMP, there is no thread count to compare");
 #endif
 }

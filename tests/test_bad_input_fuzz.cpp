@@ -1,5 +1,5 @@
-// Fuzz test of the public API with bad input (issue 15): a fixed seed draws
-// cases from the families of bad input the issue lists (bad geometry, options,
+// Fuzz test of the public API with bad input: a fixed seed draws cases
+// from the families of bad input the library must refuse (bad geometry, options,
 // sets, loads, conditions, run control, pre-cracks), each with a random victim
 // (particle, quad, option) and a random bad value (NaN, ±infinity, negative,
 // zero, huge, a duplicate, an index out of range). Every case must end in a

@@ -1,4 +1,4 @@
-// Bad geometry (issue 15): each kind of inconsistent model ends in a
+// Bad geometry: each kind of inconsistent model ends in a
 // sphshell::Error naming the quad, particle or option at fault and its value,
 // at construction, instead of a misleading error later or a silent result.
 #include "bad_input_support.hpp"

@@ -1,4 +1,4 @@
-// Memory (issue 15): a model too large for the memory the process may take is
+// Memory: a model too large for the memory the process may take is
 // refused up front with the estimate, and an allocation that fails anyway
 // leaves the API as a sphshell::Error naming the size, never std::bad_alloc
 // (nor std::terminate from inside an OpenMP region).

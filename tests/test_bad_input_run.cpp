@@ -1,4 +1,4 @@
-// Bad run control, loads, sets and conditions (issue 15): each ends in a
+// Bad run control, loads, sets and conditions: each ends in a
 // sphshell::Error naming the parameter, the particle and the value, instead of
 // running for ever, doing nothing or applying something else.
 #include "bad_input_support.hpp"

@@ -1,4 +1,4 @@
-// Output paths and files that go wrong (issue 15's output rows): every one is a
+// Output paths and files that go wrong: every one is a
 // sphshell::Error naming the path and the system's reason; the three ParaView
 // collections agree however a run is killed; a reused output directory holds
 // only the new run's frames. Uses the Solver's public API only.

@@ -1,4 +1,4 @@
-// What the solver's ParaView frames hold (issue 14's output item): the shell
+// What the solver's ParaView frames hold: the shell
 // as cells over the particles, removed stress points as gaps, the coordinate
 // convention, through-thickness points named by position, the encodings.
 // Read back with the tests' own reader (tests/support/vtu_reader.hpp) and

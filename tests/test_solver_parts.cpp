@@ -398,7 +398,8 @@ TEST_CASE("parallel::for_each gives each thread one contiguous block, not indice
   // two-thread team runs one contiguous range of a loop (its block, less what
   // the caller took from the block's back), whichever thread ran faster.
 #ifndef _OPENMP
-  SUCCEED("built without OpenMP: the loops run on one thread");
+  // Not a pass: tests/CMakeLists.txt has ctest report this case as skipped.
+  WARN("SKIPPED: built without OpenMP, the loops run on one thread and there is no worker to check");
 #else
   omp_set_num_threads(2);
   constexpr std::size_t n = 20000;

@@ -1,4 +1,4 @@
-// The standard shell benchmarks (issue 11), solved statically by Newton's
+// The standard shell benchmarks, solved statically by Newton's
 // method on the solver's own forces (tests/support/static_shell.hpp; the cases
 // in tests/support/shell_benchmarks.hpp). The README's table and charts come
 // from the shell_benchmarks example, which runs the same cases one refinement
