@@ -15,7 +15,7 @@ int main(int argc, char** argv) try {
                                     "elastoplastic and geometrically nonlinear, under a 1 MPa step pressure.");
   command_line.output_folder(output);
   command_line.writes("centre.csv", "every step: the centre particle's displacement, velocity and rotation");
-  command_line.writes("particles.pvd, stress_points.pvd", "ParaView frames every 0.2 ms");
+  command_line.writes("particles.pvd, stress_points.pvd", "ParaView frames of particles and stress points");
   if (!command_line.parse(argc, argv)) return 0;
 
   using PlateSolver = Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<5>,
@@ -36,7 +36,7 @@ int main(int argc, char** argv) try {
   solver.add_particle_probe(output + "/centre.csv", centre);
   solver.run_until(2e-3, [&](const PlateSolver& s) {
     if (s.steps() % 500 == 0)
-      std::cout << "t = " << s.time() << " s  w = " << s.displacement(centre).z() << " m\n";
+      std::clog << "t = " << s.time() << " s  w = " << s.displacement(centre).z() << " m\n";
   });
   std::cout << "centre deflection at 2 ms: " << solver.displacement(centre).z() * 1e3 << " mm, "
             << solver.steps() << " steps\n";

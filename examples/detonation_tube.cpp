@@ -167,8 +167,9 @@ std::optional<Arguments> parse(int argc, char** argv) {
       "Ep 640 MPa, ε̄sp 0.13, ε̄cp 0.343, Dc 0.3; Lemaitre damage, crack::LineSegments, geometrically "
       "nonlinear) torn by an internal gaseous detonation, the paper's §4.2 (Figs 28-32): the pressure of "
       "eq. (4.4), pcj = 6.2 MPa travelling at vcj = 2390 m/s from z = 0, pushes the wall outward; both ends "
-      "are clamped and a 50.8 mm axial notch is centred at half the length. Prints progress lines, a table "
-      "of the crack tips and their speeds, the peak and mean axial tip speeds, when each end turns round "
+      "are clamped and a " + example::format_number(notch_length() * 1e3) +
+          " mm axial notch is centred at half the length. Prints progress lines on standard error; on standard "
+          "output a table of the crack tips and their speeds, the peak and mean axial tip speeds, when each end turns round "
       "the tube, the axial growth of each end, the total crack growth rate and the energies.");
   command_line.number("--spacing", a.spacing, "m", "target particle spacing, circumferential and axial");
   command_line.number("--radius", a.radius, "m", "mid-surface radius");
@@ -232,7 +233,7 @@ std::optional<Arguments> parse(int argc, char** argv) {
                               "must be at most a quarter of the notch length (12.7 mm), so the notch spans several "
                               "spacings");
   if (!(a.length > notch_length() + 4 * a.spacing))
-    detail::invalid_parameter("--length", a.length, "must exceed the notch (50.8 mm) by a few spacings");
+    detail::invalid_parameter("--length", a.length, "must exceed the notch (" + example::format_number(notch_length() * 1e3) + " mm) by a few spacings");
   return a;
 }
 
@@ -319,11 +320,11 @@ int run(const Arguments& a) {
   std::cout << "detonation tube (assumed geometry, see detonation_tube.cpp): R = " << a.radius << " m, L = "
             << a.length << " m, d = " << thickness << " m, " << n_circ << " x " << n_axial << " = "
             << model.particle_count() << " particles, " << model.stress_point_count() << " stress points\n"
-            << "  notch 50.8 mm centred at z = " << notch_centre << " m (wave arrives at its rear end at "
+            << "  notch " << notch_length() * 1e3 << " mm centred at z = " << notch_centre << " m (wave arrives at its rear end at "
             << notch_rear_end / v_cj * 1e6 << " µs), dt = " << solver.time_step()
             << " s (stable " << solver.stable_time_step() << " s), rotary-inertia scale " << rotary_scale
             << ", particle share " << a.particle_share
-            << ", end " << a.end_time * 1e6 << " µs\n";
+            << ", end " << a.end_time * 1e6 << " µs" << std::endl;  // before the progress lines on stderr
 
   struct Sample {
     double t, rear, front, rear_path, front_path, length, radial, arc, rear_arc, front_arc;
@@ -396,10 +397,9 @@ int run(const Arguments& a) {
     if (s.steps() >= next_progress) {
       const auto [rear, front] = tips(s);
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      std::printf("  step %6ld  t %6.1f µs  rear tip z %7.1f mm  front tip z %7.1f mm  crack length %7.1f mm  damaged SPs %5zu  (%4.0f s)\n",
+      std::fprintf(stderr, "  step %6ld  t %6.1f µs  rear tip z %7.1f mm  front tip z %7.1f mm  crack length %7.1f mm  damaged SPs %5zu  (%4.0f s)\n",
                   s.steps(), s.time() * 1e6, rear * 1e3, front * 1e3, s.crack().total_length() * 1e3,
                   s.damaged_stress_point_count(), seconds);
-      std::fflush(stdout);
       next_progress += 200;
     }
   });
@@ -492,8 +492,10 @@ int run(const Arguments& a) {
   std::printf("cracks %d, total length %.1f mm, damaged stress points %zu, fragment particles %zu\n",
               solver.crack().crack_count(), solver.crack().total_length() * 1e3, solver.damaged_stress_point_count(),
               solver.fragment_count());
+  const double scale = example::energy_scale(e);
   std::printf("energy: kinetic %.4g J, plastic dissipation %.4g J, external work %.4g J, balance %.3g J\n",
-              e.kinetic, e.plastic_dissipation, e.external_work, e.balance());
+              example::shown_energy(e.kinetic, scale), example::shown_energy(e.plastic_dissipation, scale),
+              example::shown_energy(e.external_work, scale), e.balance());
   io::PlotSeries rear{"rear tip, axial", {}, {}}, front{"front tip, axial", {}, {}};
   io::PlotSeries rear_arc{"rear end, circumferential half-extent", {}, {}, io::PlotStyle::dashed},
       front_arc{"front end, circumferential half-extent", {}, {}, io::PlotStyle::dashed};

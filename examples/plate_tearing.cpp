@@ -137,11 +137,11 @@ std::optional<Arguments> parse(int argc, char** argv) {
       "Plate tearing after Simonsen & Törnqvist (2004), the paper's §4.1 (Figs 23-27, Table 5): a pre-cracked "
       "steel plate (d 0.01 m, ρ 7800 kg/m³, E 200 GPa, ν 0.3, σs0 270 MPa, Ep 833 MPa, ε̄sp 0.13, ε̄cp 0.37, "
       "Dc 0.22; Lemaitre damage, crack::LineSegments) torn by two rigid arms that rotate about pins while a "
-      "crosshead pulls them apart, eq. (4.1)-(4.3). Prints progress lines, a table of the crosshead force "
-      "and crack advance over the stroke, the peak force and the energies.");
+      "crosshead pulls them apart, eq. (4.1)-(4.3). Prints progress lines on standard error; on standard "
+      "output a table of the crosshead force and crack advance over the stroke, the peak force and the energies.");
   command_line.integer("--n", a.n,
-                       "particles along the plate width, at least 11; the height gets the same spacing (61: "
-                       "61 × 60 = 3660 particles at 10 mm, close to the paper's 3599)");
+                       "particles along the plate width, at least 11; the height gets the same spacing (the "
+                       "paper's mesh has 3599 particles)");
   command_line.number("--speed", a.speed, "m/s",
                       "crosshead speed, reached after a smooth 0.5 ms start so that no shock enters the plate");
   command_line.number("--end-displacement", a.end_displacement, "m",
@@ -299,7 +299,7 @@ int run(const Arguments& a) {
             << " m, " << model.particle_count() << " particles, " << model.stress_point_count()
             << " stress points, spacing " << spacing * 1e3 << " mm, pre-crack " << a.precrack * 1e3
             << " mm\n  crosshead " << speed << " m/s to " << a.end_displacement * 1e3 << " mm, dt = "
-            << solver.time_step() << " s (stable " << solver.stable_time_step() << " s)\n";
+            << solver.time_step() << " s (stable " << solver.stable_time_step() << " s)" << std::endl;  // before the progress lines on stderr
   struct Row { double stroke, p_grip, p_cross, advance, grown; };
   std::vector<Row> table;
   io::PlotSeries force_curve{"P_crosshead (SPH shell)", {}, {}}, grip_curve{"P_grip", {}, {}, io::PlotStyle::dashed};
@@ -337,10 +337,9 @@ int run(const Arguments& a) {
     }
     if (s.steps() >= next_progress) {
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      std::printf("  step %7ld  t %7.3f ms  stroke %6.1f mm  P_crosshead %7.1f kN  P_grip %7.1f kN  crack +%6.1f mm  damaged SPs %5zu  (%5.0f s)\n",
+      std::fprintf(stderr, "  step %7ld  t %7.3f ms  stroke %6.1f mm  P_crosshead %7.1f kN  P_grip %7.1f kN  crack +%6.1f mm  damaged SPs %5zu  (%5.0f s)\n",
                   s.steps(), s.time() * 1e3, delta * 1e3, p_cross * 1e-3, p_grip * 1e-3, (tip - a.precrack) * 1e3,
                   s.damaged_stress_point_count(), seconds);
-      std::fflush(stdout);
       next_progress += 1000;
     }
   });
@@ -351,8 +350,10 @@ int run(const Arguments& a) {
     std::printf("  %10.1f  %16.1f  %11.1f  %18.1f  %17.1f\n", r.stroke * 1e3, r.p_cross * 1e-3, r.p_grip * 1e-3,
                 r.advance * 1e3, r.grown * 1e3);
   std::printf("\npeak crosshead force %.1f kN at stroke %.1f mm\n", peak_force * 1e-3, peak_stroke * 1e3);
+  const double scale = example::energy_scale(e);
   std::printf("energy: kinetic %.4g J, plastic dissipation %.4g J, external work %.4g J, balance %.3g J\n",
-              e.kinetic, e.plastic_dissipation, e.external_work, e.balance());
+              example::shown_energy(e.kinetic, scale), example::shown_energy(e.plastic_dissipation, scale),
+              example::shown_energy(e.external_work, scale), e.balance());
   const std::string plot = std::filesystem::path(csv).replace_extension(".svg").string();
   io::write_svg_plot(plot, {{"Crosshead force (paper Fig. 26)", "crosshead displacement [mm]", "force [kN]",
                              {force_curve, grip_curve}},

@@ -55,10 +55,10 @@ std::optional<Arguments> parse(int argc, char** argv) {
                       {"all", "linear", "nonlinear", "paths", "hemisphere-path", "pullout-stability"},
                       "which benchmarks to run: all is linear and nonlinear; paths follows the whole load paths of "
                       "Sze et al.'s hemisphere (at three resolutions), pull-out and pinched cylinder (one each) by "
-                      "displacement control, about 17 min; hemisphere-path follows only the hemisphere's, at 33², "
-                      "41² and 45² (finer than paths) with the director hourglass, about 20 min; pullout-stability follows the pull-out without the director "
+                      "displacement control; hemisphere-path follows only the hemisphere's, at 33², "
+                      "41² and 45² (finer than paths) with the director hourglass; pullout-stability follows the pull-out without the director "
                       "hourglass at 13×9 and 22×15 and with it at 22×15 by displacement control with the tangent's "
-                      "stability after every step, then (without it) by arc length, about 3 min");
+                      "stability after every step, then (without it) by arc length");
   command_line.output_folder(arguments.output);
   command_line.writes("benchmarks.csv", "every run: case, resolution, value, reference, error, seconds");
   command_line.writes("end_shear.csv", "cantilever under end shear: P/Pmax, tip w and -u, the elastica's");

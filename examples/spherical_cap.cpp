@@ -23,6 +23,9 @@ namespace cap = sphshell::test_support::spherical_cap;
 
 namespace {
 
+// The paper's five Gauss points through the thickness.
+using CapRule = thickness::Gauss<5>;
+
 struct Arguments {
   bool plastic = false;
   bool linear = false;
@@ -42,8 +45,9 @@ std::optional<Arguments> parse(int argc, char** argv) {
       "spherical_cap",
       "The clamped spherical cap of the paper's Figs 6-7: R = 22.27 in = 0.5657 m, d = 0.41 in = 0.010414 m, "
       "half angle 26.67°, E = 72.4 GPa, ν = 0.3, ρ = 2618 kg/m³, inward step pressure 600 psi, geometrically "
-      "nonlinear, 5 Gauss points. Prints the apex displacement u/d while running, then its first peak beside "
-      "that of an independent axisymmetric shell solution, which the chart draws too.");
+      "nonlinear, through-thickness rule " + example::rule_name<CapRule>() +
+          ". Prints the apex displacement u/d while running on standard error, then on standard output its "
+          "first peak beside that of an independent axisymmetric shell solution, which the chart draws too.");
   command_line.flag("--plastic", arguments.plastic,
                     "the elastoplastic variant (σs0 = 165.5 MPa, tangent modulus Et = 1.448 GPa) instead of "
                     "the elastic cap");
@@ -93,7 +97,7 @@ int run(const Arguments& arguments, const typename Material::Parameters& paramet
   options.nonlinear = !arguments.linear;
   options.output_directory = arguments.frames ? arguments.output : "";
   options.output_interval = arguments.frames ? 5e-5 : 0.0;
-  Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<5>, Material> solver(cap_model(arguments), parameters,
+  Solver<approx::MLS<kernel::CubicSpline>, CapRule, Material> solver(cap_model(arguments), parameters,
                                                                                   options);
   const ShellModel& model = solver.model();
   solver.clamp(model.set("boundary"));
@@ -112,7 +116,7 @@ int run(const Arguments& arguments, const typename Material::Parameters& paramet
   std::cout << "spherical cap (" << arguments.grid << " grid): " << model.particle_count() << " particles, "
             << model.stress_point_count() << " stress points, " << Material::name << ", "
             << cap::name(analysis(arguments)) << ", dt = " << solver.time_step() << " s (stable "
-            << solver.stable_time_step() << " s)\n";
+            << solver.stable_time_step() << " s)" << std::endl;  // before the progress lines on stderr
   solver.run_until(arguments.end_time, [&](const auto& s) {
     const double u = -s.displacement(apex).dot(model.particle_normal[apex]);
     history.write_row({s.time(), u / cap::thickness});
@@ -121,7 +125,7 @@ int run(const Arguments& arguments, const typename Material::Parameters& paramet
     apex_curve.x.push_back(s.time() * 1e3);
     apex_curve.y.push_back(u / cap::thickness);
     if (s.steps() >= next_report) {
-      std::cout << "  t = " << s.time() * 1e3 << " ms  apex u/d = " << u / cap::thickness << '\n';
+      std::clog << "  t = " << s.time() * 1e3 << " ms  apex u/d = " << u / cap::thickness << '\n';
       next_report += 100;
     }
   });

@@ -48,15 +48,14 @@ std::optional<Arguments> parse(int argc, char** argv) {
                       "or damage with cracks");
   command_line.choice("--rule", a.rule, {"gauss5", "gauss3", "gauss7", "global"},
                       "through-thickness integration: 5, 3 or 7 Gauss points, or resultants (thickness::Global)");
-  command_line.integer("--n", a.n, "particles along each edge, at least 3 (51: 2601 particles, 2500 stress points)");
+  command_line.integer("--n", a.n, "particles along each edge, at least 3 (n × n particles, (n - 1)² stress points)");
   command_line.custom("--pressure", "X", "Pa", "1e6, 5e6 with --case fracture", "step pressure q, > 0",
                       [&a](const std::string& text) { a.pressure = example::parse_number("--pressure", text); });
   command_line.number("--end-time", a.end_time, "s", "simulated time");
   command_line.custom("--particle-share", "X", "-",
                       example::format_number(a.particle_share) + ", the library's",
                       "SolverOptions::particle_integration_share, in [0, 1): the share of the membrane and "
-                      "bending work the particles integrate (with 0.02 damage starts at 1.66 instead of "
-                      "1.56 ms and the cracks grow as fast)",
+                      "bending work the particles integrate",
                       [&a](const std::string& text) {
                         a.particle_share = example::parse_particle_share("--particle-share", text);
                       });
@@ -123,9 +122,9 @@ int run(const Arguments& a, const typename Material::Parameters& parameters) {
   io::CsvProbe history(csv, columns);
 
   std::cout << "square plate: " << model.particle_count() << " particles, " << model.stress_point_count()
-            << " stress points, " << Rule::name << ", " << Material::name << ", "
+            << " stress points, " << example::rule_name<Rule>() << ", " << Material::name << ", "
             << (options.nonlinear ? "nonlinear" : "linear") << " analysis, q = " << pressure
-            << " Pa, dt = " << solver.time_step() << " s\n";
+            << " Pa, dt = " << solver.time_step() << " s" << std::endl;  // before the progress lines on stderr
   double peak = 0.0, peak_time = 0.0;
   io::PlotSeries deflection{"w at the centre A", {}, {}}, crack_length{"total crack length", {}, {}};
   io::PlotSeries longest_crack{"longest crack", {}, {}, io::PlotStyle::dashed};
@@ -166,12 +165,14 @@ int run(const Arguments& a, const typename Material::Parameters& parameters) {
   });
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const EnergyReport energy = solver.energy();
+  const double scale = example::energy_scale(energy);
   std::cout << "done: " << solver.steps() << " steps in " << seconds << " s ("
             << 1e6 * seconds / solver.steps() << " µs per step)\n"
             << "peak centre deflection " << peak * 1e3 << " mm at t = " << peak_time * 1e3 << " ms\n"
-            << "energy at the end: kinetic " << energy.kinetic << " J, internal " << energy.internal
-            << " J (plastic dissipation " << energy.plastic_dissipation << " J), external work "
-            << energy.external_work << " J, balance " << energy.balance() << " J\n";
+            << "energy at the end: kinetic " << example::shown_energy(energy.kinetic, scale) << " J, internal "
+            << example::shown_energy(energy.internal, scale) << " J (plastic dissipation "
+            << example::shown_energy(energy.plastic_dissipation, scale) << " J), external work "
+            << example::shown_energy(energy.external_work, scale) << " J, balance " << energy.balance() << " J\n";
   if constexpr (Crack::enabled)
     std::cout << "cracks: " << solver.crack().crack_count() << " cracks, total length "
               << solver.crack().total_length() << " m (longest " << longest_crack_length(solver) << " m), "

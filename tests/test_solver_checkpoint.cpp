@@ -99,12 +99,15 @@ void require_bitwise_equal(const S& restarted, const S& reference) {
 }
 
 // Every file of two output folders, byte for byte; returns the file count.
+// The output files, not the live solvers' lock files (which name the process, not the run).
 std::size_t require_same_files(const fs::path& restarted_dir, const fs::path& reference_dir) {
   std::map<std::string, std::string> reference_files, restarted_files;
   for (const auto& entry : fs::directory_iterator(reference_dir))
-    reference_files[entry.path().filename().string()] = file_bytes(entry.path());
+    if (entry.path().filename() != io::DirectoryLock::file_name)
+      reference_files[entry.path().filename().string()] = file_bytes(entry.path());
   for (const auto& entry : fs::directory_iterator(restarted_dir))
-    restarted_files[entry.path().filename().string()] = file_bytes(entry.path());
+    if (entry.path().filename() != io::DirectoryLock::file_name)
+      restarted_files[entry.path().filename().string()] = file_bytes(entry.path());
   for (const auto& [name, bytes] : reference_files) {
     INFO("file " << name);
     REQUIRE(restarted_files.count(name) == 1);

@@ -116,7 +116,7 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
         assembler_(options_.nonlinear, points_),
         ledger_(options_.monitoring(), law_.youngs_modulus(), solver::shell_volume(model_)),
         progress_(options_.monitoring()),
-        output_(options_.output()),
+        output_(options_.output(), options_.progress_stream),
         checkpoints_(options_.output()) {
     fracture_.initialize(model_, points_);
     stable_time_step_ = solver::stable_time_step(model_, law_, options_.physics(), points_, states_);

@@ -102,6 +102,9 @@ TEST_CASE("Distributed frames and probes", "[mpi][output]") {
     CHECK_THROWS_WITH(distributed.add_stress_point_probe(directory + "/other.csv",
                                                          static_cast<int>(model.stress_point_count())),
                       Catch::Contains("stress point index"));
+    // The folder is this solver's while it lives: a second one there is an Error on every rank.
+    CHECK_THROWS_WITH(Distributed(comm, model, {210e9, 0.3}, distributed_options),
+                      Catch::Contains(distributed_options.output_directory) && Catch::Contains("in use"));
     distributed.run_until(end_time);
     CHECK(distributed.positions() == serial_positions);
   }

@@ -22,6 +22,7 @@
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/io/csv_probe.hpp>
+#include <sphshell/io/directory_lock.hpp>
 #include <sphshell/io/output_directory.hpp>
 #include <sphshell/io/output_file.hpp>
 #include <sphshell/io/pvd_collection.hpp>
@@ -54,14 +55,16 @@ struct FramePiece {
 class DistributedFrames {
  public:
   DistributedFrames() = default;
-  // Collective: rank 0 creates the directory (and the empty series); an
-  // Error there stops every rank.
+  // Collective: rank 0 creates the directory, takes it (its lock file, as a
+  // serial Solver does: io/directory_lock.hpp) and starts the empty series;
+  // an Error there stops every rank.
   DistributedFrames(const Communicator& comm, const OutputOptions& options, bool with_cracks)
       : options_(options), with_cracks_(with_cracks) {
     if (options_.output_directory.empty()) return;
     collectively(comm, [&] {
       if (comm.is_root()) {
         io::make_directory(options_.output_directory, "", "output_directory");
+        lock_ = std::make_unique<io::DirectoryLock>(options_.output_directory, "output_directory");
         start_series({});
       }
     });
@@ -226,6 +229,7 @@ class DistributedFrames {
 
   OutputOptions options_;
   bool with_cracks_ = false;
+  std::unique_ptr<io::DirectoryLock> lock_;  // rank 0's, held while the solver lives
   std::array<std::optional<io::PvdCollection>, series_count> series_;  // rank 0
   long frames_written_ = 0;
   long last_frame_step_ = -1;

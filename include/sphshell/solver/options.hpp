@@ -121,6 +121,10 @@ struct OutputOptions {
   // show as gaps (solver/output.hpp has the details). A directory used before
   // loses its earlier frames (particles_*.vtu, stress_points_*.vtu, cracks_*.vtu, the three .pvd and
   // their .tmp files) when the first frame is written; other files stay.
+  // The solver holds the directory while it lives (the lock file
+  // .sphshell.lock: a second live solver there is an Error), and a probe file
+  // or checkpoint_path that is a frame, a collection or the lock file is an
+  // Error (solver/output.hpp).
   // output_interval > 0 needs an output_directory; with a directory and an
   // interval of 0, frames are written only by Solver::write_frame().
   std::string output_directory;

@@ -25,6 +25,14 @@
 // its top and carries the point array "displacement". Each file holds its
 // time as FieldData TimeValue.
 //
+// Collisions: the output directory is the solver's alone while it lives (a
+// lock file, io/directory_lock.hpp); a probe file, the checkpoint_path, the
+// frames, the collections and the lock file must all be different files,
+// which is checked when the solver is built and when a probe is added, before
+// the first step. A file in the folder that is named like a frame but that no
+// run of this library can have written (a folder, a number past any frame's)
+// is kept and named on the notes stream (MonitoringOptions::progress_stream).
+//
 // Kill safety: a frame's .vtu files are written (each atomically) before the
 // three collections are rewritten together (io::write_together), so at any
 // moment the collections list the same frames and every listed file is
@@ -38,6 +46,7 @@
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/io/csv_probe.hpp>
+#include <sphshell/io/directory_lock.hpp>
 #include <sphshell/io/output_directory.hpp>
 #include <sphshell/io/pvd_collection.hpp>
 #include <sphshell/io/vtu_writer.hpp>
@@ -48,8 +57,10 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <charconv>
 #include <cstdio>
 #include <filesystem>
+#include <iostream>
 #include <memory>
 #include <set>
 #include <sstream>
@@ -143,9 +154,23 @@ class SolverOutput {
   using StressProbe = StressPointProbe<output_points>;
 
   // Creates the output directory at once, so that a path that cannot be one
-  // fails before the run rather than at its first frame.
-  explicit SolverOutput(const OutputOptions& options) : options_(options) {
-    if (!options_.output_directory.empty()) io::make_directory(options_.output_directory, "", "output_directory");
+  // fails before the run rather than at its first frame, and takes it (its
+  // lock file) for this solver. Notes on kept files go to `notes` (std::clog
+  // when null).
+  explicit SolverOutput(const OutputOptions& options, std::ostream* notes = nullptr)
+      : options_(options), notes_(notes) {
+    if (!options_.output_directory.empty()) {
+      io::make_directory(options_.output_directory, "", "output_directory");
+      directory_key_ = io::identity_of(options_.output_directory);
+      if (directory_key_.size() > 1 && directory_key_.back() == '/') directory_key_.pop_back();
+      if (!options_.checkpoint_path.empty()) {
+        const std::string use = output_file_use(options_.checkpoint_path);
+        if (!use.empty())
+          detail::invalid_parameter("checkpoint_path", options_.checkpoint_path,
+                                    "it is " + use + "; give the checkpoint a file of its own");
+      }
+      lock_ = std::make_unique<io::DirectoryLock>(options_.output_directory, "output_directory");
+    }
   }
 
   // A probe on a file a loaded checkpoint recorded continues that file (no
@@ -157,6 +182,12 @@ class SolverOutput {
       if (open.key == key)
         throw Error("sphshell: probe file '" + csv_path + "' is already the file of another probe (added as '" +
                     open.file.path() + "'); give each probe a file of its own");
+    if (!options_.checkpoint_path.empty() && key == io::identity_of(options_.checkpoint_path))
+      throw Error("sphshell: probe file '" + csv_path + "' is the checkpoint_path '" + options_.checkpoint_path +
+                  "' (the checkpoint would replace it); give the probe a file of its own");
+    const std::string use = output_file_use(csv_path);
+    if (!use.empty())
+      throw Error("sphshell: probe file '" + csv_path + "' is " + use + "; give the probe a file of its own");
     create_parent_directory(csv_path);
     if constexpr (std::is_same_v<Probe, StressProbe>)
       probe.point_names = thickness_point_names<typename Solver::rule_type>();
@@ -379,7 +410,35 @@ class SolverOutput {
     return entries;
   }
 
-  // The number N of a frame file "<series>_N.vtu" (or its .tmp), -1 for any other name.
+  // What a file of the output directory is to the series ("the frame file
+  // 'particles_000003.vtu' of output_directory '...'"), "" for none of them.
+  std::string output_file_use(const std::string& path) const {
+    if (directory_key_.empty()) return "";
+    const std::filesystem::path file(io::identity_of(path));
+    if (file.parent_path().string() != directory_key_) return "";
+    const std::string name = file.filename().string();
+    if (name == io::DirectoryLock::file_name)
+      return "the lock file of output_directory '" + options_.output_directory + "'";
+    if (io::is_frame_file(name))
+      return "a frame file ('" + name + "', a frame or collection of the series) of output_directory '" +
+             options_.output_directory + "'";
+    return "";
+  }
+
+  // A file named like a frame that no run wrote: kept, and named.
+  void note_kept(const std::string& name, const std::string& why) const {
+    std::ostream& out = notes_ ? *notes_ : std::clog;
+    out << "sphshell: output_directory '" << options_.output_directory << "': kept '" << name
+        << "', which is named like a frame file but is " << why
+        << "; move it out of the folder to keep it out of the series' way\n";
+    out.flush();
+  }
+
+  // The frames number files with a long: digits past one are no frame's.
+  static constexpr long unreadable_number = -2;
+
+  // The number N of a frame file "<series>_N.vtu" (or its .tmp), -1 for any
+  // other name, unreadable_number for digits no long holds.
   static long frame_number(std::string name) {
     if (!io::is_frame_file(name)) return -1;
     const std::string temporary = ".tmp", extension = ".vtu";
@@ -389,7 +448,11 @@ class SolverOutput {
       return -1;  // a collection
     name.resize(name.size() - extension.size());
     const std::size_t underscore = name.rfind('_');
-    return std::stol(name.substr(underscore + 1));  // is_frame_file vouches for the digits
+    const std::string digits = name.substr(underscore + 1);  // is_frame_file vouches they are digits
+    long number = 0;
+    const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), number);
+    if (error != std::errc() || end != digits.data() + digits.size()) return unreadable_number;
+    return number;
   }
 
   // The collections as the checkpoint had them, rewritten together; the
@@ -412,8 +475,18 @@ class SolverOutput {
     std::vector<fs::path> later;
     for (fs::directory_iterator entry(options_.output_directory, error), end; !error && entry != end;
          entry.increment(error)) {
-      const long number = frame_number(entry->path().filename().string());
-      if (number >= frames_written_) later.push_back(entry->path());
+      const std::string name = entry->path().filename().string();
+      if (!io::is_frame_file(name)) continue;
+      std::error_code kind_error;
+      if (!entry->is_regular_file(kind_error)) {
+        note_kept(name, "not a file (a folder, say)");
+        continue;
+      }
+      const long number = frame_number(name);
+      if (number == unreadable_number)
+        note_kept(name, "numbered past any frame");
+      else if (number >= frames_written_)
+        later.push_back(entry->path());
     }
     if (error)
       throw Error("sphshell: cannot list output_directory '" + options_.output_directory + "' (" + error.message() +
@@ -459,7 +532,14 @@ class SolverOutput {
     for (fs::directory_iterator entry(options_.output_directory, error), end; !error && entry != end;
          entry.increment(error)) {
       const std::string name = entry->path().filename().string();
-      if (io::is_frame_file(name) && name.compare(name.size() - 4, 4, ".pvd") != 0) stale.push_back(entry->path());
+      if (!io::is_frame_file(name) || name.compare(name.size() - 4, 4, ".pvd") == 0) continue;
+      std::error_code kind_error;
+      if (!entry->is_regular_file(kind_error))
+        note_kept(name, "not a file (a folder, say)");
+      else if (frame_number(name) == unreadable_number)
+        note_kept(name, "numbered past any frame");
+      else
+        stale.push_back(entry->path());
     }
     if (error)
       throw Error("sphshell: cannot list output_directory '" + options_.output_directory + "' (" + error.message() +
@@ -675,6 +755,9 @@ class SolverOutput {
   }
 
   OutputOptions options_;
+  std::ostream* notes_ = nullptr;
+  std::string directory_key_;                // identity_of(output_directory), "" without one
+  std::unique_ptr<io::DirectoryLock> lock_;  // held while the solver lives
   std::vector<OpenProbe> probes_;
   std::unique_ptr<io::PvdCollection> particle_collection_, stress_point_collection_, crack_collection_;
   long frames_written_ = 0;
