@@ -73,6 +73,11 @@ struct ResultantState {
 
 template <class Law>
 class Section<Global, Law> {
+  static_assert(!material::is_rate_dependent_v<Law>,
+                "sphshell::thickness::Section<Global, Law>: the resultant model integrates linear hardening "
+                "(hardening()) only; a rate-dependent law needs integral points through the thickness "
+                "(Gauss<N> or Simpson<N>)");
+
  public:
   static constexpr int num_points = 0;
   static constexpr int output_points = 1;
@@ -130,6 +135,12 @@ class Section<Global, Law> {
     State state;
     state.sigma_y = initial_yield_stress_;
     return state;
+  }
+
+  // The assembler's call with the step's context, which no law allowed here uses.
+  Resultants update(State& state, const StrainVoigt& d_membrane_strain, const StrainVoigt& d_curvature,
+                    const material::UpdateContext&) const {
+    return update(state, d_membrane_strain, d_curvature);
   }
 
   Resultants update(State& state, const StrainVoigt& d_membrane_strain,
