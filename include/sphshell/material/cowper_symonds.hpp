@@ -7,11 +7,11 @@
 // - The rate is the plastic one of the step, ε̄̇p = Δε̄p/Δt, and it enters the
 //   consistency condition (consistent, not lagged): with no plastic flow the
 //   overstress vanishes, so the elastic test is J2's, against σs(ε̄p,n).
-// - The return starts from J2's own (return_map::solve with the law's Ep):
-//   the rate factor is ≥ 1, so the rate-scaled Δε̄p lies below J2's, which
-//   bounds the bracket. When (Δε̄p/(DΔt))^(1/q) at J2's Δε̄p does not change
-//   1 + x in double precision, J2's return already satisfies the rate-scaled
-//   condition to the last bit and is kept: D → ∞ is J2Plasticity bit for bit.
+// - The rate factor is ≥ 1, so the rate-scaled Δε̄p lies below J2's, and J2's
+//   lies below excess/min(κᵢ + Ep) (return_map.hpp's bracket). When
+//   (Δε̄p/(DΔt))^(1/q) at that bound does not change 1 + x in double
+//   precision, the rate factor is 1 at every admissible Δε̄p and J2's own
+//   return (return_map::solve) is the answer: D → ∞ is J2Plasticity bit for bit.
 // - Otherwise Newton runs on x = (Δε̄p/(DΔt))^(1/q), Δε̄p = DΔt xᵠ
 //   (flow_stress_return.hpp): in Δε̄p the rate factor rises with an infinite
 //   slope at 0 (q > 1), in x it is linear, and a typical explicit step's root
@@ -87,19 +87,25 @@ struct CowperSymonds {
       return {false, 0};
     }
     detail::require_time_step(context.time_step);
-    const return_map::Solution quasi_static =
-        return_map::solve(elasticity_, constants_, trial, state.sigma_y, ReturnMapOptions{});
+    const double trial_equivalent = std::sqrt(von_mises_squared(trial));
+    const double sigma_y_n = state.sigma_y, plastic_modulus = parameters_.Ep, q = parameters_.q;
     const double rate_time = parameters_.D * context.time_step;  // DΔt: Δε̄p/(DΔt) = ε̄̇p/D
-    const double quasi_static_x = std::pow(quasi_static.plastic_strain_increment / rate_time, inverse_exponent_);
-    if (1.0 + quasi_static_x == 1.0) {
+    // J2's Δε̄p is at most excess/min(κᵢ + Ep) (return_map.hpp), and the
+    // rate-scaled one lies below J2's; x of that bound bounds x.
+    const double bound_x =
+        std::pow((trial_equivalent - sigma_y_n) * constants_.inverse_min_slope / rate_time, inverse_exponent_);
+    if (1.0 + bound_x == 1.0) {
+      // The rate factor is 1 in double at every admissible Δε̄p (always in the
+      // quasi-static limit, Δt = +inf): J2's return, bit for bit.
+      const return_map::Solution quasi_static =
+          return_map::solve(elasticity_, constants_, trial, sigma_y_n, ReturnMapOptions{});
       state.stress = quasi_static.stress;
       state.eps_p += quasi_static.plastic_strain_increment;
-      state.sigma_y += parameters_.Ep * quasi_static.plastic_strain_increment;  // eq. (2.34)
+      state.sigma_y += plastic_modulus * quasi_static.plastic_strain_increment;  // eq. (2.34)
       state.flow_stress = state.sigma_y;
       state.strain_rate = quasi_static.plastic_strain_increment / context.time_step;
       return {true, quasi_static.iterations};
     }
-    const double sigma_y_n = state.sigma_y, plastic_modulus = parameters_.Ep, q = parameters_.q;
     const auto flow = [&](double x) {
       const double increment = rate_time * std::pow(x, q);
       // dΔε̄p/dx = q Δε̄p/x; at x = 0: +inf (q < 1), DΔt (q = 1) or 0.
@@ -109,13 +115,15 @@ struct CowperSymonds {
                                          plastic_modulus * increment_slope * (1.0 + x) + quasi_static_flow};
     };
     // Bracket in x: 0 (g > 0: the trial lies outside σs,n) and the smaller of
-    // J2's x and excess/σs,n; at x = excess/σs,n already σy ≥ σs,n(1 + x) = σ̄*
-    // and uᵢ > σy, so g ≤ 0. Newton starts from the upper end; the safeguard
-    // keeps it inside the bracket.
-    const double excess_ratio = (std::sqrt(von_mises_squared(trial)) - sigma_y_n) / sigma_y_n;
-    const double upper = std::min(quasi_static_x, excess_ratio);
+    // bound_x and excess/σs,n; at x = excess/σs,n already σy ≥ σs,n(1 + x) = σ̄*
+    // and uᵢ > σy, so g ≤ 0. Newton starts from the last step's x, σy/σs − 1
+    // (in steady flow the root hardly moves), or from the upper end; the
+    // safeguard keeps it inside the bracket.
+    const double upper = std::min(bound_x, (trial_equivalent - sigma_y_n) / sigma_y_n);
+    const double last_x = state.flow_stress / state.sigma_y - 1.0;
+    const double start = last_x > 0.0 && last_x < upper ? last_x : upper;
     const return_map::FlowStressSolution solution =
-        return_map::solve_flow_stress(constants_, trial, flow, upper, 0.0, upper);
+        return_map::solve_flow_stress(constants_, trial, flow, start, 0.0, upper);
     const double increment = solution.plastic_strain_increment;
     state.stress = solution.stress;
     state.eps_p += increment;

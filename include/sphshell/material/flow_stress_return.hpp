@@ -145,14 +145,15 @@ FlowStressSolution solve_flow_stress(const ClosedFormConstants& constants, const
 // The return for a flow stress whose iteration variable is Δε̄p itself and
 // that does not fall below σs(0) as Δε̄p grows, given the excess σ̄* − σs(0) > 0
 // of the trial stress over it. The bracket is [0, excess/min κᵢ] (uᵢ ≥ σs(0) +
-// min κᵢ Δε̄p, so S ≤ 1 there); the start is the perfectly plastic return
-// (eq. B.8 with Ep = 0), which lies inside it.
+// min κᵢ Δε̄p, so S ≤ 1 there). The start is `guess` when it lies inside (a
+// law passes the last step's Δε̄p at the same rate: in steady flow the root
+// hardly moves), else the perfectly plastic return (eq. B.8 with Ep = 0).
 template <class FlowStress>
 FlowStressSolution solve_flow_stress(const ClosedFormConstants& constants, const StressVoigt& trial,
-                                     const FlowStress& flow, double excess) {
+                                     const FlowStress& flow, double excess, double guess = 0.0) {
   detail::FlowStressKernel<FlowStress> kernel(constants, trial, flow);
   const double upper = excess / std::min(constants.kappa_1, constants.kappa_2);
-  double increment = std::min(kernel.perfectly_plastic_start(excess), upper);
+  double increment = guess > 0.0 && guess < upper ? guess : std::min(kernel.perfectly_plastic_start(excess), upper);
   kernel.evaluate(increment);
   const int iterations = detail::solve_safeguarded(kernel, increment, 0.0, upper);
   return FlowStressSolution{kernel.stress(), kernel.value().increment, kernel.value().flow_stress, iterations};

@@ -152,8 +152,11 @@ struct JohnsonCook {
           increment, 1.0, hardening * rate_factor * thermal,
           (hardening_slope * rate_factor + hardening * rate_slope) * thermal};
     };
+    // Started from the last step's Δε̄p at the same rate (0 after an elastic step or
+    // in the quasi-static limit: then from the perfectly plastic return).
+    const double guess = state.strain_rate * context.time_step;
     const return_map::FlowStressSolution solution =
-        return_map::solve_flow_stress(constants_, trial, flow, std::sqrt(trial_squared) - quasi_static);
+        return_map::solve_flow_stress(constants_, trial, flow, std::sqrt(trial_squared) - quasi_static, guess);
     const double increment = solution.plastic_strain_increment;
     const double rate = increment * rate_per_increment;
 
