@@ -97,6 +97,9 @@ const StrainVoigt preload_strain =
     1.2 * yield_stress / youngs_modulus * StrainVoigt(1.0, -0.5, 0.0);
 const std::vector<StrainVoigt> stream = tension_shear_stream(5e-6);
 const std::vector<StrainVoigt> coarse_stream = tension_shear_stream(3e-5);
+// From the unstressed state, increments a thousand times smaller: every step
+// elastic (the yield test only), as most points of a run are most of the time.
+const std::vector<StrainVoigt> elastic_stream = tension_shear_stream(5e-9);
 
 template <class Law>
 void run_stream(benchmark::State& benchmark_state, const Law& law, const typename Law::State& start,
@@ -186,6 +189,15 @@ void BM_cowper_symonds(benchmark::State& state) {
 }
 void BM_cowper_symonds_huge_d(benchmark::State& state) {
   run_rate_stream(state, cowper_symonds_static_law, preloaded(cowper_symonds_static_law, preload_strain), stream);
+}
+void BM_j2_elastic_steps(benchmark::State& state) {
+  run_stream(state, j2_law, j2_law.initial_state(), elastic_stream, {});
+}
+void BM_johnson_cook_elastic_steps(benchmark::State& state) {
+  run_rate_stream(state, johnson_cook_law, johnson_cook_law.initial_state(), elastic_stream);
+}
+void BM_cowper_symonds_elastic_steps(benchmark::State& state) {
+  run_rate_stream(state, cowper_symonds_law, cowper_symonds_law.initial_state(), elastic_stream);
 }
 
 // One stress point: 5 integral points through the thickness (Gauss–Legendre
@@ -326,6 +338,9 @@ BENCHMARK(BM_damage_closed);
 BENCHMARK(BM_johnson_cook);
 BENCHMARK(BM_cowper_symonds);
 BENCHMARK(BM_cowper_symonds_huge_d);
+BENCHMARK(BM_j2_elastic_steps);
+BENCHMARK(BM_johnson_cook_elastic_steps);
+BENCHMARK(BM_cowper_symonds_elastic_steps);
 BENCHMARK(BM_stress_point_5_integral_points);
 
 void print_histogram(const char* label, const std::vector<StrainVoigt>& increments,

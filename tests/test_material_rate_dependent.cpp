@@ -4,6 +4,8 @@
 // failure strain at the triaxialities of plane stress, and bad input. The
 // strain paths are driven through the laws' public update() with the step's
 // UpdateContext.
+#include "support/mesh_files.hpp"
+
 #include <sphshell/sphshell.hpp>
 
 #include <catch2/catch.hpp>
@@ -11,6 +13,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 using namespace sphshell;
@@ -557,7 +560,7 @@ TEST_CASE("Rate-dependent laws: bad parameters are refused by name", "[material]
   }
 }
 
-TEST_CASE("Rate-dependent laws run in a Solver", "[material][rate][solver]") {
+TEST_CASE("Rate-dependent laws run in a Solver and restart from a checkpoint", "[material][rate][solver]") {
   // A 7 × 7 clamped plate under a pressure that yields it near the clamp
   // within a few explicit steps (tests/support/policy_smoke.hpp): each law
   // flows plastically with the solver's time step and stays finite.
@@ -589,6 +592,21 @@ TEST_CASE("Rate-dependent laws run in a Solver", "[material][rate][solver]") {
     CHECK(finite);
     CHECK(largest_eps_p > 0.0);
     CHECK(std::isfinite(solver.energy().balance()));
+    // The State lists every field (for_each_field): a run reloaded from a
+    // checkpoint repeats the uninterrupted one bit for bit (the last step's
+    // rate, which starts the next Newton iteration, included).
+    test_support::ScratchDirectory scratch(std::string("rate_dependent_") + Law::name);
+    const std::string checkpoint = (scratch / "run.ckpt").string();
+    solver.save_checkpoint(checkpoint);
+    for (int step = 0; step < 10; ++step) solver.step();
+    const std::vector<Vector3> uninterrupted = solver.positions();
+    solver.load_checkpoint(checkpoint);
+    for (int step = 0; step < 10; ++step) solver.step();
+    for (std::size_t i = 0; i < uninterrupted.size(); ++i) {
+      REQUIRE(solver.positions()[i].x() == uninterrupted[i].x());
+      REQUIRE(solver.positions()[i].y() == uninterrupted[i].y());
+      REQUIRE(solver.positions()[i].z() == uninterrupted[i].z());
+    }
   };
   JohnsonCook::Parameters jc = steel_4340();
   jc.A = 235e6;  // yields under the smoke test's pressure

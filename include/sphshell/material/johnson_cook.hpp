@@ -77,10 +77,14 @@ struct JohnsonCook {
     double temperature;  // T, K
     double D;            // Johnson–Cook damage Σ Δε̄p/εf
     bool failed;
+    // At the state's T and ε̄p, kept so that an elastic step costs no pow():
+    double thermal_softening;  // 1 − T*ᵐ
+    double yield_stress;       // quasi-static (A + B ε̄pⁿ)(1 − T*ᵐ): the next step's elastic limit
     // The fields a checkpoint stores (material.hpp).
     template <class S, class F>
     static void for_each_field(S& self, F&& field) {
-      field(self.stress, self.eps_p, self.sigma_y, self.strain_rate, self.temperature, self.D, self.failed);
+      field(self.stress, self.eps_p, self.sigma_y, self.strain_rate, self.temperature, self.D, self.failed,
+            self.thermal_softening, self.yield_stress);
     }
   };
   struct UpdateResult {
@@ -108,7 +112,7 @@ struct JohnsonCook {
   State initial_state() const {
     const double thermal = thermal_factor(homologous_temperature(parameters_.initial_temperature));
     return State{StressVoigt::Zero(), 0.0, parameters_.A * thermal, 0.0, parameters_.initial_temperature, 0.0,
-                 false};
+                 false, thermal, parameters_.A * thermal};
   }
 
   // Quasi-static limit: Δt = +inf, no rate effect (material.hpp).
@@ -124,9 +128,7 @@ struct JohnsonCook {
     }
     detail::require_finite_strain(d_eps);
     const StressVoigt trial = state.stress + elasticity_.stress_increment(d_eps);  // eq. (2.23)
-    const double homologous = homologous_temperature(state.temperature);
-    const double thermal = thermal_factor(homologous);
-    const double quasi_static = strain_hardening(state.eps_p) * thermal;
+    const double quasi_static = state.yield_stress;
     const double trial_squared = von_mises_squared(trial);
     if (trial_squared <= quasi_static * quasi_static) {
       state.stress = trial;
@@ -134,6 +136,8 @@ struct JohnsonCook {
       return {false, 0};
     }
     detail::require_time_step(context.time_step);
+    const double homologous = homologous_temperature(state.temperature);
+    const double thermal = state.thermal_softening;
     // ε̇* per unit Δε̄p; 0 in the quasi-static limit.
     const double rate_per_increment = 1.0 / (context.time_step * parameters_.reference_strain_rate);
     const double eps_p_n = state.eps_p;
@@ -163,8 +167,12 @@ struct JohnsonCook {
     state.eps_p = eps_p_n + increment;
     state.sigma_y = solution.flow_stress;
     state.strain_rate = increment / context.time_step;
-    state.temperature += heating_ * solution.flow_stress * increment;
     state.D += increment / failure_strain(triaxiality(solution.stress), rate, homologous);
+    if (heating_ > 0.0) {
+      state.temperature += heating_ * solution.flow_stress * increment;
+      state.thermal_softening = thermal_factor(homologous_temperature(state.temperature));
+    }
+    state.yield_stress = strain_hardening(state.eps_p) * state.thermal_softening;
     if (state.D >= 1.0 || state.temperature >= parameters_.melting_temperature) {
       state.failed = true;
       state.stress.setZero();
