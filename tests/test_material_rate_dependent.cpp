@@ -616,3 +616,32 @@ TEST_CASE("Rate-dependent laws run in a Solver and restart from a checkpoint", "
   run(jc, JohnsonCook(jc));
   run(CowperSymonds::Parameters{210e9, 0.3, 235e6, 1e9, 40.4, 5.0}, CowperSymonds({210e9, 0.3, 235e6, 1e9, 40.4, 5.0}));
 }
+
+TEST_CASE("Johnson-Cook failure feeds the crack handler", "[material][rate][damage][solver]") {
+  // The smoke test's clamped plate with a failure strain of 0.2 %: the
+  // integral points that reach D = 1 fail, and a stress point whose points
+  // have all failed leaves the integration as a damaged stress point.
+  JohnsonCook::Parameters jc = steel_4340();
+  jc.A = 235e6;
+  jc.D1 = 0.002;
+  jc.D2 = 0.0;
+  jc.D3 = 0.0;
+  SolverOptions options;
+  options.nonlinear = true;
+  Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<3>, JohnsonCook, crack::LineSegments> solver(
+      ShellModel::rectangular_plate(0.06, 0.06, 7, 7, 0.01), jc, options);
+  solver.clamp(solver.model().set("x_min"));
+  solver.add_uniform_pressure(solver.model().all_particles(), 5e7);
+  int steps = 0;
+  for (; steps < 3000 && solver.damaged_stress_point_count() == 0; ++steps) solver.step();
+  INFO(steps << " steps");
+  REQUIRE(solver.damaged_stress_point_count() > 0);
+  // Every integral point of a damaged stress point has D >= 1.
+  int damaged_points_checked = 0;
+  for (int p = 0; p < int(solver.model().stress_point_count()); ++p) {
+    bool all_failed = true;
+    for (int k = 0; k < 3; ++k) all_failed = all_failed && solver.damage(p, k) >= 1.0;
+    damaged_points_checked += all_failed ? 1 : 0;
+  }
+  CHECK(damaged_points_checked >= int(solver.damaged_stress_point_count()));
+}
