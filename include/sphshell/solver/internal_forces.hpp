@@ -346,8 +346,15 @@ class InternalForceAssembler {
     const StrainVoigt d_membrane = strains.membrane - states.membrane_strain(p);
     const StrainVoigt d_curvature = strains.curvature - states.curvature(p);
     const Vector2 d_shear = strains.shear - states.shear_strain(p);
-    const thickness::Resultants resultants =
-        states.section(p).update(states.state(p), d_membrane, d_curvature, update_context_);
+    // A rate-dependent law's section gets the step's time step; every other
+    // section is called as it always was (a Section of the user's own need
+    // not take the context).
+    const thickness::Resultants resultants = [&] {
+      if constexpr (material::is_rate_dependent_v<Law>)
+        return states.section(p).update(states.state(p), d_membrane, d_curvature, update_context_);
+      else
+        return states.section(p).update(states.state(p), d_membrane, d_curvature);
+    }();
     // The elastic transverse shear force (weighted: the shear weight holds
     // κs G d A) is updated incrementally like the other resultants, so a
     // change of shape functions (after a crack) leaves it continuous.

@@ -137,12 +137,6 @@ class Section<Global, Law> {
     return state;
   }
 
-  // The assembler's call with the step's context, which no law allowed here uses.
-  Resultants update(State& state, const StrainVoigt& d_membrane_strain, const StrainVoigt& d_curvature,
-                    const material::UpdateContext&) const {
-    return update(state, d_membrane_strain, d_curvature);
-  }
-
   Resultants update(State& state, const StrainVoigt& d_membrane_strain,
                     const StrainVoigt& d_curvature) const {
     if (!d_membrane_strain.allFinite() || !d_curvature.allFinite())
