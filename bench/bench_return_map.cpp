@@ -1,5 +1,7 @@
 // Cost of the integral-point stress update along a strain stream that keeps
-// yielding, like the 500 steps of the paper's Table 1.
+// yielding, like the 500 steps of the paper's Table 1: J2's return map in its
+// variants, and beside it the rate-dependent laws (JohnsonCook, CowperSymonds)
+// on the same stream with a time step per increment.
 //
 // The stream: a state preloaded to 1.2× the uniaxial yield strain, then 500
 // increments whose direction swings between tension (1, −½, 0) and shear
@@ -36,6 +38,42 @@ const Elastic elastic_law({youngs_modulus, poisson_ratio});
 const LemaitreDamage damage_law({youngs_modulus, poisson_ratio, yield_stress, plastic_modulus, 0.0,
                                  0.5, 0.9});
 
+// The rate-dependent laws on the same stream, one increment per time step of
+// rate_time_step (the stream's 5e-6 increments then run at ~50 /s).
+constexpr double rate_time_step = 1e-7;
+// Johnson & Cook (1983) 4340 steel's B, n, C, m, Tm and (1985) failure
+// constants, with the stream's E, ν and A = σs0 so that the preloaded state
+// yields as J2's does; adiabatic heating on (β = 0.9, ρ = 7850, cp = 477).
+JohnsonCook::Parameters johnson_cook_parameters() {
+  JohnsonCook::Parameters p{};
+  p.E = youngs_modulus;
+  p.nu = poisson_ratio;
+  p.A = yield_stress;
+  p.B = 510e6;
+  p.n = 0.26;
+  p.C = 0.014;
+  p.reference_strain_rate = 1.0;
+  p.m = 1.03;
+  p.reference_temperature = 293.0;
+  p.melting_temperature = 1793.0;
+  p.initial_temperature = 293.0;
+  p.taylor_quinney = 0.9;
+  p.density = 7850.0;
+  p.specific_heat = 477.0;
+  p.D1 = -0.80;
+  p.D2 = 2.10;
+  p.D3 = -0.5;
+  p.D4 = 0.002;
+  p.D5 = 0.61;
+  return p;
+}
+const JohnsonCook johnson_cook_law(johnson_cook_parameters());
+// Mild steel's Cowper–Symonds constants (D = 40.4 /s, q = 5) on J2's hardening.
+const CowperSymonds cowper_symonds_law({youngs_modulus, poisson_ratio, yield_stress, plastic_modulus, 40.4, 5.0});
+// D so large that the rate factor is 1 in double: J2's return plus the test for it.
+const CowperSymonds cowper_symonds_static_law({youngs_modulus, poisson_ratio, yield_stress, plastic_modulus,
+                                               1e300, 5.0});
+
 std::vector<StrainVoigt> tension_shear_stream(double magnitude) {
   std::vector<StrainVoigt> stream;
   stream.reserve(stream_length);
@@ -59,6 +97,9 @@ const StrainVoigt preload_strain =
     1.2 * yield_stress / youngs_modulus * StrainVoigt(1.0, -0.5, 0.0);
 const std::vector<StrainVoigt> stream = tension_shear_stream(5e-6);
 const std::vector<StrainVoigt> coarse_stream = tension_shear_stream(3e-5);
+// From the unstressed state, increments a thousand times smaller: every step
+// elastic (the yield test only), as most points of a run are most of the time.
+const std::vector<StrainVoigt> elastic_stream = tension_shear_stream(5e-9);
 
 template <class Law>
 void run_stream(benchmark::State& benchmark_state, const Law& law, const typename Law::State& start,
@@ -67,6 +108,24 @@ void run_stream(benchmark::State& benchmark_state, const Law& law, const typenam
   std::size_t index = 0;
   for (auto _ : benchmark_state) {
     auto result = law.update(state, increments[index], options);
+    benchmark::DoNotOptimize(result);
+    benchmark::DoNotOptimize(state);
+    if (++index == increments.size()) {
+      index = 0;
+      state = start;
+    }
+  }
+  benchmark_state.SetItemsProcessed(benchmark_state.iterations());
+}
+
+template <class Law>
+void run_rate_stream(benchmark::State& benchmark_state, const Law& law, const typename Law::State& start,
+                     const std::vector<StrainVoigt>& increments) {
+  typename Law::State state = start;
+  const UpdateContext context{rate_time_step};
+  std::size_t index = 0;
+  for (auto _ : benchmark_state) {
+    auto result = law.update(state, increments[index], context);
     benchmark::DoNotOptimize(result);
     benchmark::DoNotOptimize(state);
     if (++index == increments.size()) {
@@ -121,6 +180,24 @@ void BM_j2_closed_coarse_stream(benchmark::State& state) {
 }
 void BM_damage_closed(benchmark::State& state) {
   run_stream(state, damage_law, preloaded(damage_law, preload_strain), stream, {});
+}
+void BM_johnson_cook(benchmark::State& state) {
+  run_rate_stream(state, johnson_cook_law, preloaded(johnson_cook_law, preload_strain), stream);
+}
+void BM_cowper_symonds(benchmark::State& state) {
+  run_rate_stream(state, cowper_symonds_law, preloaded(cowper_symonds_law, preload_strain), stream);
+}
+void BM_cowper_symonds_huge_d(benchmark::State& state) {
+  run_rate_stream(state, cowper_symonds_static_law, preloaded(cowper_symonds_static_law, preload_strain), stream);
+}
+void BM_j2_elastic_steps(benchmark::State& state) {
+  run_stream(state, j2_law, j2_law.initial_state(), elastic_stream, {});
+}
+void BM_johnson_cook_elastic_steps(benchmark::State& state) {
+  run_rate_stream(state, johnson_cook_law, johnson_cook_law.initial_state(), elastic_stream);
+}
+void BM_cowper_symonds_elastic_steps(benchmark::State& state) {
+  run_rate_stream(state, cowper_symonds_law, cowper_symonds_law.initial_state(), elastic_stream);
 }
 
 // One stress point: 5 integral points through the thickness (Gauss–Legendre
@@ -258,6 +335,12 @@ BENCHMARK(BM_j2_closed_fixed_3);
 BENCHMARK(BM_j2_generic_appendix_b);
 BENCHMARK(BM_j2_closed_coarse_stream);
 BENCHMARK(BM_damage_closed);
+BENCHMARK(BM_johnson_cook);
+BENCHMARK(BM_cowper_symonds);
+BENCHMARK(BM_cowper_symonds_huge_d);
+BENCHMARK(BM_j2_elastic_steps);
+BENCHMARK(BM_johnson_cook_elastic_steps);
+BENCHMARK(BM_cowper_symonds_elastic_steps);
 BENCHMARK(BM_stress_point_5_integral_points);
 
 void print_histogram(const char* label, const std::vector<StrainVoigt>& increments,
@@ -274,6 +357,21 @@ void print_histogram(const char* label, const std::vector<StrainVoigt>& incremen
   std::printf("  %-40s %5d %5d %5d %5d %5d   of %d plastic (%.1f %% in <= 1)\n", label, counts[0],
               counts[1], counts[2], counts[3], counts[4], plastic,
               100.0 * (counts[0] + counts[1]) / std::max(plastic, 1));
+}
+
+template <class Law>
+void print_rate_histogram(const char* label, const Law& law) {
+  std::array<int, 5> counts{};  // 0, 1, 2, 3, > 3 corrections
+  int plastic = 0;
+  typename Law::State state = preloaded(law, preload_strain);
+  for (const StrainVoigt& d_eps : stream) {
+    const auto result = law.update(state, d_eps, UpdateContext{rate_time_step});
+    if (!result.plastic) continue;
+    ++plastic;
+    ++counts[static_cast<std::size_t>(std::min(result.iterations, 4))];
+  }
+  std::printf("  %-40s %5d %5d %5d %5d %5d   of %d plastic\n", label, counts[0], counts[1], counts[2], counts[3],
+              counts[4], plastic);
 }
 
 // Error of a return against a round-off reference (12 plain Newton steps),
@@ -323,6 +421,10 @@ void print_stream_report() {
                                NewtonFunction::squared));
   print_histogram("generic 3x3, Appendix B start, phi", stream,
                   options_with(ReturnMapForm::generic, InitialGuess::appendix_b));
+  std::printf(" stream, rate-dependent laws (dt = %g s):\n", rate_time_step);
+  print_rate_histogram("Johnson-Cook", johnson_cook_law);
+  print_rate_histogram("Cowper-Symonds", cowper_symonds_law);
+  print_rate_histogram("Cowper-Symonds, D = 1e300", cowper_symonds_static_law);
   std::printf(" coarse stream (increments 1.5-4.5e-5):\n");
   print_histogram("Appendix B start, phi", coarse_stream, {});
   print_histogram("zero start, phi", coarse_stream,

@@ -24,6 +24,20 @@
 // check_material_law<Law>() static_asserts them one by one so a compile error
 // names the missing member.
 //
+// Rate-dependent laws. A law whose flow stress depends on the plastic strain
+// rate declares
+//   static constexpr bool rate_dependent = true;
+// and provides, besides the update above,
+//   UpdateResult update(State&, const StrainVoigt& d_eps, const UpdateContext&) const;
+// UpdateContext carries the time step Δt that the strain increment spans (the
+// rate is formed from it); Section::update passes it to such a law and calls
+// every other law as before, so rate-independent laws and their call sites do
+// not change (is_rate_dependent_v; a law without the flag is rate-independent).
+// The two-argument update of a rate-dependent law is its quasi-static limit
+// (Δt = +inf: the plastic strain rate is zero). Temperature, where a law uses
+// it (JohnsonCook), is part of its State: adiabatic heating is local to the
+// integral point, so it needs nothing from the solver.
+//
 // Checkpoints (solver/checkpoint.hpp) store each integral point's State field
 // by field. A law whose solver is checkpointed gives its State
 //   template <class S, class F> static void for_each_field(S& self, F&& field)
@@ -55,6 +69,14 @@ struct DamageParameters {
   double critical_damage = 0.0;
 };
 
+// What a rate-dependent law needs of the step besides its strain increment.
+struct UpdateContext {
+  // Δt, s, over which the strain increment is applied: the plastic strain
+  // rate is Δε̄p/Δt. +inf is the quasi-static limit (rate zero); NaN, zero or
+  // a negative value is refused by the law when it flows plastically.
+  double time_step;
+};
+
 namespace detail {
 
 using std::void_t;
@@ -83,6 +105,12 @@ using initial_state_t = decltype(std::declval<const Law&>().initial_state());
 template <class Law>
 using update_t = decltype(std::declval<const Law&>().update(std::declval<typename Law::State&>(),
                                                             std::declval<const StrainVoigt&>()));
+template <class Law>
+using context_update_t = decltype(std::declval<const Law&>().update(std::declval<typename Law::State&>(),
+                                                                    std::declval<const StrainVoigt&>(),
+                                                                    std::declval<const UpdateContext&>()));
+template <class Law>
+using rate_dependent_t = decltype(std::bool_constant<Law::rate_dependent>{});
 template <class Law>
 using parameters_accessor_t = decltype(std::declval<const Law&>().parameters());
 template <class Law>
@@ -138,7 +166,28 @@ template <class Law>
 struct update_returns_result<Law, void_t<update_result_t<Law>, update_t<Law>>>
     : std::is_convertible<update_t<Law>, typename Law::UpdateResult> {};
 
+template <class Law, class = void>
+struct context_update_returns_result : std::false_type {};
+template <class Law>
+struct context_update_returns_result<Law, void_t<update_result_t<Law>, context_update_t<Law>>>
+    : std::is_convertible<context_update_t<Law>, typename Law::UpdateResult> {};
+
+template <class Law, class = void>
+struct rate_dependent_flag : std::false_type {};
+template <class Law>
+struct rate_dependent_flag<Law, void_t<rate_dependent_t<Law>>> : std::bool_constant<Law::rate_dependent> {};
+
 }  // namespace detail
+
+// Whether Law declares `static constexpr bool rate_dependent = true` (and so
+// is updated with an UpdateContext).
+template <class Law>
+struct is_rate_dependent : detail::rate_dependent_flag<Law> {};
+template <class Law>
+inline constexpr bool is_rate_dependent_v = is_rate_dependent<Law>::value;
+
+template <class Law>
+struct has_context_update : detail::context_update_returns_result<Law> {};
 
 template <class Law>
 struct has_parameters_type : detail::is_detected<detail::parameters_type_t, Law> {};
@@ -176,6 +225,10 @@ template <class Law>
 struct has_parameters_its_flags_need<Law, void_t<has_plasticity_t<Law>, has_damage_t<Law>>>
     : std::bool_constant<(!Law::has_plasticity || has_hardening<Law>::value) &&
                          (!Law::has_damage || has_damage_parameters<Law>::value)> {};
+// A rate-dependent law must take the step's context.
+template <class Law>
+struct has_update_its_flags_need
+    : std::bool_constant<!is_rate_dependent<Law>::value || has_context_update<Law>::value> {};
 }  // namespace detail
 template <class Law>
 struct has_plasticity_flag : detail::is_detected<detail::has_plasticity_t, Law> {};
@@ -205,7 +258,8 @@ struct is_material_law
                        has_plasticity_flag<Law>, detail::has_parameters_its_flags_need<Law>,
                        has_damage_flag<Law>, has_name<Law>, has_equivalent_stress<Law>,
                        has_equivalent_plastic_strain<Law>, has_damage_accessor<Law>,
-                       has_failed<Law>, has_elastic_energy_density<Law>> {};
+                       has_failed<Law>, has_elastic_energy_density<Law>,
+                       detail::has_update_its_flags_need<Law>> {};
 
 template <class Law>
 inline constexpr bool is_material_law_v = is_material_law<Law>::value;
@@ -222,6 +276,10 @@ constexpr bool check_material_law() {
   static_assert(has_initial_state<Law>::value, "material law: missing initial state; add `State initial_state() const`");
   static_assert(has_update<Law>::value,
                 "material law: missing update; add `UpdateResult update(State&, const StrainVoigt& d_eps) const`");
+  if constexpr (is_rate_dependent<Law>::value)
+    static_assert(has_context_update<Law>::value,
+                  "material law: a law with rate_dependent = true needs the step's time step; add `UpdateResult "
+                  "update(State&, const StrainVoigt& d_eps, const UpdateContext&) const`");
   static_assert(has_parameters_accessor<Law>::value,
                 "material law: missing parameters accessor; add `const Parameters& parameters() const`");
   static_assert(has_youngs_modulus<Law>::value,

@@ -25,6 +25,7 @@
 #include <sphshell/core/parallel.hpp>
 #include <sphshell/core/statistics.hpp>
 #include <sphshell/core/types.hpp>
+#include <sphshell/material/material.hpp>
 #include <sphshell/shell/cell_shear.hpp>
 #include <sphshell/shell/kinematics.hpp>
 #include <sphshell/solver/assembly_schedule.hpp>
@@ -38,6 +39,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <exception>
+#include <limits>
 #include <memory>
 #include <string>
 #include <utility>
@@ -179,6 +181,14 @@ class InternalForceAssembler {
     }
     return detail::interleaved_sum(chunk_sums);
   }
+
+  // The time step that the strain increments of the next compute() span,
+  // passed to rate-dependent laws (material.hpp, UpdateContext); other laws
+  // never read it. Set by the particle pass that moved the particles
+  // (solver/particle_pass.hpp) before every step's compute_packed(); until
+  // then it is NaN, which a rate-dependent law refuses as soon as it flows.
+  void set_time_step(double time_step) { update_context_.time_step = time_step; }
+  double time_step() const { return update_context_.time_step; }
 
   // The work of the generalized stresses over the last compute(), summed over
   // the points as sum_over_points() does.
@@ -336,7 +346,15 @@ class InternalForceAssembler {
     const StrainVoigt d_membrane = strains.membrane - states.membrane_strain(p);
     const StrainVoigt d_curvature = strains.curvature - states.curvature(p);
     const Vector2 d_shear = strains.shear - states.shear_strain(p);
-    const thickness::Resultants resultants = states.section(p).update(states.state(p), d_membrane, d_curvature);
+    // A rate-dependent law's section gets the step's time step; every other
+    // section is called as it always was (a Section of the user's own need
+    // not take the context).
+    const thickness::Resultants resultants = [&] {
+      if constexpr (material::is_rate_dependent_v<Law>)
+        return states.section(p).update(states.state(p), d_membrane, d_curvature, update_context_);
+      else
+        return states.section(p).update(states.state(p), d_membrane, d_curvature);
+    }();
     // The elastic transverse shear force (weighted: the shear weight holds
     // κs G d A) is updated incrementally like the other resultants, so a
     // change of shape functions (after a crack) leaves it continuous.
@@ -427,6 +445,7 @@ class InternalForceAssembler {
   };
 
   bool nonlinear_;
+  material::UpdateContext update_context_{std::numeric_limits<double>::quiet_NaN()};
   std::size_t failed_point_ = 0;
   // Per point: its conjugate forces (zero for a removed point). Per stress
   // point corner (row × max_cell_corners + corner): the tied shear's forces

@@ -73,6 +73,11 @@ struct ResultantState {
 
 template <class Law>
 class Section<Global, Law> {
+  static_assert(!material::is_rate_dependent_v<Law>,
+                "sphshell::thickness::Section<Global, Law>: the resultant model integrates linear hardening "
+                "(hardening()) only; a rate-dependent law needs integral points through the thickness "
+                "(Gauss<N> or Simpson<N>)");
+
  public:
   static constexpr int num_points = 0;
   static constexpr int output_points = 1;

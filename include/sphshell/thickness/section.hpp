@@ -10,6 +10,7 @@
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/material/lanes.hpp>
+#include <sphshell/material/material.hpp>
 #include <sphshell/thickness/thickness.hpp>
 
 #include <array>
@@ -46,7 +47,8 @@ class Section {
   // Contiguous per stress point so the loop over integral points stays in cache.
   using State = std::array<typename Law::State, std::size_t(num_points)>;
   // Whether update() takes the law's batched path.
-  static constexpr bool batched = SPHSHELL_BATCHED_SECTIONS != 0 && material::has_update_lanes_v<Law, num_points>;
+  static constexpr bool batched = SPHSHELL_BATCHED_SECTIONS != 0 && material::has_update_lanes_v<Law, num_points> &&
+                                  !material::is_rate_dependent_v<Law>;
 
   Section(const Law& law, double thickness) : law_(law), thickness_(thickness) {
     sphshell::detail::require_positive("thickness", thickness);
@@ -85,6 +87,22 @@ class Section {
       }
     }
     return resultants(state);
+  }
+
+  // The same with the step's context (material.hpp): a rate-dependent law
+  // gets it at every integral point; every other law is updated exactly as
+  // above (the context is not used).
+  Resultants update(State& state, const StrainVoigt& d_membrane_strain, const StrainVoigt& d_curvature,
+                    const material::UpdateContext& context) const {
+    if constexpr (material::is_rate_dependent_v<Law>) {
+      for (int k = 0; k < num_points; ++k) {
+        const StrainVoigt d_strain = d_membrane_strain + zeta_[std::size_t(k)] * d_curvature;
+        law_.update(state[std::size_t(k)], d_strain, context);
+      }
+      return resultants(state);
+    } else {
+      return update(state, d_membrane_strain, d_curvature);
+    }
   }
 
   Resultants resultants(const State& state) const {

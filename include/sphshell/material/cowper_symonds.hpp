@@ -1,0 +1,166 @@
+#pragma once
+// Cowper–Symonds rate scaling of the plane-stress J2 law with linear isotropic
+// hardening (Cowper & Symonds 1957, Brown Univ. Tech. Rep. 28; Jones,
+// "Structural Impact", 2nd ed., 2012, eq. 8.3):
+//   σy = σs(ε̄p) [1 + (ε̄̇p/D)^(1/q)],   σs(ε̄p) = σs0 + Ep ε̄p   (eq. 2.34–2.35).
+// Choices, and why:
+// - The rate is the plastic one of the step, ε̄̇p = Δε̄p/Δt, and it enters the
+//   consistency condition (consistent, not lagged): with no plastic flow the
+//   overstress vanishes, so the elastic test is J2's, against σs(ε̄p,n).
+// - The rate factor is ≥ 1, so the rate-scaled Δε̄p lies below J2's, and J2's
+//   lies below excess/min(κᵢ + Ep) (return_map.hpp's bracket). When
+//   (Δε̄p/(DΔt))^(1/q) at that bound does not change 1 + x in double
+//   precision, the rate factor is 1 at every admissible Δε̄p and J2's own
+//   return (return_map::solve) is the answer: D → ∞ is J2Plasticity bit for bit.
+// - Otherwise Newton runs on x = (Δε̄p/(DΔt))^(1/q), Δε̄p = DΔt xᵠ
+//   (flow_stress_return.hpp): in Δε̄p the rate factor rises with an infinite
+//   slope at 0 (q > 1), in x it is linear, and a typical explicit step's root
+//   lies at Δε̄p ~ 1e-15 where Newton in Δε̄p would bisect for dozens of steps.
+
+#include <sphshell/core/error.hpp>
+#include <sphshell/core/types.hpp>
+#include <sphshell/material/elastic.hpp>
+#include <sphshell/material/flow_stress_return.hpp>
+#include <sphshell/material/j2_plasticity.hpp>
+#include <sphshell/material/material.hpp>
+#include <sphshell/material/return_map.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace sphshell::material {
+
+struct CowperSymonds {
+  struct Parameters {
+    double E;         // Pa
+    double nu;
+    double sigma_y0;  // quasi-static initial yield stress σs0, Pa
+    double Ep;        // plastic modulus E·Et/(E − Et), eq. (2.35), Pa
+    double D;         // Cowper–Symonds rate constant, 1/s
+    double q;         // Cowper–Symonds exponent
+  };
+  struct State {
+    StressVoigt stress;
+    double eps_p;        // equivalent plastic strain ε̄p
+    double sigma_y;      // quasi-static yield stress σs = σs0 + Ep ε̄p, accumulated as J2Plasticity's
+    double flow_stress;  // σy of the last step: σs [1 + (ε̄̇p/D)^(1/q)]
+    double strain_rate;  // ε̄̇p = Δε̄p/Δt of the last step, 1/s (0 if elastic)
+    // The fields a checkpoint stores (material.hpp).
+    template <class S, class F>
+    static void for_each_field(S& self, F&& field) {
+      field(self.stress, self.eps_p, self.sigma_y, self.flow_stress, self.strain_rate);
+    }
+  };
+  struct UpdateResult {
+    bool plastic;
+    int iterations;
+  };
+
+  static constexpr bool has_plasticity = true;
+  static constexpr bool has_damage = false;
+  static constexpr bool rate_dependent = true;
+  static constexpr const char* name = "Cowper-Symonds";
+
+  explicit CowperSymonds(const Parameters& parameters)
+      : parameters_((validate(parameters), parameters)),
+        elasticity_(parameters.E, parameters.nu),
+        constants_(elasticity_, parameters.Ep),
+        inverse_exponent_(1.0 / parameters.q) {}
+
+  State initial_state() const {
+    return State{StressVoigt::Zero(), 0.0, parameters_.sigma_y0, parameters_.sigma_y0, 0.0};
+  }
+
+  // Quasi-static limit: Δt = +inf, J2Plasticity's update (material.hpp).
+  UpdateResult update(State& state, const StrainVoigt& d_eps) const {
+    return update(state, d_eps, UpdateContext{std::numeric_limits<double>::infinity()});
+  }
+
+  UpdateResult update(State& state, const StrainVoigt& d_eps, const UpdateContext& context) const {
+    detail::require_finite_strain(d_eps);
+    const StressVoigt trial = state.stress + elasticity_.stress_increment(d_eps);  // eq. (2.23)
+    if (von_mises_squared(trial) <= state.sigma_y * state.sigma_y) {
+      state.stress = trial;
+      state.flow_stress = state.sigma_y;
+      state.strain_rate = 0.0;
+      return {false, 0};
+    }
+    detail::require_time_step(context.time_step);
+    const double trial_equivalent = std::sqrt(von_mises_squared(trial));
+    const double sigma_y_n = state.sigma_y, plastic_modulus = parameters_.Ep, q = parameters_.q;
+    const double rate_time = parameters_.D * context.time_step;  // DΔt: Δε̄p/(DΔt) = ε̄̇p/D
+    // J2's Δε̄p is at most excess/min(κᵢ + Ep) (return_map.hpp), and the
+    // rate-scaled one lies below J2's; x of that bound bounds x.
+    const double bound_x =
+        std::pow((trial_equivalent - sigma_y_n) * constants_.inverse_min_slope / rate_time, inverse_exponent_);
+    if (1.0 + bound_x == 1.0) {
+      // The rate factor is 1 in double at every admissible Δε̄p (always in the
+      // quasi-static limit, Δt = +inf): J2's return, bit for bit.
+      const return_map::Solution quasi_static =
+          return_map::solve(elasticity_, constants_, trial, sigma_y_n, ReturnMapOptions{});
+      state.stress = quasi_static.stress;
+      state.eps_p += quasi_static.plastic_strain_increment;
+      state.sigma_y += plastic_modulus * quasi_static.plastic_strain_increment;  // eq. (2.34)
+      state.flow_stress = state.sigma_y;
+      state.strain_rate = quasi_static.plastic_strain_increment / context.time_step;
+      return {true, quasi_static.iterations};
+    }
+    const auto flow = [&](double x) {
+      const double increment = rate_time * std::pow(x, q);
+      // dΔε̄p/dx = q Δε̄p/x; at x = 0: +inf (q < 1), DΔt (q = 1) or 0.
+      const double increment_slope = x > 0.0 ? q * increment / x : q * rate_time * std::pow(x, q - 1.0);
+      const double quasi_static_flow = sigma_y_n + plastic_modulus * increment;
+      return return_map::FlowStressValue{increment, increment_slope, quasi_static_flow * (1.0 + x),
+                                         plastic_modulus * increment_slope * (1.0 + x) + quasi_static_flow};
+    };
+    // Bracket in x: 0 (g > 0: the trial lies outside σs,n) and the smaller of
+    // bound_x and excess/σs,n; at x = excess/σs,n already σy ≥ σs,n(1 + x) = σ̄*
+    // and uᵢ > σy, so g ≤ 0. Newton starts from the last step's x, σy/σs − 1
+    // (in steady flow the root hardly moves), or from the upper end; the
+    // safeguard keeps it inside the bracket.
+    const double upper = std::min(bound_x, (trial_equivalent - sigma_y_n) / sigma_y_n);
+    const double last_x = state.flow_stress / state.sigma_y - 1.0;
+    const double start = last_x > 0.0 && last_x < upper ? last_x : upper;
+    const return_map::FlowStressSolution solution =
+        return_map::solve_flow_stress(constants_, trial, flow, start, 0.0, upper);
+    const double increment = solution.plastic_strain_increment;
+    state.stress = solution.stress;
+    state.eps_p += increment;
+    state.sigma_y += plastic_modulus * increment;  // eq. (2.34)
+    state.flow_stress = solution.flow_stress;
+    state.strain_rate = increment / context.time_step;
+    return {true, solution.iterations};
+  }
+
+  const Parameters& parameters() const { return parameters_; }
+  double youngs_modulus() const { return parameters_.E; }
+  double poisson_ratio() const { return parameters_.nu; }
+  double shear_modulus() const { return elasticity_.shear_modulus(); }
+  // The quasi-static hardening the rate factor scales.
+  HardeningParameters hardening() const { return {parameters_.sigma_y0, parameters_.Ep}; }
+  const PlaneStressElasticity& elasticity() const { return elasticity_; }
+  Matrix3 elasticity_matrix() const { return elasticity_.matrix(); }
+
+  double equivalent_stress(const State& state) const { return std::sqrt(von_mises_squared(state.stress)); }
+  double equivalent_plastic_strain(const State& state) const { return state.eps_p; }
+  double damage(const State&) const { return 0.0; }
+  bool failed(const State&) const { return false; }
+  double elastic_energy_density(const State& state) const {
+    return elasticity_.complementary_energy_density(state.stress);
+  }
+
+ private:
+  static void validate(const Parameters& parameters) {
+    detail::validate_plastic_constants(parameters.E, parameters.nu, parameters.sigma_y0, parameters.Ep);
+    sphshell::detail::require_positive("D", parameters.D);
+    sphshell::detail::require_positive("q", parameters.q);
+  }
+
+  Parameters parameters_;
+  PlaneStressElasticity elasticity_;
+  return_map::ClosedFormConstants constants_;
+  double inverse_exponent_;  // 1/q
+};
+
+}  // namespace sphshell::material

@@ -1,0 +1,287 @@
+#pragma once
+// Johnson–Cook plasticity and failure in plane stress (Johnson & Cook 1983,
+// "A constitutive model and data for metals subjected to large strains, high
+// strain rates and high temperatures", 7th Int. Symp. Ballistics; Johnson &
+// Cook 1985, "Fracture characteristics of three metals subjected to various
+// strains, strain rates, temperatures and pressures", Eng. Fract. Mech. 21).
+//
+// Flow stress (1983, eq. 1):
+//   σy = (A + B ε̄pⁿ)(1 + C ln ε̇*)(1 − T*ᵐ),  ε̇* = ε̄̇p/ε̇0,  T* = (T − Tr)/(Tm − Tr).
+// Choices, and why:
+// - The rate is the plastic one of the step itself, ε̄̇p = Δε̄p/Δt (backward
+//   Euler), and it enters the consistency condition: the return solves
+//   σ̄(Δε̄p) = σy(ε̄p,n + Δε̄p, Δε̄p/Δt) by Newton (flow_stress_return.hpp), the
+//   consistent form, not the rate of the previous step.
+// - ln ε̇* is taken as 0 for ε̇* < 1, as in common practice (the rate factor
+//   never softens; the fit is made for ε̇* ≥ 1). With no plastic flow the rate
+//   is zero, so the elastic test is against the quasi-static surface
+//   (A + B ε̄p,nⁿ)(1 − T*ᵐ).
+// - Temperature is part of the state and lagged: the step uses T_n in the
+//   thermal factor and in the damage, then adds the adiabatic rise of its
+//   plastic work, ΔT = β σy Δε̄p/(ρ cp) (β the Taylor–Quinney coefficient; β =
+//   0: isothermal). σy Δε̄p is exactly the plastic work per volume of the
+//   backward-Euler step: σ·Δεp = (Δε̄p/σy) σᵀΞσ = σy Δε̄p. T0 ≥ Tr is required,
+//   so T* ≥ 0; a point whose T reaches Tm has melted: it fails.
+// - Damage (1985, eq. 2–3): D = Σ Δε̄p/εf with
+//     εf = [D1 + D2 exp(D3 σ*)][1 + D4 ln ε̇*][1 + D5 T*],
+//   σ* = σm/σ̄ the stress triaxiality of the returned plane-stress state
+//   (σm = (σx + σy)/3 since σ33 = 0; σ* ∈ [−⅔, ⅔]), ε̇* this step's rate (ln
+//   floored at 0 as above) and T* at T_n. The damage does not soften the
+//   stress (uncoupled, as in the 1985 paper); a point whose D reaches 1 has
+//   failed: it keeps zero stress for ever, and failed(state) reports it to
+//   the crack handler (a stress point whose integral points have all failed
+//   is damaged, thickness/section.hpp).
+
+#include <sphshell/core/error.hpp>
+#include <sphshell/core/types.hpp>
+#include <sphshell/material/elastic.hpp>
+#include <sphshell/material/flow_stress_return.hpp>
+#include <sphshell/material/j2_plasticity.hpp>
+#include <sphshell/material/material.hpp>
+#include <sphshell/material/return_map.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <string>
+
+namespace sphshell::material {
+
+struct JohnsonCook {
+  // SI units throughout.
+  struct Parameters {
+    double E;                        // Young's modulus, Pa
+    double nu;                       // Poisson's ratio
+    double A;                        // yield stress at ε̄p = 0, ε̇* = 1, T = Tr, Pa
+    double B;                        // hardening coefficient, Pa
+    double n;                        // hardening exponent
+    double C;                        // strain-rate coefficient
+    double reference_strain_rate;    // ε̇0, 1/s
+    double m;                        // thermal softening exponent
+    double reference_temperature;    // Tr, K
+    double melting_temperature;      // Tm, K
+    double initial_temperature;      // T0 ∈ [Tr, Tm), K
+    double taylor_quinney = 0.0;     // β ∈ [0, 1]; 0: no adiabatic heating
+    double density = 0.0;            // ρ, kg/m³ (used only for the heating)
+    double specific_heat = 0.0;      // cp, J/(kg·K) (used only for the heating)
+    // Failure strain constants (1985); D1..D3 must keep D1 + D2 exp(D3 σ*)
+    // positive on the plane-stress range σ* ∈ [−⅔, ⅔].
+    double D1 = 0.0, D2 = 0.0, D3 = 0.0, D4 = 0.0, D5 = 0.0;
+  };
+  struct State {
+    StressVoigt stress;
+    double eps_p;        // equivalent plastic strain ε̄p
+    double sigma_y;      // flow stress of the last plastic step (initially the quasi-static one)
+    double strain_rate;  // ε̄̇p = Δε̄p/Δt of the last step, 1/s (0 if it was elastic)
+    double temperature;  // T, K
+    double D;            // Johnson–Cook damage Σ Δε̄p/εf
+    bool failed;
+    // At the state's T and ε̄p, kept so that an elastic step costs no pow():
+    double thermal_softening;  // 1 − T*ᵐ
+    double yield_stress;       // quasi-static (A + B ε̄pⁿ)(1 − T*ᵐ): the next step's elastic limit
+    // The fields a checkpoint stores (material.hpp).
+    template <class S, class F>
+    static void for_each_field(S& self, F&& field) {
+      field(self.stress, self.eps_p, self.sigma_y, self.strain_rate, self.temperature, self.D, self.failed,
+            self.thermal_softening, self.yield_stress);
+    }
+  };
+  struct UpdateResult {
+    bool plastic;
+    int iterations;
+  };
+
+  static constexpr bool has_plasticity = true;
+  static constexpr bool has_damage = true;
+  static constexpr bool rate_dependent = true;
+  static constexpr const char* name = "Johnson-Cook";
+
+  // The largest |σ*| of a plane-stress state (equibiaxial: σm/σ̄ = ⅔).
+  static constexpr double max_plane_stress_triaxiality = 2.0 / 3.0;
+
+  explicit JohnsonCook(const Parameters& parameters)
+      : parameters_((validate(parameters), parameters)),
+        elasticity_(parameters.E, parameters.nu),
+        constants_(elasticity_, 0.0),
+        inverse_temperature_range_(1.0 / (parameters.melting_temperature - parameters.reference_temperature)),
+        heating_(parameters.taylor_quinney > 0.0
+                     ? parameters.taylor_quinney / (parameters.density * parameters.specific_heat)
+                     : 0.0) {}
+
+  State initial_state() const {
+    const double thermal = thermal_factor(homologous_temperature(parameters_.initial_temperature));
+    return State{StressVoigt::Zero(), 0.0, parameters_.A * thermal, 0.0, parameters_.initial_temperature, 0.0,
+                 false, thermal, parameters_.A * thermal};
+  }
+
+  // Quasi-static limit: Δt = +inf, no rate effect (material.hpp).
+  UpdateResult update(State& state, const StrainVoigt& d_eps) const {
+    return update(state, d_eps, UpdateContext{std::numeric_limits<double>::infinity()});
+  }
+
+  UpdateResult update(State& state, const StrainVoigt& d_eps, const UpdateContext& context) const {
+    if (state.failed) {
+      state.stress.setZero();
+      state.strain_rate = 0.0;
+      return {false, 0};
+    }
+    detail::require_finite_strain(d_eps);
+    const StressVoigt trial = state.stress + elasticity_.stress_increment(d_eps);  // eq. (2.23)
+    const double quasi_static = state.yield_stress;
+    const double trial_squared = von_mises_squared(trial);
+    if (trial_squared <= quasi_static * quasi_static) {
+      state.stress = trial;
+      state.strain_rate = 0.0;
+      return {false, 0};
+    }
+    detail::require_time_step(context.time_step);
+    const double homologous = homologous_temperature(state.temperature);
+    const double thermal = state.thermal_softening;
+    // ε̇* per unit Δε̄p; 0 in the quasi-static limit.
+    const double rate_per_increment = 1.0 / (context.time_step * parameters_.reference_strain_rate);
+    const double eps_p_n = state.eps_p;
+    const auto flow = [&](double increment) {
+      const double eps_p = eps_p_n + increment;
+      const double power = std::pow(eps_p, parameters_.n);
+      const double hardening = parameters_.A + parameters_.B * power;
+      // d(Bε̄pⁿ)/dε̄p; at ε̄p = 0 it is +inf (n < 1), B (n = 1) or 0.
+      const double hardening_slope = eps_p > 0.0 ? parameters_.n * parameters_.B * power / eps_p
+                                                 : parameters_.n * parameters_.B * std::pow(eps_p, parameters_.n - 1.0);
+      const double rate = increment * rate_per_increment;
+      const bool rate_active = rate > 1.0;  // ln ε̇* taken as 0 below ε̇* = 1
+      const double rate_factor = rate_active ? 1.0 + parameters_.C * std::log(rate) : 1.0;
+      const double rate_slope = rate_active ? parameters_.C / increment : 0.0;
+      return return_map::FlowStressValue{
+          increment, 1.0, hardening * rate_factor * thermal,
+          (hardening_slope * rate_factor + hardening * rate_slope) * thermal};
+    };
+    // Started from the last step's Δε̄p at the same rate (0 after an elastic step or
+    // in the quasi-static limit: then from the perfectly plastic return).
+    const double guess = state.strain_rate * context.time_step;
+    const return_map::FlowStressSolution solution =
+        return_map::solve_flow_stress(constants_, trial, flow, std::sqrt(trial_squared) - quasi_static, guess);
+    const double increment = solution.plastic_strain_increment;
+    const double rate = increment * rate_per_increment;
+
+    state.eps_p = eps_p_n + increment;
+    state.sigma_y = solution.flow_stress;
+    state.strain_rate = increment / context.time_step;
+    state.D += increment / failure_strain(triaxiality(solution.stress), rate, homologous);
+    if (heating_ > 0.0) {
+      state.temperature += heating_ * solution.flow_stress * increment;
+      state.thermal_softening = thermal_factor(homologous_temperature(state.temperature));
+    }
+    state.yield_stress = strain_hardening(state.eps_p) * state.thermal_softening;
+    if (state.D >= 1.0 || state.temperature >= parameters_.melting_temperature) {
+      state.failed = true;
+      state.stress.setZero();
+    } else {
+      state.stress = solution.stress;
+    }
+    return {true, solution.iterations};
+  }
+
+  // A + B ε̄pⁿ.
+  double strain_hardening(double eps_p) const { return parameters_.A + parameters_.B * std::pow(eps_p, parameters_.n); }
+  // T* = (T − Tr)/(Tm − Tr).
+  double homologous_temperature(double temperature) const {
+    return (temperature - parameters_.reference_temperature) * inverse_temperature_range_;
+  }
+  // 1 − T*ᵐ (T* ∈ [0, 1) while the point has not melted).
+  double thermal_factor(double homologous) const {
+    return homologous > 0.0 ? 1.0 - std::pow(homologous, parameters_.m) : 1.0;
+  }
+  // σ* = σm/σ̄ of a plane-stress state, σm = (σx + σy)/3 (σ33 = 0); 0 at zero stress.
+  static double triaxiality(const StressVoigt& stress) {
+    const double equivalent = std::sqrt(von_mises_squared(stress));
+    return equivalent > 0.0 ? (stress.x() + stress.y()) / (3.0 * equivalent) : 0.0;
+  }
+  // εf of the 1985 paper at σ*, ε̇* and T* (ln ε̇* taken as 0 for ε̇* < 1).
+  double failure_strain(double triaxiality, double rate, double homologous) const {
+    const double log_rate = rate > 1.0 ? std::log(rate) : 0.0;
+    return (parameters_.D1 + parameters_.D2 * std::exp(parameters_.D3 * triaxiality)) *
+           (1.0 + parameters_.D4 * log_rate) * (1.0 + parameters_.D5 * homologous);
+  }
+
+  const Parameters& parameters() const { return parameters_; }
+  double youngs_modulus() const { return parameters_.E; }
+  double poisson_ratio() const { return parameters_.nu; }
+  double shear_modulus() const { return elasticity_.shear_modulus(); }
+  // The linear law's constants this law reduces to with n = 1, C = 0 and no
+  // thermal softening: σs0 = A, Ep = B.
+  HardeningParameters hardening() const { return {parameters_.A, parameters_.B}; }
+  // No threshold; the critical strain is εf in uniaxial tension (σ* = ⅓) at
+  // ε̇* ≤ 1 and T = Tr; failure at D = 1.
+  DamageParameters damage_parameters() const { return {0.0, failure_strain(1.0 / 3.0, 1.0, 0.0), 1.0}; }
+  const PlaneStressElasticity& elasticity() const { return elasticity_; }
+  Matrix3 elasticity_matrix() const { return elasticity_.matrix(); }
+
+  double equivalent_stress(const State& state) const { return std::sqrt(von_mises_squared(state.stress)); }
+  double equivalent_plastic_strain(const State& state) const { return state.eps_p; }
+  double damage(const State& state) const { return state.D; }
+  bool failed(const State& state) const { return state.failed; }
+  double elastic_energy_density(const State& state) const {
+    return elasticity_.complementary_energy_density(state.stress);
+  }
+
+ private:
+  static void validate(const Parameters& p) {
+    using sphshell::detail::invalid_parameter;
+    detail::validate_elastic_constants(p.E, p.nu);
+    sphshell::detail::require_positive("A", p.A);
+    sphshell::detail::require_nonnegative("B", p.B);
+    sphshell::detail::require_positive("n", p.n);
+    sphshell::detail::require_nonnegative("C", p.C);
+    sphshell::detail::require_positive("reference_strain_rate", p.reference_strain_rate);
+    sphshell::detail::require_positive("m", p.m);
+    sphshell::detail::require_finite("reference_temperature", p.reference_temperature);
+    if (!(p.melting_temperature > p.reference_temperature) || !std::isfinite(p.melting_temperature))
+      invalid_parameter("melting_temperature", p.melting_temperature,
+                        "must be finite and > reference_temperature = " + number(p.reference_temperature));
+    if (!(p.initial_temperature >= p.reference_temperature && p.initial_temperature < p.melting_temperature))
+      invalid_parameter("initial_temperature", p.initial_temperature,
+                        "must lie in [reference_temperature, melting_temperature) = [" +
+                            number(p.reference_temperature) + ", " + number(p.melting_temperature) + ")");
+    if (!(p.taylor_quinney >= 0.0 && p.taylor_quinney <= 1.0))
+      invalid_parameter("taylor_quinney", p.taylor_quinney, "must lie in [0, 1] (0: no adiabatic heating)");
+    if (p.taylor_quinney > 0.0) {
+      sphshell::detail::require_finite("density", p.density);
+      sphshell::detail::require_finite("specific_heat", p.specific_heat);
+      const double heat_capacity = p.density * p.specific_heat;
+      if (!(heat_capacity > 0.0) || !std::isfinite(heat_capacity))
+        invalid_parameter("density*specific_heat", heat_capacity,
+                          "must be finite and > 0 when taylor_quinney > 0 (density = " + number(p.density) +
+                              ", specific_heat = " + number(p.specific_heat) + ")");
+    }
+    sphshell::detail::require_finite("D1", p.D1);
+    sphshell::detail::require_finite("D2", p.D2);
+    sphshell::detail::require_finite("D3", p.D3);
+    sphshell::detail::require_nonnegative("D4", p.D4);
+    sphshell::detail::require_nonnegative("D5", p.D5);
+    // D1 + D2 exp(D3 σ*) is monotonic in σ*: positive at both ends of the
+    // plane-stress range means positive on all of it.
+    for (const double end : {-max_plane_stress_triaxiality, max_plane_stress_triaxiality}) {
+      const double triaxiality_term = p.D1 + p.D2 * std::exp(p.D3 * end);
+      if (!(triaxiality_term > 0.0) || !std::isfinite(triaxiality_term))
+        invalid_parameter("D1 + D2*exp(D3*triaxiality)", triaxiality_term,
+                          "must be finite and > 0 at triaxiality " + number(end) + " (D1 = " + number(p.D1) +
+                              ", D2 = " + number(p.D2) + ", D3 = " + number(p.D3) +
+                              "): the failure strain of plane stress, triaxiality in [-2/3, 2/3]");
+    }
+  }
+  static std::string number(double value) {
+    std::ostringstream text;
+    text.precision(17);
+    text << value;
+    return text.str();
+  }
+
+  Parameters parameters_;
+  PlaneStressElasticity elasticity_;
+  return_map::ClosedFormConstants constants_;  // κᵢ of ΓΞ (Ep unused)
+  double inverse_temperature_range_;          // 1/(Tm − Tr)
+  double heating_;                             // β/(ρ cp), 0 without heating
+};
+
+}  // namespace sphshell::material
