@@ -565,7 +565,7 @@ TEST_CASE("Rate-dependent laws run in a Solver and restart from a checkpoint", "
   // within a few explicit steps (tests/support/policy_smoke.hpp): each law
   // flows plastically with the solver's time step and stays finite.
   constexpr int max_steps = 3000;
-  const auto run = [&](auto parameters, auto law_tag) {
+  const auto run = [&](auto parameters, auto law_tag, auto other_parameters, const std::string& changed) {
     using Law = decltype(law_tag);
     SolverOptions options;
     options.nonlinear = true;
@@ -607,14 +607,25 @@ TEST_CASE("Rate-dependent laws run in a Solver and restart from a checkpoint", "
       REQUIRE(solver.positions()[i].y() == uninterrupted[i].y());
       REQUIRE(solver.positions()[i].z() == uninterrupted[i].z());
     }
+    // A law with another rate, temperature or failure constant does not
+    // continue this run: the checkpoint is refused, naming the constant.
+    Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<3>, Law> other(
+        ShellModel::rectangular_plate(0.06, 0.06, 7, 7, 0.01), other_parameters, options);
+    CHECK_THROWS_WITH(other.load_checkpoint(checkpoint), Catch::Contains(changed));
   };
   JohnsonCook::Parameters jc = steel_4340();
   jc.A = 235e6;  // yields under the smoke test's pressure
   jc.taylor_quinney = 0.9;
   jc.density = 7850.0;
   jc.specific_heat = 477.0;
-  run(jc, JohnsonCook(jc));
-  run(CowperSymonds::Parameters{210e9, 0.3, 235e6, 1e9, 40.4, 5.0}, CowperSymonds({210e9, 0.3, 235e6, 1e9, 40.4, 5.0}));
+  JohnsonCook::Parameters jc_other_rate = jc;
+  jc_other_rate.C *= 1.5;
+  run(jc, JohnsonCook(jc), jc_other_rate, "material: C is");
+  JohnsonCook::Parameters jc_other_failure = jc;
+  jc_other_failure.D5 += 0.1;
+  run(jc, JohnsonCook(jc), jc_other_failure, "material: D5 is");
+  const CowperSymonds::Parameters cs{210e9, 0.3, 235e6, 1e9, 40.4, 5.0};
+  run(cs, CowperSymonds(cs), CowperSymonds::Parameters{210e9, 0.3, 235e6, 1e9, 40.4, 4.0}, "material: Cowper-Symonds q is");
 }
 
 TEST_CASE("Johnson-Cook failure feeds the crack handler", "[material][rate][damage][solver]") {

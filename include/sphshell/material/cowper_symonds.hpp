@@ -134,6 +134,11 @@ struct CowperSymonds {
   }
 
   const Parameters& parameters() const { return parameters_; }
+  // The rate constants (a checkpoint compares them, material.hpp).
+  template <class F>
+  void for_each_constant(F&& constant) const {
+    constant("Cowper-Symonds D", parameters_.D), constant("Cowper-Symonds q", parameters_.q);
+  }
   double youngs_modulus() const { return parameters_.E; }
   double poisson_ratio() const { return parameters_.nu; }
   double shear_modulus() const { return elasticity_.shear_modulus(); }

@@ -205,6 +205,17 @@ struct JohnsonCook {
   }
 
   const Parameters& parameters() const { return parameters_; }
+  // Every constant that changes results (a checkpoint compares them, material.hpp).
+  template <class F>
+  void for_each_constant(F&& constant) const {
+    const Parameters& p = parameters_;
+    constant("A", p.A), constant("B", p.B), constant("n", p.n), constant("C", p.C);
+    constant("reference strain rate", p.reference_strain_rate), constant("m", p.m);
+    constant("reference temperature", p.reference_temperature), constant("melting temperature", p.melting_temperature);
+    constant("initial temperature", p.initial_temperature), constant("Taylor-Quinney coefficient", p.taylor_quinney);
+    constant("density (heating)", p.density), constant("specific heat", p.specific_heat);
+    constant("D1", p.D1), constant("D2", p.D2), constant("D3", p.D3), constant("D4", p.D4), constant("D5", p.D5);
+  }
   double youngs_modulus() const { return parameters_.E; }
   double poisson_ratio() const { return parameters_.nu; }
   double shear_modulus() const { return elasticity_.shear_modulus(); }

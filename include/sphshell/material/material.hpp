@@ -46,6 +46,11 @@
 // enums, Eigen fixed-size matrices or structs that list theirs the same way).
 // save_checkpoint names the State that lacks it at compile time; solvers that
 // never checkpoint do not need it.
+// A law with constants beyond E, ν, hardening() and damage_parameters() that
+// change results (rate and temperature constants, failure constants) lists
+// them all, so that a checkpoint loaded with other values is refused by name:
+//   template <class F> void for_each_constant(F&& constant) const
+//   { constant("C (strain-rate coefficient)", parameters_.C); ... }
 
 #include <sphshell/core/types.hpp>
 

@@ -190,6 +190,16 @@ inline std::vector<NamedCount> model_fingerprints(const ShellModel& model) {
 }
 
 // The law's constants through the material contract's members.
+// Whether a law lists further constants (material/material.hpp).
+struct ConstantVisitor {
+  void operator()(const char*, double) const {}
+};
+template <class Law, class = void>
+struct has_for_each_constant : std::false_type {};
+template <class Law>
+struct has_for_each_constant<Law, std::void_t<decltype(std::declval<const Law&>().for_each_constant(
+                                      ConstantVisitor{}))>> : std::true_type {};
+
 template <class Material>
 std::vector<NamedValue> material_constants(const Material& law) {
   std::vector<NamedValue> values{{"Young's modulus", law.youngs_modulus()}, {"Poisson's ratio", law.poisson_ratio()}};
@@ -204,6 +214,8 @@ std::vector<NamedValue> material_constants(const Material& law) {
     values.push_back({"critical plastic strain", damage.critical_strain});
     values.push_back({"critical damage", damage.critical_damage});
   }
+  if constexpr (has_for_each_constant<Material>::value)
+    law.for_each_constant([&](const char* name, double value) { values.push_back({name, value}); });
   return values;
 }
 
