@@ -178,6 +178,46 @@ TEST_CASE("contact: a triangulated cube's signed distance is the box's", "[conta
   }
 }
 
+TEST_CASE("contact: a tetrahedron's sharp edges and corners get the sign right", "[contact]") {
+  // A regular tetrahedron: face normals 109.5° apart, so a point beyond an
+  // edge can lie behind one of the edge's faces; only the edge's own
+  // pseudonormal gives its side.
+  TriangleSurfaceParameters tetrahedron;
+  tetrahedron.vertices = {{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}};
+  tetrahedron.triangles = {{0, 1, 2}, {0, 3, 1}, {0, 2, 3}, {1, 3, 2}};
+  // The outward face planes (unit normal, offset), written independently.
+  std::vector<std::pair<Vector3, double>> planes;
+  for (const auto& tri : tetrahedron.triangles) {
+    const Vector3& a = tetrahedron.vertices[tri[0]];
+    Vector3 normal = (tetrahedron.vertices[tri[1]] - a).cross(tetrahedron.vertices[tri[2]] - a).normalized();
+    if (normal.dot(a) < 0.0) normal = -normal;
+    planes.emplace_back(normal, normal.dot(a));
+  }
+  const TriangleSurface body(tetrahedron);
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> coordinate(-2.0, 2.0);
+  int outside_behind_a_face = 0;
+  for (int k = 0; k < 4000; ++k) {
+    const Vector3 p(coordinate(random), coordinate(random), coordinate(random));
+    double largest = -1e300;
+    int negative_planes = 0;
+    for (const auto& [normal, offset] : planes) {
+      largest = std::max(largest, normal.dot(p) - offset);
+      negative_planes += normal.dot(p) - offset < 0.0;
+    }
+    const double gap = body.proximity(p).gap;
+    INFO("point " << p.transpose());
+    if (largest < 0.0) {
+      REQUIRE(gap == Approx(largest).margin(1e-12));  // inside a convex body: the nearest face plane
+    } else {
+      REQUIRE(gap > 0.0);
+      REQUIRE(gap >= largest - 1e-12);
+      outside_behind_a_face += negative_planes > 0 && gap > largest + 1e-9;
+    }
+  }
+  CHECK(outside_behind_a_face > 100);  // points off edges and corners were tried
+}
+
 TEST_CASE("contact: a triangulated sphere's signed distance within its chord error", "[contact]") {
   const double radius = 0.5;
   const TriangleSurfaceParameters mesh = icosphere(radius, 3);
