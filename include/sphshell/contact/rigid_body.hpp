@@ -128,9 +128,6 @@ class Free {
   FreeMotionParameters parameters_;
 };
 
-template <class Motion>
-inline constexpr bool is_free_motion_v = Motion::free;
-
 template <class Shape, class Motion>
 class RigidBody {
   static_assert(check_rigid_shape<Shape>(), "RigidBody needs a rigid shape (contact/contact.hpp)");
