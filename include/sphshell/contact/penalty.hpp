@@ -111,28 +111,53 @@ class PenaltyContact {
 
   const PenaltyOptions& options() const { return options_; }
 
-  // The contact of every particle with the body at configuration n; fills
-  // loads (resized to the particle count; zero where there is no contact).
+  // The contact of every particle with the body at configuration n: prepare,
+  // then compute_range over all particles.
   template <class Shape, class Motion>
   ContactStepResult compute(const ContactParticles& particles, const RigidBody<Shape, Motion>& body,
                             double time_step, ParticleContactLoads& loads) {
+    prepare(particles, time_step, loads);
+    return compute_range(particles, body, time_step, loads, 0, particles.position.size());
+  }
+
+  // Checks the particles (array sizes, masses and thicknesses finite and > 0)
+  // and the time step, and sizes the contact history and loads (to the
+  // particle count). Throws an Error naming the first bad value; once per step.
+  void prepare(const ContactParticles& particles, double time_step, ParticleContactLoads& loads) {
     sphshell::detail::require_positive("time step", time_step);
     const std::size_t count = particles.position.size();
     check_sizes(particles, count);
+    for (std::size_t i = 0; i < count; ++i) {
+      if (!(particles.mass[i] > 0.0) || !std::isfinite(particles.mass[i]))
+        sphshell::detail::invalid_parameter("mass of particle " + std::to_string(i), particles.mass[i],
+                                            "must be finite and > 0");
+      if (!(particles.thickness[i] > 0.0) || !std::isfinite(particles.thickness[i]))
+        sphshell::detail::invalid_parameter("thickness of particle " + std::to_string(i), particles.thickness[i],
+                                            "must be finite and > 0");
+    }
     if (tangential_force_.size() != count) {
       tangential_force_.assign(count, Vector3::Zero());
       previous_force_.assign(count, Vector3::Zero());
     }
-    loads.force.assign(count, Vector3::Zero());
-    loads.moment.assign(count, Vector3::Zero());
+    loads.force.resize(count);
+    loads.moment.resize(count);
+  }
+
+  // Particles [first, last) after prepare(): writes their loads (zero where
+  // there is no contact) and their contact history, nothing else, and does
+  // not throw, so that chunks of particles may run on several threads; their
+  // results summed in chunk order with accumulate() give the same bits
+  // whatever the thread count.
+  template <class Shape, class Motion>
+  ContactStepResult compute_range(const ContactParticles& particles, const RigidBody<Shape, Motion>& body,
+                                  double time_step, ParticleContactLoads& loads, std::size_t first,
+                                  std::size_t last) {
     ContactStepResult result;
     const double body_mass = body.inertial_mass();
-    for (std::size_t i = 0; i < count; ++i) {
-      const double thickness = particles.thickness[i];
-      if (!(thickness > 0.0) || !std::isfinite(thickness))
-        sphshell::detail::invalid_parameter("thickness of particle " + std::to_string(i), thickness,
-                                            "must be finite and > 0");
-      const double half_thickness = 0.5 * thickness;
+    for (std::size_t i = first; i < last; ++i) {
+      loads.force[i].setZero();
+      loads.moment[i].setZero();
+      const double half_thickness = 0.5 * particles.thickness[i];
       const Vector3& x = particles.position[i];
       const SurfaceProximity at_mid = body.proximity(x);
       // The signed distance changes by at most |c − x| = h/2 (it is 1-Lipschitz):
@@ -152,8 +177,6 @@ class PenaltyContact {
       Vector3 force = Vector3::Zero();
       if (at_face.gap < 0.0) {
         const double mass = particles.mass[i];
-        if (!(mass > 0.0) || !std::isfinite(mass))
-          sphshell::detail::invalid_parameter("mass of particle " + std::to_string(i), mass, "must be finite and > 0");
         const double spring_mass = std::isfinite(body_mass) ? mass * body_mass / (mass + body_mass) : mass;
         const double stiffness = penalty_stiffness(spring_mass, time_step, options_.stiffness_scale);
         const double tangential_stiffness = options_.tangential_stiffness_ratio * stiffness;
@@ -189,6 +212,15 @@ class PenaltyContact {
       previous_force_[i] = force;
     }
     return result;
+  }
+
+  static void accumulate(ContactStepResult& total, const ContactStepResult& part) {
+    total.body_force += part.body_force;
+    total.body_moment += part.body_moment;
+    total.work += part.work;
+    total.friction_dissipation += part.friction_dissipation;
+    total.spring_energy += part.spring_energy;
+    total.contacts += part.contacts;
   }
 
   // The tangential (friction) force each particle holds.
