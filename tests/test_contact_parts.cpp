@@ -488,7 +488,7 @@ TEST_CASE("contact: rigid motions: prescribed, free under gravity, free spin", "
   CHECK(angle == Approx(0.5 * torque / inertia * t * t).epsilon(1e-9));
 }
 
-TEST_CASE("contact: a prescribed spin turns the body; a free tumbling body keeps its angular momentum", "[contact]") {
+TEST_CASE("contact: a prescribed spin turns the body and a free tumbling body keeps its angular momentum", "[contact]") {
   const double dt = 1e-3, spin = 0.5;
   const long steps = 1000;
   auto still = [](double) { return Vector3::Zero(); };
