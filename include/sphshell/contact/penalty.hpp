@@ -15,8 +15,12 @@
 //
 // Penalty stiffness (the stiffness-from-mass rule of LS-DYNA's soft constraint
 // contact, SOFT = 1: k1 ∝ nodal mass / Δt², scaled by SOFSCL, default 0.1,
-// LS-DYNA Keyword User's Manual, *CONTACT optional card A; OpenRadioss
-// /INTER/TYPE7 likewise lets the interface stiffness enter the nodal time step):
+// LS-DYNA Keyword User's Manual, *CONTACT optional card A; its contact FAQ
+// likens each contact to a spring-mass system whose Courant step matches the
+// run's step. OpenRadioss /INTER/TYPE7 goes the other way: its reference
+// manual notes that the time step is reduced for high impact speeds or small
+// gaps, its interface stiffness bounding the step. Here the step is given and
+// the stiffness follows from it):
 //   k = s m / Δt².
 // Why it keeps the step stable: the particle on its contact spring is an
 // oscillator of angular frequency ω = √(k/m) = √s / Δt, so ω Δt = √s, and the
