@@ -14,6 +14,7 @@
 #include <sphshell/core/types.hpp>
 
 #include <sphshell/approx/all.hpp>
+#include <sphshell/contact/all.hpp>
 #include <sphshell/crack/all.hpp>
 #include <sphshell/kernel/all.hpp>
 #include <sphshell/material/all.hpp>

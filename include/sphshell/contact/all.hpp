@@ -1,0 +1,10 @@
+#pragma once
+// Every part of the contact family.
+
+#include <sphshell/contact/contact.hpp>
+#include <sphshell/contact/cylinder.hpp>
+#include <sphshell/contact/penalty.hpp>
+#include <sphshell/contact/plane.hpp>
+#include <sphshell/contact/rigid_body.hpp>
+#include <sphshell/contact/sphere.hpp>
+#include <sphshell/contact/triangle_surface.hpp>
