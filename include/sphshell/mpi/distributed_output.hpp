@@ -31,7 +31,9 @@
 #include <sphshell/mpi/error_agreement.hpp>
 #include <sphshell/solver/options.hpp>
 #include <sphshell/solver/output.hpp>
+#include <sphshell/solver/section_states.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -39,6 +41,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace sphshell::mpi {
@@ -244,6 +247,336 @@ struct DistributedProbe {
   std::string path;
   std::unique_ptr<io::CsvProbe> file;  // on the owner only
   std::size_t local_point = 0;         // a stress point's local point (owner only)
+};
+
+
+// The output part of a distributed Solver (solver.hpp, the domain's part in
+// place of solver::SolverOutput, with its interface): frames in pieces, and
+// probes written by the owner of what they probe. It reads the solver's
+// local state (a friend of it).
+template <int OutputPoints>
+class DistributedOutput {
+ public:
+  using StressProbe = solver::StressPointProbe<OutputPoints>;
+
+  // Collective: rank 0 takes the output directory.
+  DistributedOutput(const Communicator& comm, const OutputOptions& options, bool with_cracks)
+      : frames_(comm, options, with_cracks), options_(options) {}
+
+  // Probes are added after loading a checkpoint (the owner's file continues from it).
+  void check_can_load() const {
+    if (!probes_.empty())
+      throw Error("sphshell: load_checkpoint: " + std::to_string(probes_.size()) +
+                  " probe(s) were added before it; a distributed run adds its probes after loading a checkpoint");
+  }
+
+  // Every rank registers the probe; the owner opens the file.
+  template <class Probe, class Solver>
+  void add_probe(const std::string& csv_path, const Probe& probe, const Solver& solver) {
+    for (const DistributedProbe& open : probes_)
+      if (open.path == csv_path)
+        throw Error("sphshell: probe file '" + csv_path + "' is already the file of another probe; give each probe "
+                    "a file of its own");
+    DistributedProbe added;
+    added.path = csv_path;
+    if constexpr (std::is_same_v<Probe, StressProbe>) {
+      added.kind = DistributedProbe::Kind::stress_point;
+      added.index = probe.stress_point;
+      const long row = solver.domain_.owned_stress_row(static_cast<std::size_t>(probe.stress_point));
+      if (row >= 0) {
+        added.local_point = solver.points_->point(solver::PointGroup::stress_points, static_cast<std::size_t>(row));
+        open_probe(added, stress_probe<typename Solver::rule_type>(probe.stress_point).columns(), solver);
+      }
+    } else {
+      added.index = probe.particle;
+      if (solver.domain_.owns(probe.particle)) open_probe(added, probe.columns(), solver);
+    }
+    probes_.push_back(std::move(added));
+  }
+
+  // Before the first step: the reference configuration at t = 0.
+  template <class Solver>
+  void start(const Solver& solver) {
+    if (frames_.writes_on_schedule() && frames_.last_frame_step() < 0) {
+      write_frame(solver);
+      frames_.schedule_next(solver.time() + options_.output_interval);
+    }
+  }
+  // The serial schedule (solver::SolverOutput::write_scheduled).
+  template <class Solver>
+  void write_scheduled(const Solver& solver) {
+    const double time = solver.time(), time_step = solver.time_step();
+    if (frames_.writes_on_schedule() && time >= frames_.next_frame_time() - 0.5 * time_step) {
+      if (frames_.last_frame_step() != solver.steps()) write_frame(solver);
+      const double interval = options_.output_interval;
+      const double passed = std::floor((time + 0.5 * time_step - frames_.next_frame_time()) / interval);
+      frames_.schedule_next(frames_.next_frame_time() + interval * (std::max(0.0, passed) + 1.0));
+    }
+    if (!probes_.empty() && time >= next_probe_time_ - probe_schedule_tolerance * time_step) {
+      for (DistributedProbe& probe : probes_)
+        if (probe.file) write_probe_row(probe, solver);
+      next_probe_time_ = time + options_.probe_interval;
+    }
+  }
+  template <class Solver>
+  void finish(const Solver& solver) {
+    if (frames_.writes_on_schedule() && frames_.last_frame_step() != solver.steps()) write_frame(solver);
+  }
+
+  // One frame now (collective): each rank's particle and stress-point
+  // pieces, rank 0 the .pvtu files, the crack frame and the series.
+  template <class Solver>
+  void write_frame(const Solver& solver) {
+    const auto& domain = solver.domain_;
+    const auto& particles = solver.particles_;
+    FramePiece piece;
+    piece.time = solver.time();
+    const bool deformed = options_.frame_coordinates == FrameCoordinates::deformed;
+    for (std::size_t i = 0; i < domain.owned_count(); ++i) {
+      piece.points.push_back(deformed ? particles.position[i] : solver.reference_position_[i]);
+      piece.global_id.push_back(domain.global_of(i));
+      piece.displacement.push_back(particles.position[i] - solver.reference_position_[i]);
+      piece.velocity.push_back(particles.velocity[i]);
+      piece.director.push_back(particles.director[i]);
+      if constexpr (Solver::crack_type::enabled)
+        piece.fragment.push_back(solver.fracture_.is_fragment(static_cast<std::size_t>(domain.global_of(i))) ? 1 : 0);
+    }
+    const io::VtuGrid stress_points = stress_point_piece(solver);
+    if constexpr (Solver::crack_type::enabled) {
+      const io::VtuGrid cracks = crack_frame(solver);
+      frames_.write(domain.communicator(), piece, stress_points, &cracks, solver.steps());
+    } else {
+      frames_.write(domain.communicator(), piece, stress_points, nullptr, solver.steps());
+    }
+  }
+
+  // Checkpoints: the frame schedule and series, the probe schedule and the
+  // owned probes' files (for probes added after a restart to continue them).
+  template <class Writer>
+  void save(Writer& out) const {
+    frames_.save(out);
+    out(next_probe_time_);
+    std::uint64_t open_files = 0;
+    for (const DistributedProbe& probe : probes_) open_files += probe.file ? 1 : 0;
+    out(open_files);
+    for (const DistributedProbe& probe : probes_)
+      if (probe.file) {
+        const io::CsvProbe::Resume written = probe.file->written();
+        out(probe.path, static_cast<std::uint32_t>(probe.kind), static_cast<std::int64_t>(probe.index),
+            written.bytes, written.hash);
+      }
+  }
+  template <class Reader, class Solver>
+  void load(Reader& in, const Solver&) {
+    frames_.load(in);
+    in(next_probe_time_);
+    std::uint64_t open_files = 0;
+    in(open_files);
+    restored_probes_.clear();
+    for (std::uint64_t n = 0; n < open_files; ++n) {
+      RestoredProbe record;
+      std::uint32_t kind = 0;
+      std::int64_t index = 0;
+      in(record.path, kind, index, record.written.bytes, record.written.hash);
+      if (kind > 1) in.fail("a probe of unknown kind " + std::to_string(kind));
+      record.kind = static_cast<DistributedProbe::Kind>(kind);
+      record.index = static_cast<int>(index);
+      restored_probes_.push_back(std::move(record));
+    }
+  }
+
+ private:
+  // As the serial output's probe schedule (solver/output.hpp).
+  static constexpr double probe_schedule_tolerance = 1e-9;
+  struct RestoredProbe {
+    std::string path;
+    DistributedProbe::Kind kind = DistributedProbe::Kind::particle;
+    int index = 0;
+    io::CsvProbe::Resume written;
+  };
+
+  template <class Rule>
+  static StressProbe stress_probe(int stress_point) {
+    StressProbe probe(stress_point);
+    probe.point_names = solver::thickness_point_names<Rule>();
+    return probe;
+  }
+  // What solver::ParticleProbe and StressPointProbe read, for what the owner holds.
+  template <class Solver>
+  struct OwnedView {
+    const Solver& solver;
+    std::size_t local_point;
+    struct Field {
+      const std::vector<Vector3>& local;
+      const Solver& solver;
+      const Vector3& operator[](int global) const {
+        return local[static_cast<std::size_t>(solver.domain_.local_of(static_cast<std::size_t>(global)))];
+      }
+    };
+    double time() const { return solver.time(); }
+    Field velocities() const { return {solver.particles_.velocity, solver}; }
+    std::size_t local(int global) const {
+      return static_cast<std::size_t>(solver.domain_.local_of(static_cast<std::size_t>(global)));
+    }
+    Vector3 displacement(int global) const {
+      return solver.particles_.position[local(global)] - solver.reference_position_[local(global)];
+    }
+    Vector3 rotation(int global) const {
+      return solver::rotation_vector(solver.reference_normal_[local(global)], solver.particles_.director[local(global)]);
+    }
+    double integral_point_quantity(solver::IntegralPointQuantity quantity, int, int k) const {
+      return solver.states_->quantity(quantity, local_point, k);
+    }
+  };
+  template <class Solver>
+  void write_probe_row(DistributedProbe& probe, const Solver& solver) const {
+    const OwnedView<Solver> view{solver, probe.local_point};
+    if (probe.kind == DistributedProbe::Kind::particle)
+      probe.file->write_row(solver::ParticleProbe{probe.index}.row(view));
+    else
+      // A row needs no column names: no rule's names are built per row.
+      probe.file->write_row(StressProbe(probe.index).row(view));
+  }
+  // The owner's file of a new probe: the file a loaded checkpoint recorded
+  // for the same probe continues from the checkpoint's rows; else a new
+  // file starts with the row of now.
+  template <class Solver>
+  void open_probe(DistributedProbe& probe, std::vector<std::string> columns, const Solver& solver) {
+    for (auto record = restored_probes_.begin(); record != restored_probes_.end(); ++record)
+      if (record->path == probe.path && record->kind == probe.kind && record->index == probe.index) {
+        probe.file = std::make_unique<io::CsvProbe>(probe.path, std::move(columns), record->written);
+        restored_probes_.erase(record);
+        return;
+      }
+    probe.file = std::make_unique<io::CsvProbe>(probe.path, std::move(columns));
+    write_probe_row(probe, solver);
+  }
+  // This rank's stress-point piece: a vertex cell at each active stress point
+  // it owns, with the serial frame's stress-point cell arrays (integral-point
+  // quantities per thickness output point, resultants, thickness, index).
+  template <class Solver>
+  io::VtuGrid stress_point_piece(const Solver& solver) const {
+    const auto& domain = solver.domain_;
+    const ShellModel& model = solver.model();
+    const std::size_t g = solver::index_of(solver::PointGroup::stress_points);
+    const bool deformed = options_.frame_coordinates == FrameCoordinates::deformed;
+    io::VtuGrid grid;
+    grid.time = solver.time();
+    std::vector<Vector3> displacement;
+    std::vector<std::size_t> drawn;  // local points
+    std::vector<int> index;          // global stress points
+    for (std::size_t k : domain.owned_stress_rows()) {
+      const std::size_t p = solver.points_->point(solver::PointGroup::stress_points, k);
+      if (!solver.states_->active(p)) continue;
+      const auto q = domain.layout().computed[g][k];
+      const Vector3 current = solver.stress_point_position(k), reference = model.stress_point_position[q];
+      grid.cells.add_vertex(static_cast<int>(grid.points.size()));
+      grid.points.push_back(deformed ? current : reference);
+      displacement.push_back(current - reference);
+      drawn.push_back(p);
+      index.push_back(static_cast<int>(q));
+    }
+    io::PointField displacement_field{"displacement", 3, {}};
+    for (const Vector3& u : displacement) displacement_field.values.insert(displacement_field.values.end(), {u.x(), u.y(), u.z()});
+    grid.point_fields = {displacement_field};
+    const std::vector<std::string> names = solver::thickness_point_names<typename Solver::rule_type>();
+    for (const solver::IntegralPointQuantityInfo& info : solver::integral_point_quantities) {
+      if (info.needs_damage_law && !Solver::material_type::has_damage) continue;
+      io::CellField field{info.name, OutputPoints, {}, names};
+      for (std::size_t p : drawn)
+        for (int k = 0; k < OutputPoints; ++k) field.values.push_back(solver.states_->quantity(info.quantity, p, k));
+      grid.cell_fields.push_back(std::move(field));
+    }
+    io::CellField membrane{"membrane_force", 3, {}, {"Nxx", "Nyy", "Nxy"}};
+    io::CellField moment{"bending_moment", 3, {}, {"Mxx", "Myy", "Mxy"}};
+    io::CellField thickness{"thickness", 1, {}};
+    io::CellField stress_point{"stress_point", 1, {}, {}, io::FieldValues::integer};
+    for (std::size_t n = 0; n < drawn.size(); ++n) {
+      for (int c = 0; c < 3; ++c) {
+        membrane.values.push_back(solver.states_->membrane_force(drawn[n])[c]);
+        moment.values.push_back(solver.states_->bending_moment(drawn[n])[c]);
+      }
+      thickness.values.push_back(model.stress_point_thickness(static_cast<std::size_t>(index[n])));
+      stress_point.values.push_back(index[n]);
+    }
+    grid.cell_fields.push_back(std::move(membrane));
+    grid.cell_fields.push_back(std::move(moment));
+    grid.cell_fields.push_back(std::move(thickness));
+    grid.cell_fields.push_back(std::move(stress_point));
+    grid.note = std::string("sphshell frame piece (one rank's owned active stress points, a vertex cell each; "
+                            "stress-point data as cell data), t = ") +
+                io::detail::round_trip_decimal(solver.time()) + " s; points: " + (deformed ? "deformed" : "reference") +
+                " positions";
+    return grid;
+  }
+
+  // The crack segments as lines, as the serial frame draws them: a damaged
+  // stress point's crack point at the stress point's interpolated position, a
+  // pre-crack point moved by its nearest particle's displacement; the owners
+  // place the points and every rank gathers them (a crack has few points).
+  // Collective; the grid is used on rank 0.
+  template <class Solver>
+  io::VtuGrid crack_frame(const Solver& solver) const {
+    const auto& domain = solver.domain_;
+    const ShellModel& model = solver.model();
+    const auto& crack = solver.fracture_.crack();
+    const std::vector<Vector3>& reference = crack.points();
+    struct Placed {
+      std::int64_t point;
+      double position[3];
+    };
+    std::vector<Placed> mine;
+    std::vector<char> from_stress_point(reference.size(), 0);
+    for (std::size_t q = 0; q < model.stress_point_count(); ++q) {
+      const int k = crack.crack_point_of_stress_point(static_cast<int>(q));
+      if (k >= 0) from_stress_point[static_cast<std::size_t>(k)] = 1;
+    }
+    const std::size_t g = solver::index_of(solver::PointGroup::stress_points);
+    for (std::size_t k : domain.owned_stress_rows()) {
+      const int point = crack.crack_point_of_stress_point(static_cast<int>(domain.layout().computed[g][k]));
+      if (point < 0) continue;
+      const Vector3 x = solver.stress_point_position(k);
+      mine.push_back({point, {x.x(), x.y(), x.z()}});
+    }
+    for (std::size_t k = 0; k < reference.size(); ++k) {
+      if (from_stress_point[k]) continue;
+      const int nearest = model.nearest_particle(reference[k]);
+      if (!domain.owns(nearest)) continue;
+      const auto i = static_cast<std::size_t>(domain.layout().local_of[static_cast<std::size_t>(nearest)]);
+      const Vector3 x = reference[k] + (solver.particles_.position[i] - solver.reference_position_[i]);
+      mine.push_back({static_cast<std::int64_t>(k), {x.x(), x.y(), x.z()}});
+    }
+    std::vector<Vector3> current(reference.size(), Vector3::Zero());
+    for (const Placed& placed : domain.communicator().all_gather_v(mine))
+      current[static_cast<std::size_t>(placed.point)] =
+          Vector3(placed.position[0], placed.position[1], placed.position[2]);
+    const bool deformed = options_.frame_coordinates == FrameCoordinates::deformed;
+    io::VtuGrid grid;
+    grid.time = solver.time();
+    grid.points = deformed ? current : reference;
+    io::PointField displacement{"displacement", 3, {}};
+    for (std::size_t k = 0; k < reference.size(); ++k) {
+      const Vector3 u = current[k] - reference[k];
+      displacement.values.insert(displacement.values.end(), {u.x(), u.y(), u.z()});
+    }
+    io::CellField crack_id{"crack_id", 1, {}, {}, io::FieldValues::integer};
+    for (const auto& segment : crack.segments()) {
+      grid.cells.add_line(segment.start_point, segment.end_point);
+      crack_id.values.push_back(segment.crack_id);
+    }
+    grid.point_fields = {displacement};
+    grid.cell_fields = {crack_id};
+    grid.note = "sphshell frame, t = " + io::detail::round_trip_decimal(solver.time()) +
+                " s: the crack segments as lines (crack_id per segment).";
+    return grid;
+  }
+
+
+  DistributedFrames frames_;
+  OutputOptions options_;
+  std::vector<DistributedProbe> probes_;
+  std::vector<RestoredProbe> restored_probes_;  // recorded by a loaded checkpoint, not added again yet
+  double next_probe_time_ = 0.0;
 };
 
 }  // namespace sphshell::mpi

@@ -173,6 +173,9 @@ class SolverOutput {
     }
   }
 
+  // Probes added before a checkpoint is loaded continue their files from it.
+  void check_can_load() const {}
+
   // A probe on a file a loaded checkpoint recorded continues that file (no
   // header, no row now: the file has both).
   template <class Probe, class Solver>
