@@ -96,8 +96,6 @@ namespace solver {
 template <class Domain>
 struct DomainParts {
   using Ledger = EnergyLedger;
-  template <class Crack>
-  using Fracture = FractureManager<Crack>;
   template <int OutputPoints>
   using Output = SolverOutput<OutputPoints>;
 };
@@ -113,6 +111,8 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
       Share::reference_normal_, Share::points_, Share::all_points_, Share::states_, Share::point_owned_,
       Share::global_point_, Share::model_point_count_, Share::model_slot_count_;
   using typename Share::Phase;
+  using Conditions = solver::ConditionsAndLoads<Solver>;
+  using Conditions::constraints_, Conditions::loads_;
   using Share::keep_first, Share::non_finite_load, Share::stop_if_alone, Share::load_context_at, Share::key;
 
   // Each family's check names the member a policy lacks; the message here says
@@ -351,7 +351,7 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
   EnergyReport energy() const {
     if constexpr (distributed) {
       const typename Domain::Timer timer(domain_);
-      typename Parts::ExactSum elastic;
+      typename Domain::EnergySum elastic;
       for (std::size_t p = 0; p < states_->size(); ++p)
         if (point_owned_[p] && states_->active(p))
           elastic.add(states_->stored_energy(p, points_->membrane_bending_weight(p), points_->shear_weight(p)));
@@ -370,10 +370,11 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
  private:
   using Parts = solver::DomainParts<Domain>;
   using Ledger = typename Parts::Ledger;
-  using Fracture = typename Parts::template Fracture<Crack>;
+  using Fracture = solver::FractureManager<Crack, Domain>;
   using Output = typename Parts::template Output<output_points>;
   friend Output;
   friend class solver::CheckpointIO<Solver>;
+  friend class solver::FramePiece<Solver>;
   StepTime now() const { return {steps_, time_}; }
 
   void set_up(const typename Domain::Weights& weights) try {
@@ -403,8 +404,7 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
                                   "checkpoint_every_seconds to 0");
       // The share, and this process's part of everything.
       domain_.decompose(model_, all_points, weights);
-      if constexpr (distributed) fracture_.initialize(model_, all_points, domain_.layout());
-      else fracture_.initialize(model_, all_points);
+      fracture_.initialize(model_, all_points, domain_);
       this->share_points(model_, std::move(all_points), std::move(all_states), Crack::enabled);
       this->share_particles(model_, options_);
       if constexpr (distributed)
@@ -422,67 +422,16 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
     throw Error("sphshell: out of memory building the solver (std::bad_alloc): " + solver::memory_estimate_text());
   }
 
-  auto fracture_parts() {
-    if constexpr (distributed)
-      return typename Parts::template FractureParts<Approx, Rule, Material>{
-          domain_.communicator(), model_, domain_.layout(), particles_, *all_points_, *points_, *states_,
-          *assembler_, forces_, point_owned_};
-    else
-      return solver::FractureParts<Approx, Rule, Material>{model_,     particles_, *points_,
-                                                            *states_,   *assembler_, forces_};
+  solver::FractureParts<Approx, Rule, Material, Domain> fracture_parts() {
+    return {domain_,     model_, particles_, all_points_ ? *all_points_ : *points_, *points_, *states_,
+            *assembler_, forces_, point_owned_};
   }
+
 
   // The conditions and loads (solver/conditions_and_loads.hpp): every process
   // checks the whole set (the same Error everywhere), then applies it to the
   // members it owns.
   friend class solver::ConditionsAndLoads<Solver>;
-  template <class Apply>
-  void on_set(const ParticleSelection& set, Apply&& apply) {
-    domain_.collectively([&] {
-      const ParticleSet global = solver::checked_set(set.members(model_), model_.particle_count());
-      if constexpr (!distributed) {
-        apply(global, global);
-      } else {
-        ParticleSet local;
-        for (int i : global)
-          if (domain_.owns(i)) local.push_back(static_cast<int>(domain_.local_of(static_cast<std::size_t>(i))));
-        apply(global, local);
-      }
-    });
-  }
-  template <class Add>
-  void add_conditions(const ParticleSelection& set, Add&& add) {
-    on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
-      if constexpr (distributed) add(checker_, global, model_.particle_position, model_.particle_normal);
-      add(constraints_, local, reference_position_, reference_normal_);
-    });
-  }
-  template <class Make>
-  void add_load(const ParticleSelection& set, Make&& make) {
-    on_set(set, [&](const ParticleSet&, const ParticleSet& local) { loads_.add(make(local)); });
-  }
-  // The check by the owner of each particle; the failure first in the set's
-  // order wins, as in the serial loop.
-  template <class Displacement>
-  void check_displacement_start(const ParticleSelection& set, const Displacement& displacement) {
-    on_set(set, [&](const ParticleSet& global, const ParticleSet&) {
-      std::optional<domain::Failure> failure;
-      for (std::size_t k = 0; k < global.size() && !failure; ++k) {
-        const int i = global[k];
-        if (!domain_.owns(i)) continue;
-        const auto at = static_cast<std::size_t>(domain_.local_of(static_cast<std::size_t>(i)));
-        try {
-          solver::check_prescribed_displacement_start(i, displacement(model_.particle_position[i], time_),
-                                                      particles_.position[at] - reference_position_[at], time_,
-                                                      steps_, model_.minimum_spacing());
-        } catch (...) {
-          failure = domain_.failure_of_current_exception(static_cast<long>(k));
-        }
-      }
-      domain_.agree(failure);
-    });
-  }
-
   void apply_loads_now(const StepTime& at) {
     detail::LoadContext context = load_context_at(at.time);
     loads_.apply(at, context);
@@ -586,9 +535,6 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
   std::optional<Ledger> ledger_;
   Fracture fracture_;
   Stepper stepper_;
-  detail::Constraints constraints_;  // owned particles, local indices
-  detail::Constraints checker_;      // distributed: the whole sets, global ids, for the serial checks and messages
-  ExternalLoads loads_;
   std::optional<Output> output_;
   solver::ProgressReporter progress_{options_.monitoring()};
   double stable_time_step_ = 0.0;

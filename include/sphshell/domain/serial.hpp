@@ -8,7 +8,9 @@
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/domain/domain.hpp>
+#include <sphshell/solver/integration_points.hpp>
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <exception>
@@ -23,6 +25,7 @@ class Serial {
  public:
   static constexpr bool is_distributed = false;
   struct Weights {};  // a serial run has no partition to weigh
+  using EnergySum = double;  // sums in the serial loops' order
 
   int rank() const { return 0; }
   int size() const { return 1; }
@@ -57,7 +60,7 @@ class Serial {
   void decompose(const Model& model, const Points& all_points, const Weights&) {
     particles_ = model.particle_count();
     stress_points_ = model.stress_point_count();
-    (void)all_points;
+    for (solver::PointGroup group : solver::point_groups) rows_[solver::index_of(group)] = all_points.count(group);
   }
   std::size_t owned_count() const { return particles_; }
   std::size_t local_count() const { return particles_; }
@@ -72,6 +75,11 @@ class Serial {
     return rows;
   }
   std::size_t global_stress_point(std::size_t row) const { return row; }
+  // The rows of point group g computed here, and their global rows.
+  std::size_t local_row_count(std::size_t g) const { return rows_[g]; }
+  std::size_t global_row(std::size_t, std::size_t row) const { return row; }
+  // Global ids found by the processes, all of them: this process's.
+  std::vector<std::int64_t> gathered_ids(const std::vector<std::int64_t>& mine) const { return mine; }
   void exchange(const std::vector<std::vector<Vector3>*>&) {}
   // A field in global order: the field itself.
   template <class Field>
@@ -98,6 +106,7 @@ class Serial {
  private:
   std::size_t particles_ = 0;
   std::size_t stress_points_ = 0;
+  std::array<std::size_t, 2> rows_{};
 };
 
 static_assert(check_domain<Serial>());

@@ -2,13 +2,13 @@
 // Output of a distributed run (docs/distributed.md, "Output"): ParaView frames
 // in pieces and probes written by the rank that owns what they probe.
 //
-// Frames: each rank writes one .vtu piece with the particles it owns
-// (particles_NNNNNN_rR.vtu: deformed or reference positions as
-// OutputOptions::frame_coordinates says, one vertex cell per particle, and the
-// point arrays global_id, displacement, velocity, director, with fragment when
-// there are cracks) and one with the active stress points it owns
-// (stress_points_NNNNNN_rR.vtu: a vertex cell at each, the serial frame's
-// stress-point cell arrays); after every piece is on disk rank 0 writes a
+// Frames: each rank writes its pieces of every frame, drawn as the serial
+// frame is (solver::FramePiece, solver/output.hpp: the shell as its cells,
+// cracks as gaps): particles_NNNNNN_rR.vtu with its local particles (the
+// ones it owns, and the ghosts that are corners of its cells; point arrays
+// as the serial frame's, and global_id) and the cells of the active stress
+// points it owns, and stress_points_NNNNNN_rR.vtu with the same cells and the
+// stress-point cell arrays. After every piece is on disk rank 0 writes a
 // .pvtu for each naming the pieces, with cracks the crack segments
 // (cracks_NNNNNN.vtu, the whole crack set), and adds them to particles.pvd,
 // stress_points.pvd and cracks.pvd together, so ParaView opens each series
@@ -46,15 +46,6 @@
 
 namespace sphshell::mpi {
 
-// What one rank puts in its piece of a frame.
-struct FramePiece {
-  std::vector<Vector3> points;  // owned particles, as drawn
-  std::vector<int> global_id;
-  std::vector<Vector3> displacement, velocity, director;
-  std::vector<double> fragment;  // empty without cracks
-  double time = 0.0;
-};
-
 class DistributedFrames {
  public:
   DistributedFrames() = default;
@@ -81,12 +72,11 @@ class DistributedFrames {
   // Writes this rank's pieces (particles, stress points), then rank 0 the
   // .pvtu files, the crack frame (`cracks`: rank 0's, with cracks) and the
   // series entries, all series together. Collective.
-  void write(const Communicator& comm, const FramePiece& piece, const io::VtuGrid& stress_points,
+  void write(const Communicator& comm, const io::VtuGrid& particles, const io::VtuGrid& stress_points,
              const io::VtuGrid* cracks, long step) {
     if (!enabled())
       sphshell::detail::invalid_parameter("output_directory", std::string(), "a frame needs an output folder");
     const std::string number = frame_number(frames_written_);
-    const io::VtuGrid particles = grid_of(piece);
     collectively(comm, [&] {
       io::write_vtu(path(piece_name("particles_" + number, comm.rank())), particles, format());
       io::write_vtu(path(piece_name("stress_points_" + number, comm.rank())), stress_points, format());
@@ -95,11 +85,11 @@ class DistributedFrames {
       if (!comm.is_root()) return;
       write_pvtu(path("particles_" + number + ".pvtu"), "particles_" + number, comm.size(), particles);
       write_pvtu(path("stress_points_" + number + ".pvtu"), "stress_points_" + number, comm.size(), stress_points);
-      series_[0]->stage(piece.time, path("particles_" + number + ".pvtu"));
-      series_[1]->stage(piece.time, path("stress_points_" + number + ".pvtu"));
+      series_[0]->stage(particles.time, path("particles_" + number + ".pvtu"));
+      series_[1]->stage(particles.time, path("stress_points_" + number + ".pvtu"));
       if (with_cracks_) {
         io::write_vtu(path("cracks_" + number + ".vtu"), *cracks, format());
-        series_[2]->stage(piece.time, path("cracks_" + number + ".vtu"));
+        series_[2]->stage(particles.time, path("cracks_" + number + ".vtu"));
       }
       io::write_together(collections());
     });
@@ -177,28 +167,6 @@ class DistributedFrames {
   }
 
   io::VtuFormat format() const { return {options_.frame_encoding, options_.frame_precision}; }
-
-  static io::PointField vector_field(const std::string& name, const std::vector<Vector3>& values) {
-    io::PointField field{name, 3, {}};
-    for (const Vector3& v : values) field.values.insert(field.values.end(), {v.x(), v.y(), v.z()});
-    return field;
-  }
-
-  io::VtuGrid grid_of(const FramePiece& piece) const {
-    io::VtuGrid grid;
-    grid.points = piece.points;
-    grid.time = piece.time;
-    for (std::size_t i = 0; i < piece.points.size(); ++i) grid.cells.add_vertex(static_cast<int>(i));
-    io::PointField id{"global_id", 1, {}, {}, io::FieldValues::integer};
-    for (int global : piece.global_id) id.values.push_back(global);
-    grid.point_fields = {id, vector_field("displacement", piece.displacement),
-                         vector_field("velocity", piece.velocity), vector_field("director", piece.director)};
-    if (!piece.fragment.empty()) grid.point_fields.push_back({"fragment", 1, piece.fragment, {}, io::FieldValues::integer});
-    grid.note = std::string("sphshell frame piece (one rank's owned particles), t = ") +
-                io::detail::round_trip_decimal(piece.time) + " s; points: " +
-                (options_.frame_coordinates == FrameCoordinates::deformed ? "deformed" : "reference") + " positions";
-    return grid;
-  }
 
   // The parallel file of one frame: its pieces and the arrays they hold
   // (names, types and components as `layout`, a piece, has them).
@@ -327,26 +295,13 @@ class DistributedOutput {
   // pieces, rank 0 the .pvtu files, the crack frame and the series.
   template <class Solver>
   void write_frame(const Solver& solver) {
-    const auto& domain = solver.domain_;
-    const auto& particles = solver.particles_;
-    FramePiece piece;
-    piece.time = solver.time();
-    const bool deformed = options_.frame_coordinates == FrameCoordinates::deformed;
-    for (std::size_t i = 0; i < domain.owned_count(); ++i) {
-      piece.points.push_back(deformed ? particles.position[i] : solver.reference_position_[i]);
-      piece.global_id.push_back(domain.global_of(i));
-      piece.displacement.push_back(particles.position[i] - solver.reference_position_[i]);
-      piece.velocity.push_back(particles.velocity[i]);
-      piece.director.push_back(particles.director[i]);
-      if constexpr (Solver::crack_type::enabled)
-        piece.fragment.push_back(solver.fracture_.is_fragment(static_cast<std::size_t>(domain.global_of(i))) ? 1 : 0);
-    }
-    const io::VtuGrid stress_points = stress_point_piece(solver);
+    const solver::FramePiece<Solver> piece(solver, options_.frame_coordinates);
+    const io::VtuGrid particles = piece.particle_grid(), stress_points = piece.stress_point_grid();
     if constexpr (Solver::crack_type::enabled) {
-      const io::VtuGrid cracks = crack_frame(solver);
-      frames_.write(domain.communicator(), piece, stress_points, &cracks, solver.steps());
+      const io::VtuGrid cracks = piece.crack_grid();  // collective
+      frames_.write(solver.domain().communicator(), particles, stress_points, &cracks, solver.steps());
     } else {
-      frames_.write(domain.communicator(), piece, stress_points, nullptr, solver.steps());
+      frames_.write(solver.domain().communicator(), particles, stress_points, nullptr, solver.steps());
     }
   }
 
@@ -451,127 +406,6 @@ class DistributedOutput {
     probe.file = std::make_unique<io::CsvProbe>(probe.path, std::move(columns));
     write_probe_row(probe, solver);
   }
-  // This rank's stress-point piece: a vertex cell at each active stress point
-  // it owns, with the serial frame's stress-point cell arrays (integral-point
-  // quantities per thickness output point, resultants, thickness, index).
-  template <class Solver>
-  io::VtuGrid stress_point_piece(const Solver& solver) const {
-    const auto& domain = solver.domain_;
-    const ShellModel& model = solver.model();
-    const std::size_t g = solver::index_of(solver::PointGroup::stress_points);
-    const bool deformed = options_.frame_coordinates == FrameCoordinates::deformed;
-    io::VtuGrid grid;
-    grid.time = solver.time();
-    std::vector<Vector3> displacement;
-    std::vector<std::size_t> drawn;  // local points
-    std::vector<int> index;          // global stress points
-    for (std::size_t k : domain.owned_stress_rows()) {
-      const std::size_t p = solver.points_->point(solver::PointGroup::stress_points, k);
-      if (!solver.states_->active(p)) continue;
-      const auto q = domain.layout().computed[g][k];
-      const Vector3 current = solver.stress_point_position(k), reference = model.stress_point_position[q];
-      grid.cells.add_vertex(static_cast<int>(grid.points.size()));
-      grid.points.push_back(deformed ? current : reference);
-      displacement.push_back(current - reference);
-      drawn.push_back(p);
-      index.push_back(static_cast<int>(q));
-    }
-    io::PointField displacement_field{"displacement", 3, {}};
-    for (const Vector3& u : displacement) displacement_field.values.insert(displacement_field.values.end(), {u.x(), u.y(), u.z()});
-    grid.point_fields = {displacement_field};
-    const std::vector<std::string> names = solver::thickness_point_names<typename Solver::rule_type>();
-    for (const solver::IntegralPointQuantityInfo& info : solver::integral_point_quantities) {
-      if (info.needs_damage_law && !Solver::material_type::has_damage) continue;
-      io::CellField field{info.name, OutputPoints, {}, names};
-      for (std::size_t p : drawn)
-        for (int k = 0; k < OutputPoints; ++k) field.values.push_back(solver.states_->quantity(info.quantity, p, k));
-      grid.cell_fields.push_back(std::move(field));
-    }
-    io::CellField membrane{"membrane_force", 3, {}, {"Nxx", "Nyy", "Nxy"}};
-    io::CellField moment{"bending_moment", 3, {}, {"Mxx", "Myy", "Mxy"}};
-    io::CellField thickness{"thickness", 1, {}};
-    io::CellField stress_point{"stress_point", 1, {}, {}, io::FieldValues::integer};
-    for (std::size_t n = 0; n < drawn.size(); ++n) {
-      for (int c = 0; c < 3; ++c) {
-        membrane.values.push_back(solver.states_->membrane_force(drawn[n])[c]);
-        moment.values.push_back(solver.states_->bending_moment(drawn[n])[c]);
-      }
-      thickness.values.push_back(model.stress_point_thickness(static_cast<std::size_t>(index[n])));
-      stress_point.values.push_back(index[n]);
-    }
-    grid.cell_fields.push_back(std::move(membrane));
-    grid.cell_fields.push_back(std::move(moment));
-    grid.cell_fields.push_back(std::move(thickness));
-    grid.cell_fields.push_back(std::move(stress_point));
-    grid.note = std::string("sphshell frame piece (one rank's owned active stress points, a vertex cell each; "
-                            "stress-point data as cell data), t = ") +
-                io::detail::round_trip_decimal(solver.time()) + " s; points: " + (deformed ? "deformed" : "reference") +
-                " positions";
-    return grid;
-  }
-
-  // The crack segments as lines, as the serial frame draws them: a damaged
-  // stress point's crack point at the stress point's interpolated position, a
-  // pre-crack point moved by its nearest particle's displacement; the owners
-  // place the points and every rank gathers them (a crack has few points).
-  // Collective; the grid is used on rank 0.
-  template <class Solver>
-  io::VtuGrid crack_frame(const Solver& solver) const {
-    const auto& domain = solver.domain_;
-    const ShellModel& model = solver.model();
-    const auto& crack = solver.fracture_.crack();
-    const std::vector<Vector3>& reference = crack.points();
-    struct Placed {
-      std::int64_t point;
-      double position[3];
-    };
-    std::vector<Placed> mine;
-    std::vector<char> from_stress_point(reference.size(), 0);
-    for (std::size_t q = 0; q < model.stress_point_count(); ++q) {
-      const int k = crack.crack_point_of_stress_point(static_cast<int>(q));
-      if (k >= 0) from_stress_point[static_cast<std::size_t>(k)] = 1;
-    }
-    const std::size_t g = solver::index_of(solver::PointGroup::stress_points);
-    for (std::size_t k : domain.owned_stress_rows()) {
-      const int point = crack.crack_point_of_stress_point(static_cast<int>(domain.layout().computed[g][k]));
-      if (point < 0) continue;
-      const Vector3 x = solver.stress_point_position(k);
-      mine.push_back({point, {x.x(), x.y(), x.z()}});
-    }
-    for (std::size_t k = 0; k < reference.size(); ++k) {
-      if (from_stress_point[k]) continue;
-      const int nearest = model.nearest_particle(reference[k]);
-      if (!domain.owns(nearest)) continue;
-      const auto i = static_cast<std::size_t>(domain.layout().local_of[static_cast<std::size_t>(nearest)]);
-      const Vector3 x = reference[k] + (solver.particles_.position[i] - solver.reference_position_[i]);
-      mine.push_back({static_cast<std::int64_t>(k), {x.x(), x.y(), x.z()}});
-    }
-    std::vector<Vector3> current(reference.size(), Vector3::Zero());
-    for (const Placed& placed : domain.communicator().all_gather_v(mine))
-      current[static_cast<std::size_t>(placed.point)] =
-          Vector3(placed.position[0], placed.position[1], placed.position[2]);
-    const bool deformed = options_.frame_coordinates == FrameCoordinates::deformed;
-    io::VtuGrid grid;
-    grid.time = solver.time();
-    grid.points = deformed ? current : reference;
-    io::PointField displacement{"displacement", 3, {}};
-    for (std::size_t k = 0; k < reference.size(); ++k) {
-      const Vector3 u = current[k] - reference[k];
-      displacement.values.insert(displacement.values.end(), {u.x(), u.y(), u.z()});
-    }
-    io::CellField crack_id{"crack_id", 1, {}, {}, io::FieldValues::integer};
-    for (const auto& segment : crack.segments()) {
-      grid.cells.add_line(segment.start_point, segment.end_point);
-      crack_id.values.push_back(segment.crack_id);
-    }
-    grid.point_fields = {displacement};
-    grid.cell_fields = {crack_id};
-    grid.note = "sphshell frame, t = " + io::detail::round_trip_decimal(solver.time()) +
-                " s: the crack segments as lines (crack_id per segment).";
-    return grid;
-  }
-
-
   DistributedFrames frames_;
   OutputOptions options_;
   std::vector<DistributedProbe> probes_;

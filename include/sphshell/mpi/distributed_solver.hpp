@@ -1,17 +1,15 @@
 #pragma once
 // The Solver over the ranks of a communicator: Solver<..., mpi::Domain>
 // (solver.hpp has the step; docs/distributed.md the method). This header
-// gives the domain's parts: exact energy books (mpi/distributed_ledger.hpp),
-// cracks grown across rank boundaries with the whole crack set on every rank
-// (mpi/distributed_fracture.hpp), frames written in pieces and probes by the
-// owning rank (mpi/distributed_output.hpp).
+// gives the domain's parts: exact energy books (mpi/distributed_ledger.hpp)
+// and the output, frames written in pieces and probes by the owning rank
+// (mpi/distributed_output.hpp).
 //
 // mpi::DistributedSolver<Approx, Rule, Material, Crack, Stepper> is the old
 // name of Solver<Approx, Rule, Material, Crack, Stepper, mpi::Domain>, kept
 // for existing code (deprecated: use the Solver with mpi::Domain).
 
 #include <sphshell/mpi/communicator.hpp>
-#include <sphshell/mpi/distributed_fracture.hpp>
 #include <sphshell/mpi/distributed_ledger.hpp>
 #include <sphshell/mpi/distributed_output.hpp>
 #include <sphshell/mpi/domain.hpp>
@@ -23,13 +21,8 @@ namespace solver {
 template <>
 struct DomainParts<mpi::Domain> {
   using Ledger = mpi::DistributedLedger;
-  template <class Crack>
-  using Fracture = mpi::DistributedFracture<Crack>;
   template <int OutputPoints>
   using Output = mpi::DistributedOutput<OutputPoints>;
-  template <class Approx, class Rule, class Law>
-  using FractureParts = mpi::DistributedFractureParts<Approx, Rule, Law>;
-  using ExactSum = mpi::ExactSum;
 };
 }  // namespace solver
 

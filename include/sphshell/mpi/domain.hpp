@@ -10,6 +10,7 @@
 #include <sphshell/domain/domain.hpp>
 #include <sphshell/mpi/communicator.hpp>
 #include <sphshell/mpi/error_agreement.hpp>
+#include <sphshell/mpi/exact_sum.hpp>
 #include <sphshell/mpi/halo.hpp>
 #include <sphshell/mpi/layout.hpp>
 #include <sphshell/mpi/partition.hpp>
@@ -64,6 +65,7 @@ class Domain {
   // bisection partition of the whole model in the reference configuration,
   // this rank's layout, then the halo plan.
   using Weights = PartitionWeights;
+  using EnergySum = ExactSum;  // exact: the same for any rank count
   template <class Model>
   void check_share(const Model& model) const {
     detail::check_parts(size(), model.particle_count());  // before rows that a tiny model cannot build
@@ -105,6 +107,13 @@ class Domain {
     for (std::size_t k = 0; k < layout_.computed[g].size(); ++k)
       if (layout_.computed_is_owned[g][k]) rows.push_back(k);
     return rows;
+  }
+  // The rows of point group g computed here, and their global rows.
+  std::size_t local_row_count(std::size_t g) const { return layout_.computed[g].size(); }
+  std::size_t global_row(std::size_t g, std::size_t row) const { return layout_.computed[g][row]; }
+  // Global ids found by the ranks, all of them (collective).
+  std::vector<std::int64_t> gathered_ids(const std::vector<std::int64_t>& mine) const {
+    return comm_->all_gather_v(mine);
   }
   std::size_t global_stress_point(std::size_t row) const {
     return layout_.computed[solver::index_of(solver::PointGroup::stress_points)][row];

@@ -9,7 +9,7 @@
 // stable step is taken from them, so it is the serial value everywhere), then
 // keeps the share's: one process moves them in whole; a distributed run
 // keeps its subset, and with cracks the whole model's rows too (a crack
-// rebuilds a row from the whole model's, mpi/distributed_fracture.hpp).
+// rebuilds a row from the whole model's, solver/fracture.hpp).
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/parallel.hpp>
