@@ -90,12 +90,10 @@
 
 namespace sphshell {
 namespace solver {
-// The parts whose work depends on the domain: the energy books, the fracture
-// manager and the output. One process: the serial parts; mpi/distributed_solver.hpp
-// gives mpi::Domain's.
+// The output part, which depends on the domain: one process's files, or
+// pieces per process (mpi/distributed_solver.hpp gives mpi::Domain's).
 template <class Domain>
 struct DomainParts {
-  using Ledger = EnergyLedger;
   template <int OutputPoints>
   using Output = SolverOutput<OutputPoints>;
 };
@@ -355,7 +353,7 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
       for (std::size_t p = 0; p < states_->size(); ++p)
         if (point_owned_[p] && states_->active(p))
           elastic.add(states_->stored_energy(p, points_->membrane_bending_weight(p), points_->shear_weight(p)));
-      return ledger_->report(domain_.communicator(), elastic, fracture_.released_energy());
+      return ledger_->report(domain_, elastic, fracture_.released_energy());
     } else {
       // A point out of action holds 0, which adds nothing.
       const double stored = assembler_->sum_over_points(*points_, [&](std::size_t p) {
@@ -363,13 +361,13 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
                    ? states_->stored_energy(p, points_->membrane_bending_weight(p), points_->shear_weight(p))
                    : 0.0;
       });
-      return ledger_->report(stored, fracture_.released_energy());
+      return ledger_->report(domain_, stored, fracture_.released_energy());
     }
   }
 
  private:
   using Parts = solver::DomainParts<Domain>;
-  using Ledger = typename Parts::Ledger;
+  using Ledger = solver::EnergyBooks<Domain>;
   using Fracture = solver::FractureManager<Crack, Domain>;
   using Output = typename Parts::template Output<output_points>;
   friend Output;
@@ -473,10 +471,7 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
       failure = domain_.failure_of_current_exception(point);
     }
     domain_.agree(failure);
-    if constexpr (distributed)
-      ledger_->book_internal_work(assembler_->work_increments(), point_owned_);
-    else
-      ledger_->book_internal_work(assembler_->internal_work());
+    ledger_->book_internal_work(*assembler_, point_owned_);
     forces_current_ = true;
   }
 
@@ -513,13 +508,7 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
     domain_.agree(failure);
     compute_internal_forces(distributed ? Packing::needed : Packing::done_by_particle_pass);
     if constexpr (Crack::enabled) fracture_.update(fracture_parts());
-    if (solver::EnergyLedger::is_check_step(steps_)) {
-      if constexpr (distributed)
-        ledger_->check_balance(domain_.communicator(), now(), energy(),
-                               [&](std::size_t i) { return domain_.global_of(i); });
-      else
-        ledger_->check_balance(now(), energy());
-    }
+    if (solver::EnergyLedger::is_check_step(steps_)) ledger_->check_balance(domain_, now(), energy());
     // The progress line, from the reduced books, written by process 0.
     if (progress_.is_due(steps_)) {
       const EnergyReport report = energy();

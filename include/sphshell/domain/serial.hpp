@@ -97,6 +97,8 @@ class Serial {
     for (const auto& [index, x] : entries) all[index] = x;
     return all;
   }
+  // The largest (global id, value): this process's.
+  std::pair<long long, double> largest(std::pair<long long, double> mine) const { return mine; }
   // What a checkpoint records of the share: nothing beyond the model's counts.
   template <class Counts>
   void add_identity(Counts&) const {}

@@ -1,16 +1,14 @@
 #pragma once
 // The Solver over the ranks of a communicator: Solver<..., mpi::Domain>
 // (solver.hpp has the step; docs/distributed.md the method). This header
-// gives the domain's parts: exact energy books (mpi/distributed_ledger.hpp)
-// and the output, frames written in pieces and probes by the owning rank
-// (mpi/distributed_output.hpp).
+// gives the domain's output part: frames written in pieces and probes by the
+// owning rank (mpi/distributed_output.hpp).
 //
 // mpi::DistributedSolver<Approx, Rule, Material, Crack, Stepper> is the old
 // name of Solver<Approx, Rule, Material, Crack, Stepper, mpi::Domain>, kept
 // for existing code (deprecated: use the Solver with mpi::Domain).
 
 #include <sphshell/mpi/communicator.hpp>
-#include <sphshell/mpi/distributed_ledger.hpp>
 #include <sphshell/mpi/distributed_output.hpp>
 #include <sphshell/mpi/domain.hpp>
 #include <sphshell/mpi/exact_sum.hpp>
@@ -20,7 +18,6 @@ namespace sphshell {
 namespace solver {
 template <>
 struct DomainParts<mpi::Domain> {
-  using Ledger = mpi::DistributedLedger;
   template <int OutputPoints>
   using Output = mpi::DistributedOutput<OutputPoints>;
 };

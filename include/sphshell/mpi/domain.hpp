@@ -16,6 +16,8 @@
 #include <sphshell/mpi/partition.hpp>
 #include <sphshell/solver/integration_points.hpp>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -160,6 +162,40 @@ class Domain {
   void add_identity(Counts& counts) const {
     counts.push_back({"rank count", static_cast<std::uint64_t>(size())});
     counts.push_back({"rank", static_cast<std::uint64_t>(rank())});
+  }
+  // The correctly rounded totals of several exact accumulators over all
+  // ranks, in one all-reduce of their limbs side by side (collective).
+  template <std::size_t N>
+  std::array<double, N> totals(const std::array<const ExactSum*, N>& local) const {
+    std::vector<std::int64_t> raw;
+    raw.reserve(N * ExactSum::raw_size);
+    for (const ExactSum* accumulator : local) {
+      ExactSum normalised = *accumulator;
+      normalised.normalize();
+      raw.insert(raw.end(), normalised.raw().begin(), normalised.raw().end());
+    }
+    comm_->sum_in_place(raw);
+    std::array<double, N> result{};
+    for (std::size_t k = 0; k < N; ++k) {
+      ExactSum::Raw part{};
+      std::copy_n(raw.begin() + static_cast<std::ptrdiff_t>(k * ExactSum::raw_size), ExactSum::raw_size, part.begin());
+      result[k] = ExactSum::from_raw(part).value();
+    }
+    return result;
+  }
+  // The largest (global id, value) of the ranks' (id < 0: none), ties to the
+  // lowest id, as a serial max_element finds it (collective).
+  std::pair<long long, double> largest(std::pair<long long, double> mine) const {
+    struct Candidate {
+      long long id;
+      double value;
+    };
+    Candidate best{-1, -1.0};
+    for (const Candidate& candidate : comm_->all_gather(Candidate{mine.first, mine.second}))
+      if (candidate.id >= 0 &&
+          (candidate.value > best.value || (candidate.value == best.value && candidate.id < best.id)))
+        best = candidate;
+    return {best.id, best.value};
   }
   // After loading: every rank's file came from the same save.
   void check_same_save(const std::string& path, std::uint64_t stamp, long steps) const {
