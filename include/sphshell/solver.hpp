@@ -1,6 +1,9 @@
 #pragma once
-// Solver<Approx, Rule, Material, Crack, Stepper>: explicit dynamics of an SPH
-// shell (docs/method.md; the paper's Table 2 program flow).
+// Solver<Approx, Rule, Material, Crack, Stepper, Domain>: explicit dynamics
+// of an SPH shell (docs/method.md; the paper's Table 2 program flow), on one
+// process (domain::Serial, the default) or on the ranks of a communicator
+// (mpi::Domain, docs/distributed.md): the serial run is the one-process case
+// of the same code.
 //
 // Each step: loads → velocities (the stepper) → kinematic conditions → energy
 // books → positions and directors (the stepper) → strains at the integration
@@ -16,6 +19,19 @@
 // shared between the two sets, and the particles add a small, softened
 // transverse-shear term. This removes the spurious zero-energy modes of
 // stress-point-only quadrature without shear locking.
+//
+// The domain part (domain/domain.hpp) says which share of the shell this
+// process steps. Set-up, from the same (replicated) model on every process:
+// the whole model's integration points and section states, the stable step
+// from them (so it is the serial value everywhere), the share (all of it
+// serially; a recursive-coordinate-bisection partition over MPI), then only
+// the share's particles (owned first, then ghosts), rows and states are kept.
+// A distributed run computes its ghost rows redundantly (mpi/layout.hpp) so
+// that every force on an owned particle is summed in the serial order: the
+// owned particles' motion is bitwise the serial one for any process count.
+// The step has two agreement points (the particle pass; the internal forces):
+// a failure on any process stops every process with the message the serial
+// step would stop with.
 
 #include <sphshell/approx/approx.hpp>
 #include <sphshell/approx/memory_estimate.hpp>
@@ -24,6 +40,7 @@
 #include <sphshell/core/types.hpp>
 #include <sphshell/crack/crack.hpp>
 #include <sphshell/crack/none.hpp>
+#include <sphshell/domain/serial.hpp>
 #include <sphshell/material/material.hpp>
 #include <sphshell/shell/constraints.hpp>
 #include <sphshell/shell/loads.hpp>
@@ -31,6 +48,7 @@
 #include <sphshell/shell/particle_selection.hpp>
 #include <sphshell/io/binary_stream.hpp>
 #include <sphshell/solver/checkpoint.hpp>
+#include <sphshell/solver/checkpoint_io.hpp>
 #include <sphshell/solver/conditions_and_loads.hpp>
 #include <sphshell/solver/energy_ledger.hpp>
 #include <sphshell/solver/fracture.hpp>
@@ -39,7 +57,9 @@
 #include <sphshell/solver/options.hpp>
 #include <sphshell/solver/output.hpp>
 #include <sphshell/solver/particle_pass.hpp>
+#include <sphshell/solver/particle_share.hpp>
 #include <sphshell/solver/particles.hpp>
+#include <sphshell/solver/point_share.hpp>
 #include <sphshell/solver/progress.hpp>
 #include <sphshell/solver/run_checks.hpp>
 #include <sphshell/solver/section_states.hpp>
@@ -61,6 +81,7 @@
 #include <memory>
 #include <mutex>
 #include <new>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <type_traits>
@@ -68,10 +89,30 @@
 #include <vector>
 
 namespace sphshell {
+namespace solver {
+// The output part, which depends on the domain: one process's files, or
+// pieces per process (mpi/distributed_solver.hpp gives mpi::Domain's).
+template <class Domain>
+struct DomainParts {
+  template <int OutputPoints>
+  using Output = SolverOutput<OutputPoints>;
+};
+}  // namespace solver
 
 template <class Approx, class Rule, class Material, class Crack = crack::None,
-          class Stepper = stepper::CentralDifference>
-class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, Crack, Stepper>> {
+          class Stepper = stepper::CentralDifference, class Domain = domain::Serial>
+class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, Crack, Stepper, Domain>>,
+               public solver::PointShare<Approx, Rule, Material, Domain>,
+               public solver::CheckpointIO<Solver<Approx, Rule, Material, Crack, Stepper, Domain>> {
+  using Share = solver::PointShare<Approx, Rule, Material, Domain>;
+  using Share::domain_, Share::particles_, Share::inertia_, Share::forces_, Share::reference_position_,
+      Share::reference_normal_, Share::points_, Share::all_points_, Share::states_, Share::point_owned_,
+      Share::global_point_, Share::model_point_count_, Share::model_slot_count_;
+  using typename Share::Phase;
+  using Conditions = solver::ConditionsAndLoads<Solver>;
+  using Conditions::constraints_, Conditions::loads_;
+  using Share::keep_first, Share::non_finite_load, Share::stop_if_alone, Share::load_context_at, Share::key;
+
   // Each family's check names the member a policy lacks; the message here says
   // which parameter it was.
   static_assert(approx::check_approximation<Approx>(),
@@ -88,6 +129,9 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
   static_assert(stepper::check_stepper<Stepper>(),
                 "Solver: the fifth parameter must be a stepper; use stepper::CentralDifference or a type "
                 "meeting stepper/stepper.hpp");
+  static_assert(domain::check_domain<Domain>(),
+                "Solver: the sixth parameter must be a domain part; use domain::Serial or mpi::Domain");
+  static constexpr bool distributed = Domain::is_distributed;
 
  public:
   using approximation_type = Approx;
@@ -95,67 +139,58 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
   using material_type = Material;
   using crack_type = Crack;
   using stepper_type = Stepper;
+  using domain_type = Domain;
   using Section = thickness::Section<Rule, Material>;
   using SectionState = typename Section::State;
   using MaterialParameters = typename Material::Parameters;
-  // Per stress point, the thickness output points k (integral points; one for Global).
-  static constexpr int output_points = Section::output_points;
+  using typename Share::Points;
+  using typename Share::States;
+  using Share::output_points;
   // Whether save_checkpoint compiles for these policies (solver/checkpoint.hpp).
   static constexpr bool can_checkpoint = solver::checkpoint::can_checkpoint<Crack, Stepper, SectionState>();
 
-  Solver(ShellModel model, const MaterialParameters& parameters, SolverOptions options = {}) try
-      : model_(std::move(model)),
+  // One process.
+  template <class D = Domain, std::enable_if_t<!D::is_distributed, int> = 0>
+  Solver(ShellModel model, const MaterialParameters& parameters, SolverOptions options = {})
+      : solver::CheckpointIO<Solver>(options.output()),
+        model_(std::move(model)),
         law_(parameters),
-        options_((validate(options), solver::check_memory<SectionState>(model_, options), std::move(options))),
-        particles_(solver::ParticleState::at_rest(model_.particle_position, model_.particle_normal)),
-        inertia_(solver::Inertia::lumped(model_, options_.density, options_.rotary_inertia_scale)),
-        forces_(model_.particle_count()),
-        points_(model_, options_.physics(), options_.particle_integration(), law_.shear_modulus(),
-                law_.poisson_ratio()),
-        states_(model_, law_, points_.count(solver::PointGroup::particles)),
-        assembler_(options_.nonlinear, points_),
-        ledger_(options_.monitoring(), law_.youngs_modulus(), solver::shell_volume(model_)),
-        progress_(options_.monitoring()),
-        output_(options_.output(), options_.progress_stream),
-        checkpoints_(options_.output()) {
-    fracture_.initialize(model_, points_);
-    stable_time_step_ = solver::stable_time_step(model_, law_, options_.physics(), points_, states_);
-    if (options_.time_step > 0.0) {
-      if (options_.time_step > stable_time_step_)
-        detail::invalid_parameter("time_step", options_.time_step,
-                                  "exceeds the stable bound " + solver::number_text(stable_time_step_) + " s");
-      time_step_ = options_.time_step;
-    } else {
-      time_step_ = options_.safety_factor * stable_time_step_;
-    }
-    solver::check_damping(options_.damping, time_step_);
-    if (!can_checkpoint && checkpoints_.enabled())
-      detail::invalid_parameter("checkpoint_path", options_.checkpoint_path,
-                                "periodic checkpoints need policies that can be checkpointed: a material State "
-                                "that lists its fields (for_each_field), a crack policy and a stepper with state "
-                                "that have save/load (see solver/checkpoint.hpp); set checkpoint_every_steps and "
-                                "checkpoint_every_seconds to 0");
-  } catch (const std::bad_alloc&) {
-    // Members are gone here; the estimate check_memory made is kept for the message.
-    throw Error("sphshell: out of memory building the solver (std::bad_alloc): " + solver::memory_estimate_text());
+        options_(std::move(options)) {
+    set_up({});
+  }
+  // Collective: every process of the domain passes the same model, parameters
+  // and options; `where` (an mpi::Communicator) must outlive the solver.
+  template <class Where, class D = Domain, std::enable_if_t<D::is_distributed, int> = 0>
+  Solver(const Where& where, ShellModel model, const MaterialParameters& parameters, SolverOptions options = {},
+         const typename D::Weights& weights = {})
+      : Share(where),
+        solver::CheckpointIO<Solver>(options.output()),
+        model_(std::move(model)),
+        law_(parameters),
+        options_(std::move(options)) {
+    set_up(weights);
   }
 
-  // CSV time history of one particle: t, displacement, velocity, rotation.
+  // CSV time history of one particle: t, displacement, velocity, rotation;
+  // written by the process that owns it. Collective.
   void add_particle_probe(const std::string& csv_path, int particle) {
-    checked({particle});
-    output_.add_probe(csv_path, solver::ParticleProbe{particle}, *this);
+    domain_.collectively([&] {
+      solver::checked_set({particle}, model_.particle_count());
+      output_->add_probe(csv_path, solver::ParticleProbe{particle}, *this);
+    });
   }
   // CSV time history of one stress point: t, then the equivalent stress,
   // equivalent plastic strain and damage at each thickness output point
-  // (integral points in the rule's order, ζ ascending).
+  // (integral points in the rule's order, ζ ascending). Collective.
   void add_stress_point_probe(const std::string& csv_path, int stress_point) {
-    if (stress_point < 0 || static_cast<std::size_t>(stress_point) >= model_.stress_point_count())
-      detail::invalid_parameter("stress point index", stress_point, "out of range");
-    output_.add_probe(csv_path, typename Output::StressProbe{stress_point}, *this);
+    domain_.collectively([&] {
+      this->check_stress_point(stress_point);
+      output_->add_probe(csv_path, typename Output::StressProbe{stress_point}, *this);
+    });
   }
   // Writes one ParaView frame now (particles, stress points and cracks),
-  // whatever the output interval; requires output_directory.
-  void write_frame() { output_.write_frame(*this); }
+  // whatever the output interval; requires output_directory. Collective.
+  void write_frame() { output_->write_frame(*this); }
 
   // A pre-crack: a polyline on the shell (reference coordinates). Pairs across
   // it stop interacting at once. Stress points lying on it become its crack
@@ -169,122 +204,32 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
   }
   // Stress points removed because they lie on a pre-crack (not counted as damaged).
   std::size_t precrack_stress_point_count() const { return fracture_.precrack_stress_point_count(); }
-  // The crack topology (reference configuration); crack::None has none.
+  // The crack topology (reference configuration), whole on every process; crack::None has none.
   const Crack& crack() const { return fracture_.crack(); }
   // Stress points removed from the force integration (all integral points failed).
   std::size_t damaged_stress_point_count() const { return fracture_.damaged_stress_point_count(); }
   bool is_fragment(int particle) const {
-    check_particle(particle);
+    this->check_particle(particle);
     return fracture_.is_fragment(static_cast<std::size_t>(particle));
   }
   std::size_t fragment_count() const { return fracture_.fragment_count(); }
-  // Whether a stress point has left the integration (damaged or on a pre-crack).
-  bool is_removed(int stress_point) const {
-    check_output_point(stress_point, 0);
-    return !states_.active(static_cast<std::size_t>(stress_point));
-  }
 
-  // One explicit step of size time_step(). A step that stops with an Error
-  // (an instability) leaves a half-updated state: every later step() refuses
-  // with that error.
+  // One explicit step of size time_step() (collective). A step that stops
+  // with an Error (an instability) leaves a half-updated state: every later
+  // step() refuses with that error. Periodic checkpoints (OutputOptions) are
+  // written after the steps that are due; by wall-clock time, process 0's
+  // clock decides for all.
   void step() {
     latch_.run(steps_, [&] { advance(); });
     // Outside the latch: the state is whole, a failed write leaves the solver usable.
-    if constexpr (can_checkpoint)
-      if (checkpoints_.is_due(steps_)) {
-        save_checkpoint(checkpoints_.path());
-        checkpoints_.written(steps_);
-      }
+    if constexpr (can_checkpoint) this->save_if_due();
   }
 
-  // Checkpoint and restart (solver/checkpoint.hpp has the file format). A
-  // checkpoint holds the whole state between two steps: particles, every
-  // integration point's material state, strains and resultants, cracks and
-  // fragments with the shape functions they changed, the energy books, t0, the
-  // step count and Δt, the step latch, and the output and probe schedules. A
-  // solver of the same five policies, model, material and result-changing
-  // options that loads it continues bit for bit as the saving one would have.
-  // The file is replaced atomically (a kill while writing leaves the previous
-  // one whole).
-  void save_checkpoint(const std::string& path) const {
-    using solver::checkpoint::write_section;
-    io::BinaryWriter out;
-    write_section(out, "IDNT", [&] { out(identity()); });
-    write_section(out, "TIME", [&] {
-      out(start_time_, static_cast<std::int64_t>(steps_), time_step_, time_, forces_current_, latch_.message());
-    });
-    write_section(out, "PART", [&] { particles_.save(out); });
-    write_section(out, "FORC", [&] { forces_.save(out); });
-    write_section(out, "PNTS", [&] { points_.save(out, model_.particle_position, model_.particle_normal); });
-    write_section(out, "SECT", [&] { states_.save(out); });
-    write_section(out, "FRAC", [&] { fracture_.save(out); });
-    write_section(out, "ENRG", [&] { ledger_.save(out); });
-    out.begin_section("STEP");
-    if constexpr (!std::is_empty_v<Stepper>) {
-      static_assert(solver::checkpoint::has_save_load<Stepper>::value,
-                    "save_checkpoint: the stepper has members but no save/load; add `template <class Writer> void "
-                    "save(Writer&) const` and `template <class Reader> void load(Reader&)` (stepper/stepper.hpp)");
-      stepper_.save(out);
-    }
-    out.end_section();
-    write_section(out, "OUTP", [&] { output_.save(out); });
-    solver::checkpoint::write_file(path, policies(), out);
-  }
-
-  // Loads a checkpoint into this solver, which must have been built with the
-  // same policies, model, material and result-changing options (an Error
-  // names what differs, or what is wrong with the file: not a checkpoint,
-  // another format version, truncated, corrupted). Conditions and loads stay
-  // as this solver has them; pre-cracks come from the checkpoint (do not add
-  // them again). Probes already added continue their files from the
-  // checkpoint's rows; probes added later do too, when their file is one the
-  // checkpoint recorded. An Error after the file was accepted leaves the
-  // solver stopped (step() refuses).
-  void load_checkpoint(const std::string& path) {
-    using solver::checkpoint::read_section;
-    io::BinaryReader in = solver::checkpoint::read_file(path, policies());
-    solver::checkpoint::Identity file;
-    read_section(in, "IDNT", [&] { in(file); });
-    solver::checkpoint::check_identity(file, identity(), path);
-    try {
-      // Rows a crack rebuilt here since construction go back to the model's.
-      if (points_.any_rebuilt())
-        points_ = solver::IntegrationPoints<Approx>(model_, options_.physics(), options_.particle_integration(),
-                                                    law_.shear_modulus(), law_.poisson_ratio());
-      assembler_ = solver::InternalForceAssembler(options_.nonlinear, points_);
-      std::int64_t steps = 0;
-      // The identity matched this solver's time step; the steps must have been taken with it.
-      const double identity_time_step = time_step_;
-      read_section(in, "TIME", [&] { in(start_time_, steps, time_step_, time_, forces_current_, latch_.message()); });
-      steps_ = static_cast<long>(steps);
-      solver::checkpoint::check_time_step(in, time_step_, identity_time_step);
-      solver::checkpoint::check_time_of_steps(in, start_time_, steps_, time_step_, time_);
-      read_section(in, "PART", [&] { particles_.load(in); });
-      read_section(in, "FORC", [&] { forces_.load(in); });
-      read_section(in, "PNTS", [&] { points_.load(in, model_.particle_count()); });
-      read_section(in, "SECT", [&] { states_.load(in); });
-      read_section(in, "FRAC", [&] { fracture_.load(in); });
-      read_section(in, "ENRG", [&] { ledger_.load(in); });
-      read_section(in, "STEP", [&] { if constexpr (!std::is_empty_v<Stepper>) stepper_.load(in); });
-      read_section(in, "OUTP", [&] { output_.load(in, *this); });
-      if (!in.at_end()) in.fail("there are bytes after its last section");
-    } catch (const Error& error) {
-      latch_.close(std::string("sphshell: loading a checkpoint failed part-way, so this solver's state is mixed and "
-                               "it cannot step; the error was: ") +
-                   error.what());
-      throw;
-    } catch (const std::exception& error) {
-      // Not the file's fault (memory ran out, say), but the state is as mixed.
-      const std::string message = "sphshell: loading checkpoint '" + path + "' failed part-way: " + error.what();
-      latch_.close(message + "; this solver's state is mixed and it cannot step");
-      throw Error(message);
-    }
-    checkpoints_.written(steps_);
-  }
-
-  // A solver built from a checkpoint: the model, material and options as for
-  // the run that wrote it, the state from the file. Then give the conditions,
-  // loads and probes as for that run (not its pre-cracks: they are in the file).
+  // A serial solver built from a checkpoint: the model, material and options
+  // as for the run that wrote it, the state from the file. Then give the
+  // conditions, loads and probes as for that run (not its pre-cracks: they
+  // are in the file).
+  template <class D = Domain, std::enable_if_t<!D::is_distributed, int> = 0>
   static Solver from_checkpoint(const std::string& path, ShellModel model, const MaterialParameters& parameters,
                                 SolverOptions options = {}) {
     Solver solver(std::move(model), parameters, std::move(options));
@@ -292,38 +237,22 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
     return solver;
   }
 
- private:
-  void advance() {
-    if (!forces_current_) compute_internal_forces();
-    if (steps_ == 0) output_.start(*this);
-    const stepper::StepContext context{now(), time_step_, stepper_.velocity_step(steps_, time_step_),
-                                       options_.damping};
-    const std::size_t unstable = advance_particles(context);
-    ++steps_;
-    time_ = start_time_ + static_cast<double>(steps_) * time_step_;  // t = t0 + n Δt, never summed
-    forces_current_ = false;
-    if (unstable < particles_.size()) fail_non_finite_state(unstable);
-    compute_internal_forces(Packing::done_by_particle_pass);
-    if constexpr (Crack::enabled) fracture_.update(fracture_parts());
-    if (solver::EnergyLedger::is_check_step(steps_)) ledger_.check_balance(now(), energy());
-    if (progress_.is_due(steps_)) progress_.write(now(), energy());
-    output_.write_scheduled(*this);
-  }
-
- public:
   // Steps until time t_end (the step nearest it: the run stops within half a
-  // step of t_end), calling observer(*this) after every step. With frames on
+  // step of t_end), calling observer(*this) after every step, on every
+  // process (it may call the collective queries). With frames on
   // (OutputOptions), the last state is a frame, whether or not one was due.
   // The progress line (MonitoringOptions) then reports the share done and the time left.
   template <class Observer>
   void run_until(double t_end, Observer&& observer) {
-    solver::check_run_end(t_end, solver::RunPosition{time_, time_step_, steps_}, options_.max_steps_per_run);
+    domain_.collectively([&] {
+      solver::check_run_end(t_end, solver::RunPosition{time_, time_step_, steps_}, options_.max_steps_per_run);
+    });
     progress_.start_run(now(), t_end);
     while (time_ < t_end - 0.5 * time_step_) {
       step();
       observer(*this);
     }
-    output_.finish(*this);
+    output_->finish(*this);
     progress_.end_run();
   }
   void run_until(double t_end) { run_until(t_end, [](const Solver&) {}); }
@@ -334,42 +263,52 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
   // (velocities zero, energy books restarted at it) and can step on from there.
   // observer(const solver::StaticIteration&) is called after every iteration.
   // An Error (no convergence within the budget, a free rigid-body mode, bad
-  // parameters) leaves the solver as it was before the call.
+  // parameters) leaves the solver as it was before the call. A distributed
+  // run has none yet: an Error on every process.
   template <class Observer>
   solver::StaticResult solve_static(const solver::StaticParameters& parameters, Observer&& observer) {
     latch_.check();
-    solver::validate(parameters);
-    const double load_time = std::isnan(parameters.load_time) ? time_ : parameters.load_time;
-    const solver::ParticleState start = particles_;
-    const solver::SectionStates<Rule, Material> start_states = states_;
-    solver::SectionStates<Rule, Material> converged = states_;
-    auto evaluate = [&](double load_factor) {
-      apply_loads({steps_, load_time});
-      for (std::size_t i = 0; i < particles_.size(); ++i) {
-        forces_.external[i] *= load_factor;
-        forces_.external_moment[i] *= load_factor;
+    if constexpr (distributed) {
+      domain_.collectively([&] {
+        throw Error("sphshell: solve_static: a distributed run has no static solver yet: neither the tangent "
+                    "(StaticMass::tangent, Newton steps) nor the dynamic relaxation (StaticMass::particle_bound) "
+                    "runs over a domain's processes; solve on one process and load its state, or run the "
+                    "dynamics to rest with damping");
+      });
+      return {};
+    } else {
+      solver::validate(parameters);
+      const double load_time = std::isnan(parameters.load_time) ? time_ : parameters.load_time;
+      const solver::ParticleState start = particles_;
+      const States start_states = *states_;
+      States converged = *states_;
+      auto evaluate = [&](double load_factor) {
+        apply_loads_now({steps_, load_time});
+        for (std::size_t i = 0; i < particles_.size(); ++i) {
+          forces_.external[i] *= load_factor;
+          forces_.external_moment[i] *= load_factor;
+        }
+        assembler_->compute(now(), particles_, *points_, *states_, forces_);
+      };
+      auto save = [&] {
+        if constexpr (!solver::is_path_independent_v<Material>) converged = *states_;
+      };
+      auto restore = [&] {
+        if constexpr (!solver::is_path_independent_v<Material>) *states_ = converged;
+      };
+      solver::StaticSystem<Approx, decltype(evaluate), decltype(save), decltype(restore)> system{
+          model_, particles_, forces_, constraints_, *points_, evaluate, save, restore, options_.progress_stream};
+      try {
+        const solver::StaticResult result = solver::solve_static(system, parameters, observer);
+        forces_current_ = true;
+        ledger_->restart_at_rest(energy().elastic);
+        return result;
+      } catch (...) {
+        particles_ = start;
+        *states_ = start_states;
+        compute_internal_forces();
+        throw;
       }
-      assembler_.compute(now(), particles_, points_, states_, forces_);
-    };
-    auto save = [&] {
-      if constexpr (!solver::is_path_independent_v<Material>) converged = states_;
-    };
-    auto restore = [&] {
-      if constexpr (!solver::is_path_independent_v<Material>) states_ = converged;
-    };
-    solver::StaticSystem<Approx, decltype(evaluate), decltype(save), decltype(restore)> system{
-        model_, particles_, forces_, constraints_, points_, evaluate, save, restore,
-        options_.progress_stream};
-    try {
-      const solver::StaticResult result = solver::solve_static(system, parameters, observer);
-      forces_current_ = true;
-      ledger_.restart_at_rest(energy().elastic);
-      return result;
-    } catch (...) {
-      particles_ = start;
-      states_ = start_states;
-      compute_internal_forces();
-      throw;
     }
   }
   solver::StaticResult solve_static(const solver::StaticParameters& parameters = {}) {
@@ -385,32 +324,12 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
   const SolverOptions& options() const { return options_; }
   // The time integrator (the fifth template parameter).
   const Stepper& integrator() const { return stepper_; }
-
-  std::size_t particle_count() const { return particles_.size(); }
-  const std::vector<Vector3>& positions() const { return particles_.position; }
-  const std::vector<Vector3>& directors() const { return particles_.director; }
-  const std::vector<Vector3>& velocities() const { return particles_.velocity; }
-  const std::vector<Vector3>& angular_velocities() const { return particles_.angular_velocity; }
-  Vector3 displacement(int particle) const {
-    check_particle(particle);
-    return particles_.position[particle] - model_.particle_position[particle];
-  }
-  // Rotation vector taking the reference director to the current one.
-  Vector3 rotation(int particle) const {
-    check_particle(particle);
-    return solver::rotation_vector(model_.particle_normal[particle], particles_.director[particle]);
-  }
-  const std::vector<double>& masses() const { return inertia_.mass; }
-  const std::vector<double>& rotary_inertias() const { return inertia_.rotary_inertia; }
-  const std::vector<Vector3>& internal_forces() const { return forces_.internal; }
-  // ∂Π/∂d_j: the internal generalized force on each director.
-  const std::vector<Vector3>& internal_director_forces() const { return forces_.internal_director; }
-
   // Moves the particles and directors to a new configuration at once (a
   // kinematic jump, used e.g. to probe the discrete stiffness): the strain
   // change goes through the material law like a step's, and the internal
-  // forces are recomputed. Velocities are kept.
+  // forces are recomputed. Velocities are kept. One process only.
   void set_configuration(std::vector<Vector3> positions, std::vector<Vector3> directors) {
+    static_assert(!distributed, "set_configuration: a distributed run sets no configuration");
     if (positions.size() != particles_.size() || directors.size() != particles_.size())
       detail::invalid_parameter("configuration size", positions.size(), "must equal the particle count");
     for (std::size_t i = 0; i < positions.size(); ++i) {
@@ -426,167 +345,187 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
     compute_internal_forces();
   }
 
-  // Per stress point and thickness output point k (integral point; one for Global).
-  std::size_t stress_point_count() const { return model_.stress_point_count(); }
-  double integral_point_quantity(solver::IntegralPointQuantity quantity, int stress_point, int k) const {
-    check_output_point(stress_point, k);
-    return states_.quantity(quantity, static_cast<std::size_t>(stress_point), k);
-  }
-  double equivalent_stress(int stress_point, int k) const {
-    return integral_point_quantity(solver::IntegralPointQuantity::equivalent_stress, stress_point, k);
-  }
-  double equivalent_plastic_strain(int stress_point, int k) const {
-    return integral_point_quantity(solver::IntegralPointQuantity::equivalent_plastic_strain, stress_point, k);
-  }
-  double damage(int stress_point, int k) const {
-    return integral_point_quantity(solver::IntegralPointQuantity::damage, stress_point, k);
-  }
-  // Membrane forces (N/m) and moments (N·m/m) at a stress point, Voigt (xx, yy, xy)
-  // in its reference tangent frame.
-  const StressVoigt& membrane_force(int stress_point) const {
-    check_output_point(stress_point, 0);
-    return states_.membrane_force(static_cast<std::size_t>(stress_point));
-  }
-  const StressVoigt& bending_moment(int stress_point) const {
-    check_output_point(stress_point, 0);
-    return states_.bending_moment(static_cast<std::size_t>(stress_point));
-  }
-  // Current stress point positions, interpolated from the particles.
-  std::vector<Vector3> stress_point_positions() const {
-    std::vector<Vector3> positions(model_.stress_point_count(), Vector3::Zero());
-    const approx::ShapeFunctions& shape = points_.shape(solver::PointGroup::stress_points);
-    parallel::for_each(std::size_t{0}, positions.size(), [&](std::size_t row) noexcept {
-      for (std::size_t s = shape.row_begin[row]; s < shape.row_begin[row] + shape.row_size[row]; ++s)
-        positions[row] += shape.value[s].phi * particles_.position[shape.neighbour[s]];
-    });
-    return positions;
-  }
-
+  // The energy books over all processes (collective).
   EnergyReport energy() const {
-    // A point out of action holds 0, which adds nothing.
-    const double stored = assembler_.sum_over_points(points_, [&](std::size_t p) {
-      return states_.active(p) ? states_.stored_energy(p, points_.membrane_bending_weight(p), points_.shear_weight(p))
-                               : 0.0;
-    });
-    return ledger_.report(stored, fracture_.released_energy());
+    if constexpr (distributed) {
+      const typename Domain::Timer timer(domain_);
+      typename Domain::EnergySum elastic;
+      for (std::size_t p = 0; p < states_->size(); ++p)
+        if (point_owned_[p] && states_->active(p))
+          elastic.add(states_->stored_energy(p, points_->membrane_bending_weight(p), points_->shear_weight(p)));
+      return ledger_->report(domain_, elastic, fracture_.released_energy());
+    } else {
+      // A point out of action holds 0, which adds nothing.
+      const double stored = assembler_->sum_over_points(*points_, [&](std::size_t p) {
+        return states_->active(p)
+                   ? states_->stored_energy(p, points_->membrane_bending_weight(p), points_->shear_weight(p))
+                   : 0.0;
+      });
+      return ledger_->report(domain_, stored, fracture_.released_energy());
+    }
   }
 
  private:
-  using Output = solver::SolverOutput<output_points>;
-  using Parts = solver::FractureParts<Approx, Rule, Material>;
-
+  using Parts = solver::DomainParts<Domain>;
+  using Ledger = solver::EnergyBooks<Domain>;
+  using Fracture = solver::FractureManager<Crack, Domain>;
+  using Output = typename Parts::template Output<output_points>;
+  friend Output;
+  friend class solver::CheckpointIO<Solver>;
+  friend class solver::FramePiece<Solver>;
   StepTime now() const { return {steps_, time_}; }
 
-  static std::array<std::string, 5> policies() {
-    return solver::checkpoint::policy_names<Approx, Rule, Material, Crack, Stepper>();
+  void set_up(const typename Domain::Weights& weights) try {
+    domain_.collectively([&] {
+      domain_.check_share(model_);
+      validate(options_);
+      solver::check_memory<SectionState>(model_, options_);
+      // The whole model's points and states; the stable step from them.
+      Points all_points(model_, options_.physics(), options_.particle_integration(), law_.shear_modulus(),
+                        law_.poisson_ratio());
+      States all_states(model_, law_, all_points.count(solver::PointGroup::particles));
+      stable_time_step_ = solver::stable_time_step(model_, law_, options_.physics(), all_points, all_states);
+      if (options_.time_step > 0.0) {
+        if (options_.time_step > stable_time_step_)
+          detail::invalid_parameter("time_step", options_.time_step,
+                                    "exceeds the stable bound " + solver::number_text(stable_time_step_) + " s");
+        time_step_ = options_.time_step;
+      } else {
+        time_step_ = options_.safety_factor * stable_time_step_;
+      }
+      solver::check_damping(options_.damping, time_step_);
+      if (!can_checkpoint && this->periodic_checkpoints())
+        detail::invalid_parameter("checkpoint_path", options_.checkpoint_path,
+                                  "periodic checkpoints need policies that can be checkpointed: a material State "
+                                  "that lists its fields (for_each_field), a crack policy and a stepper with state "
+                                  "that have save/load (see solver/checkpoint.hpp); set checkpoint_every_steps and "
+                                  "checkpoint_every_seconds to 0");
+      // The share, and this process's part of everything.
+      domain_.decompose(model_, all_points, weights);
+      fracture_.initialize(model_, all_points, domain_);
+      this->share_points(model_, std::move(all_points), std::move(all_states), Crack::enabled);
+      this->share_particles(model_, options_);
+      if constexpr (distributed)
+        constraints_.name_particles_by(std::vector<int>(domain_.layout().owned.begin(), domain_.layout().owned.end()));
+      assembler_.emplace(options_.nonlinear, *points_);
+      ledger_.emplace(options_.monitoring(), law_.youngs_modulus(), solver::shell_volume(model_));
+    });
+    if constexpr (distributed) {
+      domain_.plan_halo();
+      output_.emplace(domain_.communicator(), options_.output(), Crack::enabled);
+    } else {
+      output_.emplace(options_.output(), options_.progress_stream);
+    }
+  } catch (const std::bad_alloc&) {
+    throw Error("sphshell: out of memory building the solver (std::bad_alloc): " + solver::memory_estimate_text());
   }
-  // What a checkpoint must agree on with the solver loading it.
-  solver::checkpoint::Identity identity() const {
-    solver::checkpoint::Identity id;
-    id.counts = {{"particle count", static_cast<std::uint64_t>(model_.particle_count())},
-                 {"stress point count", static_cast<std::uint64_t>(model_.stress_point_count())},
-                 {"integration point count", static_cast<std::uint64_t>(points_.size())},
-                 {"shape-function slot count", static_cast<std::uint64_t>(points_.slot_count())}};
-    id.model = solver::checkpoint::model_fingerprints(model_);
-    id.material = solver::checkpoint::material_constants(law_);
-    id.options = solver::checkpoint::result_options(options_, time_step_);
-    return id;
-  }
-  Parts fracture_parts() { return Parts{model_, particles_, points_, states_, assembler_, forces_}; }
 
-  // A set's indices in range and each listed once (solver/run_checks.hpp).
-  ParticleSet checked(const ParticleSelection& set) const {
-    return solver::checked_set(set.members(model_), model_.particle_count());
+  solver::FractureParts<Approx, Rule, Material, Domain> fracture_parts() {
+    return {domain_,     model_, particles_, all_points_ ? *all_points_ : *points_, *points_, *states_,
+            *assembler_, forces_, point_owned_};
   }
-  void check_particle(int particle) const {
-    if (particle < 0 || static_cast<std::size_t>(particle) >= particles_.size())
-      detail::invalid_parameter("particle index", particle, "out of range");
-  }
-  void check_output_point(int stress_point, int k) const {
-    if (stress_point < 0 || static_cast<std::size_t>(stress_point) >= model_.stress_point_count())
-      detail::invalid_parameter("stress point index", stress_point, "out of range");
-    if (k < 0 || k >= output_points) detail::invalid_parameter("thickness output point", k, "out of range");
-  }
-  // The conditions and loads (solver/conditions_and_loads.hpp) on the checked set.
+
+
+  // The conditions and loads (solver/conditions_and_loads.hpp): every process
+  // checks the whole set (the same Error everywhere), then applies it to the
+  // members it owns.
   friend class solver::ConditionsAndLoads<Solver>;
-  template <class Add>
-  void add_conditions(const ParticleSelection& set, Add&& add) {
-    add(constraints_, checked(set), model_.particle_position, model_.particle_normal);
-  }
-  template <class Make>
-  void add_load(const ParticleSelection& set, Make&& make) {
-    loads_.add(make(checked(set)));
-  }
-  template <class Displacement>
-  void check_displacement_start(const ParticleSelection& set, const Displacement& displacement) const {
-    for (int i : checked(set))
-      solver::check_prescribed_displacement_start(i, displacement(model_.particle_position[i], time_),
-                                                  particles_.position[i] - model_.particle_position[i], time_, steps_,
-                                                  model_.minimum_spacing());
-  }
-
-
-  void apply_loads(const StepTime& at) {
+  void apply_loads_now(const StepTime& at) {
     detail::LoadContext context = load_context_at(at.time);
     loads_.apply(at, context);
   }
-  detail::LoadContext load_context_at(double time) {
-    return {time,         model_.particle_position, model_.particle_normal,
-            particles_.director, model_.particle_area,  inertia_.mass,
-            forces_.external,    forces_.external_moment};
+  // The loads that cannot be applied in chunks (a user's pressure function), before the particle pass.
+  void apply_loads(const StepTime& at, std::optional<domain::Failure>& failure) {
+    try {
+      apply_loads_now(at);
+    } catch (...) {
+      // A non-finite load: the serial message, with the lowest global id of
+      // one here. Anything else (a load function that threw, of any type)
+      // stops every process with its own message.
+      for (std::size_t i = 0; i < domain_.owned_count(); ++i)
+        if (!forces_.external[i].allFinite() || !forces_.external_moment[i].allFinite()) {
+          keep_first(failure, non_finite_load(at, i));
+          return;
+        }
+      keep_first(failure, domain_.failure_of_current_exception(key(Phase::loads, 0)));
+    }
   }
-
   // Whether the particles' positions and directors were packed for the
-  // gathers by the particle pass since they last moved (advance_particles).
+  // gathers by the particle pass since they last moved (one process only: a
+  // distributed run's ghosts come from the halo exchange, which packs them all).
   enum class Packing { needed, done_by_particle_pass };
+  // Halo exchange, then the internal forces of every computed point; a
+  // failing point stops every process with its global index.
   void compute_internal_forces(Packing packing = Packing::needed) {
-    if (packing == Packing::done_by_particle_pass)
-      assembler_.compute_packed(now(), points_, states_, forces_);
-    else
-      assembler_.compute(now(), particles_, points_, states_, forces_);
-    ledger_.book_internal_work(assembler_.internal_work());
+    domain_.exchange({&particles_.position, &particles_.director});
+    std::optional<domain::Failure> failure;
+    try {
+      if (packing == Packing::done_by_particle_pass)
+        assembler_->compute_packed(now(), *points_, *states_, forces_);
+      else
+        assembler_->compute(now(), particles_, *points_, *states_, forces_);
+    } catch (...) {
+      // Keyed by the failing point's global index: the serial pass stops at the lowest.
+      long point = 0;
+      if constexpr (distributed) point = static_cast<long>(global_point_[assembler_->failed_point()]);
+      failure = domain_.failure_of_current_exception(point);
+    }
+    domain_.agree(failure);
+    ledger_->book_internal_work(*assembler_, point_owned_);
     forces_current_ = true;
   }
 
-  // The particles' part of a step (solver/particle_pass.hpp); the lowest
-  // particle with a non-finite state is returned (particle count if none)
-  // for advance() to report at the step's end time.
-  std::size_t advance_particles(const stepper::StepContext& context) {
+  void advance() {
+    if (!forces_current_) compute_internal_forces();
+    if (steps_ == 0) output_->start(*this);
+    const stepper::StepContext context{now(), time_step_, stepper_.velocity_step(steps_, time_step_),
+                                       options_.damping};
+    std::optional<domain::Failure> failure;
     const bool loads_in_pass = loads_.applies_in_chunks();
-    if (!loads_in_pass) apply_loads(context.at);
-    solver::ParticlePass<solver::EnergyLedger, Stepper> pass{
-        loads_,    load_context_at(context.at.time), constraints_, model_.particle_position, time_step_, ledger_,
-        stepper_,  particles_, inertia_, forces_, &assembler_};
+    if (!loads_in_pass) apply_loads(context.at, failure);
+    stop_if_alone(failure);
+    // The particle pass over the owned particles (solver/particle_pass.hpp).
+    solver::ParticlePass<Ledger, Stepper> pass{
+        loads_,   load_context_at(context.at.time), constraints_, reference_position_, time_step_, *ledger_,
+        stepper_, particles_, inertia_, forces_, distributed ? nullptr : &*assembler_};
     const solver::ParticlePassFailures failed = pass.run(context, loads_in_pass);
-    if (failed.load < particles_.size()) ExternalLoads::fail_non_finite(context.at, failed.load);
-    if (failed.condition_error) std::rethrow_exception(failed.condition_error);
-    ledger_.finish_step();  // a failed step's terms never reach the books
-    return failed.state;
-  }
-
-  [[noreturn]] void fail_non_finite_state(std::size_t i) const {
-    detail::fail_unstable(now(), "non-finite state at particle " + std::to_string(i) + " (external force " +
-                                     solver::number_text(forces_.external[i].norm()) + " N, internal force " +
-                                     solver::number_text(forces_.internal[i].norm()) + " N)");
+    if (failed.load < domain_.owned_count()) keep_first(failure, non_finite_load(context.at, failed.load));
+    if (failed.condition_error) {
+      const auto particle = static_cast<std::size_t>(constraints_.particles()[failed.condition]);
+      try {
+        std::rethrow_exception(failed.condition_error);
+      } catch (...) {
+        keep_first(failure,
+                   domain_.failure_of_current_exception(key(Phase::motions, std::size_t(domain_.global_of(particle)))));
+      }
+    }
+    stop_if_alone(failure);
+    ledger_->finish_step();  // a failed step's terms never reach the books
+    ++steps_;
+    time_ = start_time_ + static_cast<double>(steps_) * time_step_;  // t = t0 + n Δt, never summed
+    forces_current_ = false;
+    if (failed.state < domain_.owned_count()) keep_first(failure, this->non_finite_state(now(), failed.state));
+    domain_.agree(failure);
+    compute_internal_forces(distributed ? Packing::needed : Packing::done_by_particle_pass);
+    if constexpr (Crack::enabled) fracture_.update(fracture_parts());
+    if (solver::EnergyLedger::is_check_step(steps_)) ledger_->check_balance(domain_, now(), energy());
+    // The progress line, from the reduced books, written by process 0.
+    if (progress_.is_due(steps_)) {
+      const EnergyReport report = energy();
+      if (domain_.is_root()) progress_.write(now(), report);
+    }
+    output_->write_scheduled(*this);
   }
 
   ShellModel model_;
   Material law_;
   SolverOptions options_;
-  solver::ParticleState particles_;
-  solver::Inertia inertia_;
-  solver::ParticleForces forces_;
-  solver::IntegrationPoints<Approx> points_;
-  solver::SectionStates<Rule, Material> states_;
-  solver::InternalForceAssembler assembler_;
-  solver::FractureManager<Crack> fracture_;
-  solver::EnergyLedger ledger_;
-  solver::ProgressReporter progress_;
-  Output output_;
-  solver::checkpoint::Schedule checkpoints_;
+  std::optional<solver::InternalForceAssembler> assembler_;
+  std::optional<Ledger> ledger_;
+  Fracture fracture_;
   Stepper stepper_;
-  detail::Constraints constraints_;
-  ExternalLoads loads_;
+  std::optional<Output> output_;
+  solver::ProgressReporter progress_{options_.monitoring()};
   double stable_time_step_ = 0.0;
   double time_step_ = 0.0;
   double start_time_ = 0.0;  // t0

@@ -12,6 +12,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -136,6 +137,28 @@ TEST_CASE("Distributed frames and probes", "[mpi][output]") {
   }
   CHECK(particle_pieces == 6 * static_cast<std::size_t>(comm.size()));
   CHECK(stress_pieces == 6 * static_cast<std::size_t>(comm.size()));
+  // The last frame is drawn as the serial frame is, the shell as its cells:
+  // over all pieces every stress point is one cell, and the particle pieces
+  // hold the same cells plus a vertex for each particle no cell holds.
+  auto cells_in = [&](const std::string& series) {
+    std::size_t total = 0;
+    for (int r = 0; r < comm.size(); ++r) {
+      const std::string text =
+          file_text(directory + "/frames/" + series + "_000005_r" + std::to_string(r) + ".vtu");
+      const std::string key = "NumberOfCells=\"";
+      const std::size_t at = text.find(key);
+      REQUIRE(at != std::string::npos);
+      total += std::stoul(text.substr(at + key.size()));
+    }
+    return total;
+  };
+  REQUIRE(!model.cells().empty());
+  std::vector<char> in_a_cell(model.particle_count(), 0);
+  for (const Cell& cell : model.cells())
+    for (const int corner : cell) in_a_cell[static_cast<std::size_t>(corner)] = 1;
+  const auto loose = static_cast<std::size_t>(std::count(in_a_cell.begin(), in_a_cell.end(), 0));
+  CHECK(cells_in("stress_points") == model.stress_point_count());
+  CHECK(cells_in("particles") == model.stress_point_count() + loose);
 #ifdef SPHSHELL_VTK_PYTHON
   if (comm.is_root()) {
     {

@@ -140,11 +140,11 @@ TEST_CASE("Error rule: a failure on one rank stops every rank with one message",
   // (the lowest key, as the serial loop would have stopped there first).
   std::optional<mpi::Failure> failure;
   if (comm.rank() > 0 || comm.size() == 1)
-    failure = mpi::Failure{100 - comm.rank(), "failure at key " + std::to_string(100 - comm.rank())};
+    failure = mpi::Failure{100 - comm.rank(), "failure at key " + std::to_string(100 - comm.rank()), nullptr};
   const std::string expected = "failure at key " + std::to_string(100 - (comm.size() - 1));
   CHECK_THROWS_WITH(mpi::agree_on_failure(comm, failure), expected);
   // Equal keys: the lowest failing rank's message.
-  CHECK_THROWS_WITH(mpi::agree_on_failure(comm, mpi::Failure{5, "rank " + std::to_string(comm.rank())}), "rank 0");
+  CHECK_THROWS_WITH(mpi::agree_on_failure(comm, mpi::Failure{5, "rank " + std::to_string(comm.rank()), nullptr}), "rank 0");
   // collectively: an Error thrown on the last rank only.
   CHECK_THROWS_WITH(mpi::collectively(comm,
                                       [&] {
@@ -154,6 +154,6 @@ TEST_CASE("Error rule: a failure on one rank stops every rank with one message",
                     "sphshell: simulation unstable at step 12: particle 7");
   CHECK_NOTHROW(mpi::collectively(comm, [] {}));
   // A reserved key is refused (on every rank alike).
-  CHECK_THROWS_WITH(mpi::agree_on_failure(comm, mpi::Failure{std::numeric_limits<long>::max(), "x"}),
+  CHECK_THROWS_WITH(mpi::agree_on_failure(comm, mpi::Failure{std::numeric_limits<long>::max(), "x", nullptr}),
                     Catch::Contains("failure key"));
 }

@@ -20,6 +20,7 @@
 //   std::string checkpoint_file(const std::string& path) const
 //       the file of checkpoint `path` this process writes and reads.
 
+#include <exception>
 #include <optional>
 #include <string>
 #include <type_traits>
@@ -33,6 +34,7 @@ namespace sphshell::domain {
 struct Failure {
   long key = 0;
   std::string message;
+  std::exception_ptr original;  // one process: the exception itself, rethrown as it was
 };
 
 namespace detail {

@@ -3,7 +3,6 @@
 // MPI::MPI_CXX. Not part of <sphshell/sphshell.hpp>, which needs no MPI.
 
 #include <sphshell/mpi/communicator.hpp>
-#include <sphshell/mpi/distributed_ledger.hpp>
 #include <sphshell/mpi/distributed_solver.hpp>
 #include <sphshell/mpi/error_agreement.hpp>
 #include <sphshell/mpi/exact_sum.hpp>

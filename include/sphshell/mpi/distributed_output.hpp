@@ -2,13 +2,13 @@
 // Output of a distributed run (docs/distributed.md, "Output"): ParaView frames
 // in pieces and probes written by the rank that owns what they probe.
 //
-// Frames: each rank writes one .vtu piece with the particles it owns
-// (particles_NNNNNN_rR.vtu: deformed or reference positions as
-// OutputOptions::frame_coordinates says, one vertex cell per particle, and the
-// point arrays global_id, displacement, velocity, director, with fragment when
-// there are cracks) and one with the active stress points it owns
-// (stress_points_NNNNNN_rR.vtu: a vertex cell at each, the serial frame's
-// stress-point cell arrays); after every piece is on disk rank 0 writes a
+// Frames: each rank writes its pieces of every frame, drawn as the serial
+// frame is (solver::FramePiece, solver/output.hpp: the shell as its cells,
+// cracks as gaps): particles_NNNNNN_rR.vtu with its local particles (the
+// ones it owns, and the ghosts that are corners of its cells; point arrays
+// as the serial frame's, and global_id) and the cells of the active stress
+// points it owns, and stress_points_NNNNNN_rR.vtu with the same cells and the
+// stress-point cell arrays. After every piece is on disk rank 0 writes a
 // .pvtu for each naming the pieces, with cracks the crack segments
 // (cracks_NNNNNN.vtu, the whole crack set), and adds them to particles.pvd,
 // stress_points.pvd and cracks.pvd together, so ParaView opens each series
@@ -31,7 +31,9 @@
 #include <sphshell/mpi/error_agreement.hpp>
 #include <sphshell/solver/options.hpp>
 #include <sphshell/solver/output.hpp>
+#include <sphshell/solver/section_states.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -39,18 +41,10 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace sphshell::mpi {
-
-// What one rank puts in its piece of a frame.
-struct FramePiece {
-  std::vector<Vector3> points;  // owned particles, as drawn
-  std::vector<int> global_id;
-  std::vector<Vector3> displacement, velocity, director;
-  std::vector<double> fragment;  // empty without cracks
-  double time = 0.0;
-};
 
 class DistributedFrames {
  public:
@@ -78,12 +72,11 @@ class DistributedFrames {
   // Writes this rank's pieces (particles, stress points), then rank 0 the
   // .pvtu files, the crack frame (`cracks`: rank 0's, with cracks) and the
   // series entries, all series together. Collective.
-  void write(const Communicator& comm, const FramePiece& piece, const io::VtuGrid& stress_points,
+  void write(const Communicator& comm, const io::VtuGrid& particles, const io::VtuGrid& stress_points,
              const io::VtuGrid* cracks, long step) {
     if (!enabled())
       sphshell::detail::invalid_parameter("output_directory", std::string(), "a frame needs an output folder");
     const std::string number = frame_number(frames_written_);
-    const io::VtuGrid particles = grid_of(piece);
     collectively(comm, [&] {
       io::write_vtu(path(piece_name("particles_" + number, comm.rank())), particles, format());
       io::write_vtu(path(piece_name("stress_points_" + number, comm.rank())), stress_points, format());
@@ -92,11 +85,11 @@ class DistributedFrames {
       if (!comm.is_root()) return;
       write_pvtu(path("particles_" + number + ".pvtu"), "particles_" + number, comm.size(), particles);
       write_pvtu(path("stress_points_" + number + ".pvtu"), "stress_points_" + number, comm.size(), stress_points);
-      series_[0]->stage(piece.time, path("particles_" + number + ".pvtu"));
-      series_[1]->stage(piece.time, path("stress_points_" + number + ".pvtu"));
+      series_[0]->stage(particles.time, path("particles_" + number + ".pvtu"));
+      series_[1]->stage(particles.time, path("stress_points_" + number + ".pvtu"));
       if (with_cracks_) {
         io::write_vtu(path("cracks_" + number + ".vtu"), *cracks, format());
-        series_[2]->stage(piece.time, path("cracks_" + number + ".vtu"));
+        series_[2]->stage(particles.time, path("cracks_" + number + ".vtu"));
       }
       io::write_together(collections());
     });
@@ -175,28 +168,6 @@ class DistributedFrames {
 
   io::VtuFormat format() const { return {options_.frame_encoding, options_.frame_precision}; }
 
-  static io::PointField vector_field(const std::string& name, const std::vector<Vector3>& values) {
-    io::PointField field{name, 3, {}};
-    for (const Vector3& v : values) field.values.insert(field.values.end(), {v.x(), v.y(), v.z()});
-    return field;
-  }
-
-  io::VtuGrid grid_of(const FramePiece& piece) const {
-    io::VtuGrid grid;
-    grid.points = piece.points;
-    grid.time = piece.time;
-    for (std::size_t i = 0; i < piece.points.size(); ++i) grid.cells.add_vertex(static_cast<int>(i));
-    io::PointField id{"global_id", 1, {}, {}, io::FieldValues::integer};
-    for (int global : piece.global_id) id.values.push_back(global);
-    grid.point_fields = {id, vector_field("displacement", piece.displacement),
-                         vector_field("velocity", piece.velocity), vector_field("director", piece.director)};
-    if (!piece.fragment.empty()) grid.point_fields.push_back({"fragment", 1, piece.fragment, {}, io::FieldValues::integer});
-    grid.note = std::string("sphshell frame piece (one rank's owned particles), t = ") +
-                io::detail::round_trip_decimal(piece.time) + " s; points: " +
-                (options_.frame_coordinates == FrameCoordinates::deformed ? "deformed" : "reference") + " positions";
-    return grid;
-  }
-
   // The parallel file of one frame: its pieces and the arrays they hold
   // (names, types and components as `layout`, a piece, has them).
   void write_pvtu(const std::string& file_path, const std::string& frame, int pieces, const io::VtuGrid& layout) const {
@@ -244,6 +215,202 @@ struct DistributedProbe {
   std::string path;
   std::unique_ptr<io::CsvProbe> file;  // on the owner only
   std::size_t local_point = 0;         // a stress point's local point (owner only)
+};
+
+
+// The output part of a distributed Solver (solver.hpp, the domain's part in
+// place of solver::SolverOutput, with its interface): frames in pieces, and
+// probes written by the owner of what they probe. It reads the solver's
+// local state (a friend of it).
+template <int OutputPoints>
+class DistributedOutput {
+ public:
+  using StressProbe = solver::StressPointProbe<OutputPoints>;
+
+  // Collective: rank 0 takes the output directory.
+  DistributedOutput(const Communicator& comm, const OutputOptions& options, bool with_cracks)
+      : frames_(comm, options, with_cracks), options_(options) {}
+
+  // Probes are added after loading a checkpoint (the owner's file continues from it).
+  void check_can_load() const {
+    if (!probes_.empty())
+      throw Error("sphshell: load_checkpoint: " + std::to_string(probes_.size()) +
+                  " probe(s) were added before it; a distributed run adds its probes after loading a checkpoint");
+  }
+
+  // Every rank registers the probe; the owner opens the file.
+  template <class Probe, class Solver>
+  void add_probe(const std::string& csv_path, const Probe& probe, const Solver& solver) {
+    for (const DistributedProbe& open : probes_)
+      if (open.path == csv_path)
+        throw Error("sphshell: probe file '" + csv_path + "' is already the file of another probe; give each probe "
+                    "a file of its own");
+    DistributedProbe added;
+    added.path = csv_path;
+    if constexpr (std::is_same_v<Probe, StressProbe>) {
+      added.kind = DistributedProbe::Kind::stress_point;
+      added.index = probe.stress_point;
+      const long row = solver.domain_.owned_stress_row(static_cast<std::size_t>(probe.stress_point));
+      if (row >= 0) {
+        added.local_point = solver.points_->point(solver::PointGroup::stress_points, static_cast<std::size_t>(row));
+        open_probe(added, stress_probe<typename Solver::rule_type>(probe.stress_point).columns(), solver);
+      }
+    } else {
+      added.index = probe.particle;
+      if (solver.domain_.owns(probe.particle)) open_probe(added, probe.columns(), solver);
+    }
+    probes_.push_back(std::move(added));
+  }
+
+  // Before the first step: the reference configuration at t = 0.
+  template <class Solver>
+  void start(const Solver& solver) {
+    if (frames_.writes_on_schedule() && frames_.last_frame_step() < 0) {
+      write_frame(solver);
+      frames_.schedule_next(solver.time() + options_.output_interval);
+    }
+  }
+  // The serial schedule (solver::SolverOutput::write_scheduled).
+  template <class Solver>
+  void write_scheduled(const Solver& solver) {
+    const double time = solver.time(), time_step = solver.time_step();
+    if (frames_.writes_on_schedule() && time >= frames_.next_frame_time() - 0.5 * time_step) {
+      if (frames_.last_frame_step() != solver.steps()) write_frame(solver);
+      const double interval = options_.output_interval;
+      const double passed = std::floor((time + 0.5 * time_step - frames_.next_frame_time()) / interval);
+      frames_.schedule_next(frames_.next_frame_time() + interval * (std::max(0.0, passed) + 1.0));
+    }
+    if (!probes_.empty() && time >= next_probe_time_ - probe_schedule_tolerance * time_step) {
+      for (DistributedProbe& probe : probes_)
+        if (probe.file) write_probe_row(probe, solver);
+      next_probe_time_ = time + options_.probe_interval;
+    }
+  }
+  template <class Solver>
+  void finish(const Solver& solver) {
+    if (frames_.writes_on_schedule() && frames_.last_frame_step() != solver.steps()) write_frame(solver);
+  }
+
+  // One frame now (collective): each rank's particle and stress-point
+  // pieces, rank 0 the .pvtu files, the crack frame and the series.
+  template <class Solver>
+  void write_frame(const Solver& solver) {
+    const solver::FramePiece<Solver> piece(solver, options_.frame_coordinates);
+    const io::VtuGrid particles = piece.particle_grid(), stress_points = piece.stress_point_grid();
+    if constexpr (Solver::crack_type::enabled) {
+      const io::VtuGrid cracks = piece.crack_grid();  // collective
+      frames_.write(solver.domain().communicator(), particles, stress_points, &cracks, solver.steps());
+    } else {
+      frames_.write(solver.domain().communicator(), particles, stress_points, nullptr, solver.steps());
+    }
+  }
+
+  // Checkpoints: the frame schedule and series, the probe schedule and the
+  // owned probes' files (for probes added after a restart to continue them).
+  template <class Writer>
+  void save(Writer& out) const {
+    frames_.save(out);
+    out(next_probe_time_);
+    std::uint64_t open_files = 0;
+    for (const DistributedProbe& probe : probes_) open_files += probe.file ? 1 : 0;
+    out(open_files);
+    for (const DistributedProbe& probe : probes_)
+      if (probe.file) {
+        const io::CsvProbe::Resume written = probe.file->written();
+        out(probe.path, static_cast<std::uint32_t>(probe.kind), static_cast<std::int64_t>(probe.index),
+            written.bytes, written.hash);
+      }
+  }
+  template <class Reader, class Solver>
+  void load(Reader& in, const Solver&) {
+    frames_.load(in);
+    in(next_probe_time_);
+    std::uint64_t open_files = 0;
+    in(open_files);
+    restored_probes_.clear();
+    for (std::uint64_t n = 0; n < open_files; ++n) {
+      RestoredProbe record;
+      std::uint32_t kind = 0;
+      std::int64_t index = 0;
+      in(record.path, kind, index, record.written.bytes, record.written.hash);
+      if (kind > 1) in.fail("a probe of unknown kind " + std::to_string(kind));
+      record.kind = static_cast<DistributedProbe::Kind>(kind);
+      record.index = static_cast<int>(index);
+      restored_probes_.push_back(std::move(record));
+    }
+  }
+
+ private:
+  // As the serial output's probe schedule (solver/output.hpp).
+  static constexpr double probe_schedule_tolerance = 1e-9;
+  struct RestoredProbe {
+    std::string path;
+    DistributedProbe::Kind kind = DistributedProbe::Kind::particle;
+    int index = 0;
+    io::CsvProbe::Resume written;
+  };
+
+  template <class Rule>
+  static StressProbe stress_probe(int stress_point) {
+    StressProbe probe(stress_point);
+    probe.point_names = solver::thickness_point_names<Rule>();
+    return probe;
+  }
+  // What solver::ParticleProbe and StressPointProbe read, for what the owner holds.
+  template <class Solver>
+  struct OwnedView {
+    const Solver& solver;
+    std::size_t local_point;
+    struct Field {
+      const std::vector<Vector3>& local;
+      const Solver& solver;
+      const Vector3& operator[](int global) const {
+        return local[static_cast<std::size_t>(solver.domain_.local_of(static_cast<std::size_t>(global)))];
+      }
+    };
+    double time() const { return solver.time(); }
+    Field velocities() const { return {solver.particles_.velocity, solver}; }
+    std::size_t local(int global) const {
+      return static_cast<std::size_t>(solver.domain_.local_of(static_cast<std::size_t>(global)));
+    }
+    Vector3 displacement(int global) const {
+      return solver.particles_.position[local(global)] - solver.reference_position_[local(global)];
+    }
+    Vector3 rotation(int global) const {
+      return solver::rotation_vector(solver.reference_normal_[local(global)], solver.particles_.director[local(global)]);
+    }
+    double integral_point_quantity(solver::IntegralPointQuantity quantity, int, int k) const {
+      return solver.states_->quantity(quantity, local_point, k);
+    }
+  };
+  template <class Solver>
+  void write_probe_row(DistributedProbe& probe, const Solver& solver) const {
+    const OwnedView<Solver> view{solver, probe.local_point};
+    if (probe.kind == DistributedProbe::Kind::particle)
+      probe.file->write_row(solver::ParticleProbe{probe.index}.row(view));
+    else
+      // A row needs no column names: no rule's names are built per row.
+      probe.file->write_row(StressProbe(probe.index).row(view));
+  }
+  // The owner's file of a new probe: the file a loaded checkpoint recorded
+  // for the same probe continues from the checkpoint's rows; else a new
+  // file starts with the row of now.
+  template <class Solver>
+  void open_probe(DistributedProbe& probe, std::vector<std::string> columns, const Solver& solver) {
+    for (auto record = restored_probes_.begin(); record != restored_probes_.end(); ++record)
+      if (record->path == probe.path && record->kind == probe.kind && record->index == probe.index) {
+        probe.file = std::make_unique<io::CsvProbe>(probe.path, std::move(columns), record->written);
+        restored_probes_.erase(record);
+        return;
+      }
+    probe.file = std::make_unique<io::CsvProbe>(probe.path, std::move(columns));
+    write_probe_row(probe, solver);
+  }
+  DistributedFrames frames_;
+  OutputOptions options_;
+  std::vector<DistributedProbe> probes_;
+  std::vector<RestoredProbe> restored_probes_;  // recorded by a loaded checkpoint, not added again yet
+  double next_probe_time_ = 0.0;
 };
 
 }  // namespace sphshell::mpi

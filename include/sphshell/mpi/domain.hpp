@@ -10,11 +10,18 @@
 #include <sphshell/domain/domain.hpp>
 #include <sphshell/mpi/communicator.hpp>
 #include <sphshell/mpi/error_agreement.hpp>
+#include <sphshell/mpi/exact_sum.hpp>
 #include <sphshell/mpi/halo.hpp>
 #include <sphshell/mpi/layout.hpp>
+#include <sphshell/mpi/partition.hpp>
+#include <sphshell/solver/integration_points.hpp>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
+#include <random>
 #include <ctime>
 #include <optional>
 #include <string>
@@ -54,6 +61,160 @@ class Domain {
   bool owns(int global) const {
     const int k = layout_.local_of[static_cast<std::size_t>(global)];
     return k >= 0 && static_cast<std::size_t>(k) < layout_.owned_count();
+  }
+
+  // The share (collective with the Solver's set-up): the recursive-coordinate-
+  // bisection partition of the whole model in the reference configuration,
+  // this rank's layout, then the halo plan.
+  using Weights = PartitionWeights;
+  using EnergySum = ExactSum;  // exact: the same for any rank count
+  template <class Model>
+  void check_share(const Model& model) const {
+    detail::check_parts(size(), model.particle_count());  // before rows that a tiny model cannot build
+  }
+  template <class Model, class Points>
+  void decompose(const Model& model, const Points& all_points, const Weights& weights) {
+    const DecompositionInput input = decomposition_input(model, all_points);
+    partition_ = partition(input, size(), weights);
+    set_layout(rank_layout(input, partition_, rank()));
+    const std::size_t g = solver::index_of(solver::PointGroup::stress_points);
+    owned_row_of_stress_point_.assign(model.stress_point_count(), -1);
+    for (std::size_t k = 0; k < layout_.computed[g].size(); ++k)
+      if (layout_.computed_is_owned[g][k]) owned_row_of_stress_point_[layout_.computed[g][k]] = static_cast<long>(k);
+  }
+  // This rank's rows of the whole model's (the edge-tied shear's corners renumbered).
+  template <class Points>
+  Points local_rows(const Points& all) const {
+    return all.subset(layout_.computed, layout_.local_of, layout_.local_count());
+  }
+  template <class States, class Points>
+  States local_states(const States& all, const Points& all_points) const {
+    std::vector<std::size_t> computed_points;
+    for (solver::PointGroup group : solver::point_groups) {
+      const std::size_t g = solver::index_of(group);
+      for (std::size_t row : layout_.computed[g]) computed_points.push_back(all_points.point(group, row));
+    }
+    return all.subset(computed_points);
+  }
+  std::size_t owned_count() const { return layout_.owned_count(); }
+  std::size_t local_count() const { return layout_.local_count(); }
+  int global_of(std::size_t local) const { return layout_.global_of(local); }
+  long local_of(std::size_t global) const { return layout_.local_of[global]; }
+  // Stress point q's local row when this rank owns it, else -1.
+  long owned_stress_row(std::size_t q) const { return owned_row_of_stress_point_[q]; }
+  // Local stress-point rows owned here, in global order.
+  std::vector<std::size_t> owned_stress_rows() const {
+    const std::size_t g = solver::index_of(solver::PointGroup::stress_points);
+    std::vector<std::size_t> rows;
+    for (std::size_t k = 0; k < layout_.computed[g].size(); ++k)
+      if (layout_.computed_is_owned[g][k]) rows.push_back(k);
+    return rows;
+  }
+  // The rows of point group g computed here, and their global rows.
+  std::size_t local_row_count(std::size_t g) const { return layout_.computed[g].size(); }
+  std::size_t global_row(std::size_t g, std::size_t row) const { return layout_.computed[g][row]; }
+  // Global ids found by the ranks, all of them (collective).
+  std::vector<std::int64_t> gathered_ids(const std::vector<std::int64_t>& mine) const {
+    return comm_->all_gather_v(mine);
+  }
+  std::size_t global_stress_point(std::size_t row) const {
+    return layout_.computed[solver::index_of(solver::PointGroup::stress_points)][row];
+  }
+
+  // The owned values of a per-particle field, in global order on every rank
+  // (collective; O(N) bytes: for checks and small runs).
+  std::vector<Vector3> gathered(const std::vector<Vector3>& local_field) const {
+    // Checked on every rank together, so that a short field on one rank is
+    // an Error on all of them, not a rank left waiting in the gather.
+    collectively([&] {
+      if (local_field.size() < layout_.owned_count())
+        sphshell::detail::invalid_parameter("local field size", local_field.size(),
+                                            "must cover this rank's " + std::to_string(layout_.owned_count()) +
+                                                " owned particles (local numbering: owned, then ghosts)");
+    });
+    std::vector<std::pair<std::size_t, Vector3>> mine(layout_.owned_count());
+    for (std::size_t i = 0; i < mine.size(); ++i)
+      mine[i] = {static_cast<std::size_t>(layout_.owned[i]), local_field[i]};
+    return assembled(layout_.local_of.size(), mine);
+  }
+  // The value of the one rank that has it (collective).
+  template <class T>
+  T from_owner(const std::optional<T>& value) const {
+    std::vector<T> mine;
+    if (value) mine.push_back(*value);
+    return comm_->all_gather_v(mine).front();
+  }
+  // Entries (global index, value) of every rank, as the array of `count` (collective).
+  std::vector<Vector3> assembled(std::size_t count, const std::vector<std::pair<std::size_t, Vector3>>& entries) const {
+    struct Entry {  // trivially copyable, as a gather needs
+      std::int64_t index;
+      double value[3];
+    };
+    std::vector<Entry> mine;
+    for (const auto& [index, x] : entries) mine.push_back({static_cast<std::int64_t>(index), {x.x(), x.y(), x.z()}});
+    std::vector<Vector3> all(count, Vector3::Zero());
+    for (const Entry& entry : comm_->all_gather_v(mine))
+      all[static_cast<std::size_t>(entry.index)] = Vector3(entry.value[0], entry.value[1], entry.value[2]);
+    return all;
+  }
+  // What a rank's checkpoint file records of the share: the rank count and rank.
+  template <class Counts>
+  void add_identity(Counts& counts) const {
+    counts.push_back({"rank count", static_cast<std::uint64_t>(size())});
+    counts.push_back({"rank", static_cast<std::uint64_t>(rank())});
+  }
+  // The correctly rounded totals of several exact accumulators over all
+  // ranks, in one all-reduce of their limbs side by side (collective).
+  template <std::size_t N>
+  std::array<double, N> totals(const std::array<const ExactSum*, N>& local) const {
+    std::vector<std::int64_t> raw;
+    raw.reserve(N * ExactSum::raw_size);
+    for (const ExactSum* accumulator : local) {
+      ExactSum normalised = *accumulator;
+      normalised.normalize();
+      raw.insert(raw.end(), normalised.raw().begin(), normalised.raw().end());
+    }
+    comm_->sum_in_place(raw);
+    std::array<double, N> result{};
+    for (std::size_t k = 0; k < N; ++k) {
+      ExactSum::Raw part{};
+      std::copy_n(raw.begin() + static_cast<std::ptrdiff_t>(k * ExactSum::raw_size), ExactSum::raw_size, part.begin());
+      result[k] = ExactSum::from_raw(part).value();
+    }
+    return result;
+  }
+  // The largest (global id, value) of the ranks' (id < 0: none), ties to the
+  // lowest id, as a serial max_element finds it (collective).
+  std::pair<long long, double> largest(std::pair<long long, double> mine) const {
+    struct Candidate {
+      long long id;
+      double value;
+    };
+    Candidate best{-1, -1.0};
+    for (const Candidate& candidate : comm_->all_gather(Candidate{mine.first, mine.second}))
+      if (candidate.id >= 0 &&
+          (candidate.value > best.value || (candidate.value == best.value && candidate.id < best.id)))
+        best = candidate;
+    return {best.id, best.value};
+  }
+  // After loading: every rank's file came from the same save.
+  void check_same_save(const std::string& path, std::uint64_t stamp, long steps) const {
+    const std::vector<std::uint64_t> stamps = comm_->all_gather(stamp);
+    const std::vector<std::int64_t> all_steps = comm_->all_gather(static_cast<std::int64_t>(steps));
+    for (std::size_t r = 1; r < stamps.size(); ++r)
+      if (stamps[r] != stamps[0])
+        throw Error("sphshell: checkpoint files '" + path + ".rank0' (step " + std::to_string(all_steps[0]) +
+                    ") and '" + path + ".rank" + std::to_string(r) + "' (step " + std::to_string(all_steps[r]) +
+                    ") were written by different saves");
+  }
+  // A stamp of one save shared by all ranks (collective): files of different
+  // saves cannot be loaded together.
+  std::uint64_t save_stamp() const {
+    std::uint64_t stamp = 0;
+    if (is_root())
+      stamp = static_cast<std::uint64_t>(std::random_device{}()) << 32 ^
+              static_cast<std::uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count());
+    return comm_->all_gather(stamp).front();
   }
 
   void agree(const std::optional<domain::Failure>& failure) const {
@@ -109,6 +270,8 @@ class Domain {
   }
 
   const Communicator* comm_;
+  Partition partition_;
+  std::vector<long> owned_row_of_stress_point_;
   RankLayout layout_;
   HaloPlan halo_;
   HaloExchange exchange_;

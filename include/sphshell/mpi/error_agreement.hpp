@@ -57,11 +57,11 @@ inline Failure failure_of_current_exception(const Communicator& comm, long key) 
   try {
     throw;
   } catch (const Error& error) {
-    return Failure{key, error.what()};
+    return Failure{key, error.what(), nullptr};
   } catch (const std::exception& error) {
-    return Failure{key, where + error.what()};
+    return Failure{key, where + error.what(), nullptr};
   } catch (...) {
-    return Failure{key, where + "an exception that is not a std::exception"};
+    return Failure{key, where + "an exception that is not a std::exception", nullptr};
   }
 }
 

@@ -90,7 +90,7 @@ class HaloPlan {
         if (local < 0 || static_cast<std::size_t>(local) >= layout.owned_count()) {
           failure = Failure{global, "sphshell: rank " + std::to_string(r) + " asked rank " +
                                         std::to_string(comm.rank()) + " for particle " + std::to_string(global) +
-                                        ", which it does not own (the ranks' partitions differ)"};
+                                        ", which it does not own (the ranks' partitions differ)", nullptr};
           break;
         }
       }

@@ -1,29 +1,26 @@
 #pragma once
 // The conditions and loads of a run, on particle sets given by ids or by a
-// model set's name (shell/particle_selection.hpp): one API for Solver and
-// mpi::DistributedSolver, a base each derives from (CRTP). The solver
-// provides, to this base only:
-//   add_conditions(set, add): checks the set (range, each listed once; an
-//     unknown name is an Error naming it) and calls
-//     add(constraints, members, reference_position, reference_normal) for
-//     each set of conditions it keeps (a distributed run: the whole set in
-//     global ids, for the serial checks and messages, then its owned members
-//     in local ids);
-//   add_load(set, make): the same; keeps make(members), the load on the
-//     members whose loads it applies;
-//   check_displacement_start(set, u): an Error when u(X, t) does not continue
-//     the particles' own displacement;
-//   time(), time_step().
-// The values are checked first, the set then: the same Error on every rank of
-// a distributed run, whose ranks all make the same call.
+// model set's name (shell/particle_selection.hpp): a base part of the Solver
+// (CRTP) that owns them. Every process checks a whole set as a serial run
+// does (range, each listed once; an unknown name is an Error naming it: the
+// same Error on every process, which all make the same call), then keeps the
+// conditions and loads on the members it owns (local ids); a distributed run
+// also keeps the whole sets' conditions in global ids (checker_), for the
+// serial checks and messages. The values are checked first, the set then.
+// The solver gives this base its domain, model, particles, reference data,
+// time() and time_step().
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/types.hpp>
+#include <sphshell/domain/domain.hpp>
 #include <sphshell/shell/constraints.hpp>
 #include <sphshell/shell/loads.hpp>
 #include <sphshell/shell/particle_selection.hpp>
+#include <sphshell/solver/run_checks.hpp>
 
+#include <cstddef>
 #include <memory>
+#include <optional>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -78,7 +75,7 @@ class ConditionsAndLoads {
   void prescribe_displacement(const ParticleSelection& set, DisplacementFunction displacement) {
     static_assert(std::is_invocable_r_v<Vector3, DisplacementFunction, const Vector3&, double>,
                   "prescribe_displacement: the function must be callable as Vector3 u(const Vector3& X, double t)");
-    self().check_displacement_start(set, displacement);
+    check_displacement_start(set, displacement);
     motion<sphshell::detail::PrescribedDisplacement<DisplacementFunction>>(set, displacement);
   }
   // Prescribed velocity v(X, t) imposed on all three translations of the set.
@@ -95,7 +92,7 @@ class ConditionsAndLoads {
                     PressureDirection direction = PressureDirection::follower) {
     static_assert(std::is_invocable_r_v<double, PressureFunction, const Vector3&, double>,
                   "add_pressure: the pressure must be callable as double p(const Vector3& X, double t)");
-    self().add_load(set, [&](const ParticleSet& members) {
+    add_load(set, [&](const ParticleSet& members) {
       return std::make_unique<sphshell::detail::PressureLoad<PressureFunction>>(members, std::move(pressure), direction);
     });
   }
@@ -103,7 +100,7 @@ class ConditionsAndLoads {
   void add_uniform_pressure(const ParticleSelection& set, double pressure, TimeFunction time = {},
                             PressureDirection direction = PressureDirection::follower) {
     sphshell::detail::require_finite("pressure", pressure);
-    self().add_load(set, [&](const ParticleSet& members) {
+    add_load(set, [&](const ParticleSet& members) {
       return std::make_unique<sphshell::detail::UniformPressureLoad<TimeFunction>>(members, pressure, std::move(time), direction);
     });
   }
@@ -111,7 +108,7 @@ class ConditionsAndLoads {
   template <class TimeFunction = time_function::Step>
   void add_point_force(const ParticleSelection& set, const Vector3& force, TimeFunction time = {}) {
     if (!force.allFinite()) sphshell::detail::invalid_parameter("point force", force.transpose(), "must be finite");
-    self().add_load(set, [&](const ParticleSet& members) {
+    add_load(set, [&](const ParticleSet& members) {
       return std::make_unique<sphshell::detail::PointForceLoad<TimeFunction>>(members, force, std::move(time));
     });
   }
@@ -120,7 +117,7 @@ class ConditionsAndLoads {
   template <class TimeFunction = time_function::Step>
   void add_point_moment(const ParticleSelection& set, const Vector3& moment, TimeFunction time = {}) {
     if (!moment.allFinite()) sphshell::detail::invalid_parameter("point moment", moment.transpose(), "must be finite");
-    self().add_load(set, [&](const ParticleSet& members) {
+    add_load(set, [&](const ParticleSet& members) {
       return std::make_unique<sphshell::detail::PointMomentLoad<TimeFunction>>(members, moment, std::move(time));
     });
   }
@@ -129,17 +126,69 @@ class ConditionsAndLoads {
   void add_gravity(const ParticleSelection& set, const Vector3& acceleration, TimeFunction time = {}) {
     if (!acceleration.allFinite())
       sphshell::detail::invalid_parameter("gravity acceleration", acceleration.transpose(), "must be finite");
-    self().add_load(set, [&](const ParticleSet& members) {
+    add_load(set, [&](const ParticleSet& members) {
       return std::make_unique<sphshell::detail::GravityLoad<TimeFunction>>(members, acceleration, std::move(time));
     });
   }
 
+ protected:
+  sphshell::detail::Constraints constraints_;  // owned particles, local indices
+  sphshell::detail::Constraints checker_;      // distributed: the whole sets, global ids, for the serial checks and messages
+  ExternalLoads loads_;
+
  private:
   Solver& self() { return static_cast<Solver&>(*this); }
+  // A set checked by every process (range, each listed once; the same Error
+  // everywhere), handed with its members in global ids and its owned members
+  // in local ids to `apply`.
+  template <class Apply>
+  void on_set(const ParticleSelection& set, Apply&& apply) {
+    const Solver& s = self();
+    s.domain_.collectively([&] {
+      const ParticleSet global = checked_set(set.members(s.model_), s.model_.particle_count());
+      ParticleSet local;
+      for (int i : global)
+        if (s.domain_.owns(i)) local.push_back(static_cast<int>(s.domain_.local_of(static_cast<std::size_t>(i))));
+      apply(global, local);
+    });
+  }
   template <class Add>
   void conditions(const ParticleSelection& set, Add&& add) {
-    self().add_conditions(set, std::forward<Add>(add));
+    const Solver& s = self();
+    on_set(set, [&](const ParticleSet& global, const ParticleSet& local) {
+      if constexpr (Solver::domain_type::is_distributed)
+        add(checker_, global, s.model_.particle_position, s.model_.particle_normal);
+      add(constraints_, local, s.reference_position_, s.reference_normal_);
+    });
   }
+  template <class Make>
+  void add_load(const ParticleSelection& set, Make&& make) {
+    on_set(set, [&](const ParticleSet&, const ParticleSet& local) { loads_.add(make(local)); });
+  }
+  // An Error when displacement(X, t) does not continue the particles' own
+  // displacement, from the owner of each particle; the failure first in the
+  // set's order wins, as in the serial loop.
+  template <class Displacement>
+  void check_displacement_start(const ParticleSelection& set, const Displacement& displacement) {
+    const Solver& s = self();
+    on_set(set, [&](const ParticleSet& global, const ParticleSet&) {
+      std::optional<domain::Failure> failure;
+      for (std::size_t k = 0; k < global.size() && !failure; ++k) {
+        const int i = global[k];
+        if (!s.domain_.owns(i)) continue;
+        const auto at = static_cast<std::size_t>(s.domain_.local_of(static_cast<std::size_t>(i)));
+        try {
+          check_prescribed_displacement_start(i, displacement(s.model_.particle_position[i], s.time_),
+                                              s.particles_.position[at] - s.reference_position_[at], s.time_,
+                                              s.steps_, s.model_.minimum_spacing());
+        } catch (...) {
+          failure = s.domain_.failure_of_current_exception(static_cast<long>(k));
+        }
+      }
+      s.domain_.agree(failure);
+    });
+  }
+
   // A motion object per set of conditions the solver keeps (each a copy of the function).
   template <class Motion, class Function>
   void motion(const ParticleSelection& set, const Function& function) {

@@ -17,6 +17,7 @@
 #include <sphshell/stepper/stepper.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <ostream>
@@ -159,8 +160,9 @@ class ParticleEnergyTerms {
   std::vector<Sums> chunk_sums_;
 };
 
-class EnergyLedger {
- public:
+// The ledger's rules: when the balance is checked, how the particles are
+// chunked, when the balance is lost and what the run then says.
+struct EnergyLedger {
   // The balance is checked every check_interval steps (the elastic energy
   // costs a pass over all states: about 2 % of a step's time when checked
   // every step, on the square plate), from step first_checked_step on: the
@@ -176,89 +178,11 @@ class EnergyLedger {
   // round-off (e.g. before a travelling load arrives) and carry no balance.
   static constexpr double round_off_strain_squared = 1e-20;
 
-  // volume: Σ d_i A_i of the shell; youngs_modulus sets the round-off scale.
-  EnergyLedger(const MonitoringOptions& monitoring, double youngs_modulus, double volume)
-      : monitoring_(monitoring), round_off_energy_(youngs_modulus * volume * round_off_strain_squared) {}
-
-  // The step's books (the particles' part of the step, Solver::advance_particles):
-  // start_step() before the pass; in it, for each chunk of particles
-  // (particle_chunk()), remember_velocities() before the stepper updates the
-  // velocities, remember_free_velocities() after it and before the kinematic
-  // conditions (their difference is the reactions' impulse), book_chunk()
-  // after them: the chunk's work of the external forces (reactions included)
-  // and of the damping, and its kinetic energy at n+½ (ParticleEnergyTerms);
-  // finish_step() after the pass.
-  void start_step(const ParticleState& state) {
-    terms_.prepare(state.ranges.owned_begin, state.ranges.owned_end);
-  }
-  std::size_t chunk_count(const ParticleState& state) const {
-    return ParticleEnergyTerms::chunk_count(state.ranges.owned_begin, state.ranges.owned_end);
-  }
   // The particles [first, last) of chunk `chunk`.
   static std::pair<std::size_t, std::size_t> particle_chunk(const ParticleState& state, std::size_t chunk) {
     return {ParticleEnergyTerms::chunk_first(state.ranges.owned_begin, chunk),
             ParticleEnergyTerms::chunk_last(state.ranges.owned_begin, state.ranges.owned_end, chunk)};
   }
-  void remember_velocities(const ParticleState& state, std::size_t first, std::size_t last) {
-    terms_.remember_velocities(state, first, last);
-  }
-  void remember_free_velocities(const ParticleState& state, std::size_t first, std::size_t last) {
-    terms_.remember_free_velocities(state, first, last);
-  }
-  void book_chunk(const stepper::StepContext& context, const ParticleState& state, const Inertia& inertia,
-                  const ParticleForces& forces, std::size_t chunk) {
-    terms_.book_chunk(context, state, inertia, forces, state.ranges.owned_begin, state.ranges.owned_end, chunk);
-  }
-  void finish_step() {
-    const ParticleEnergyTerms::Sums sums = terms_.total();
-    external_work_ += sums.external;
-    damping_work_ += sums.damping;
-    kinetic_energy_ = sums.kinetic;
-  }
-
-  // The internal work of one force evaluation, summed over the points
-  // (InternalForceAssembler::internal_work).
-  void book_internal_work(double work) {
-    previous_internal_energy_ = internal_energy_;
-    internal_energy_ += work;
-  }
-
-  // After a static solve (solver/static_solution.hpp): the shell at rest
-  // holding `elastic`, booked as work the loads did, so the balance of a run
-  // that follows starts at zero.
-  void restart_at_rest(double elastic) {
-    previous_internal_energy_ = internal_energy_ = elastic;
-    external_work_ = elastic;
-    damping_work_ = 0.0;
-    kinetic_energy_ = 0.0;
-  }
-
-  // The books, with the elastic energy now held and the energy the fracture released.
-  EnergyReport report(double elastic, double released_by_fracture) const {
-    EnergyReport report;
-    report.kinetic = kinetic_energy_;
-    report.internal = internal_energy_;
-    report.elastic = elastic;
-    report.plastic_dissipation = internal_energy_ - elastic;
-    report.external_work = external_work_;
-    report.damping_work = damping_work_;
-    report.released_by_fracture = released_by_fracture;
-    report.balance_ = kinetic_energy_ + 0.5 * (previous_internal_energy_ + internal_energy_) + damping_work_ -
-                      external_work_;
-    return report;
-  }
-
-  // Checkpoints (solver/checkpoint.hpp): the books. The per-particle terms
-  // and remembered velocities are rewritten by every step before use.
-  template <class Writer>
-  void save(Writer& out) const {
-    out(previous_internal_energy_, internal_energy_, external_work_, damping_work_, kinetic_energy_);
-  }
-  template <class Reader>
-  void load(Reader& in) {
-    in(previous_internal_energy_, internal_energy_, external_work_, damping_work_, kinetic_energy_);
-  }
-
   // Whether step n is one whose balance is checked.
   static bool is_check_step(long step) { return step % check_interval == 0; }
 
@@ -282,27 +206,162 @@ class EnergyLedger {
       message << "; the largest kinetic energy is at particle " << largest_particle << " (" << largest_energy << " J)";
     return message.str();
   }
+};
 
-  // Stops the run when the balance is lost (balance_lost), naming the particle
-  // of largest kinetic energy.
-  void check_balance(const StepTime& at, const EnergyReport& e) const {
+// The books of a run over a domain (domain/domain.hpp). One process keeps
+// running totals, each step's added once (the chunks' sums in chunk order),
+// so they are the same for any thread count. Several keep exact
+// accumulators of every owned particle's and point's term (mpi/exact_sum.hpp)
+// and round once when a report is due (one all-reduce, collective): the
+// books are the same for any rank count and differ from the serial ones only
+// by the serial rounding; energies do not feed back into the motion. No
+// communication per step.
+template <class Domain>
+class EnergyBooks : public EnergyLedger {
+  static constexpr bool distributed = Domain::is_distributed;
+  using Sum = typename Domain::EnergySum;
+
+ public:
+  // volume: Σ d_i A_i of the shell; youngs_modulus sets the round-off scale.
+  EnergyBooks(const MonitoringOptions& monitoring, double youngs_modulus, double volume)
+      : monitoring_(monitoring), round_off_energy_(youngs_modulus * volume * round_off_strain_squared) {}
+
+  // The step's books (the particles' part of the step, solver/particle_pass.hpp):
+  // start_step() before the pass; in it, for each chunk of particles
+  // (particle_chunk()), remember_velocities() before the stepper updates the
+  // velocities, remember_free_velocities() after it and before the kinematic
+  // conditions (their difference is the reactions' impulse), book_chunk()
+  // after them: the chunk's work of the external forces (reactions included)
+  // and of the damping, and its kinetic energy at n+½ (ParticleEnergyTerms);
+  // finish_step() after the pass. The particles are the owned ones.
+  void start_step(const ParticleState& state) {
+    owned_begin_ = state.ranges.owned_begin;
+    owned_end_ = state.ranges.owned_end;
+    terms_.prepare(owned_begin_, owned_end_);
+  }
+  std::size_t chunk_count(const ParticleState& state) const {
+    return ParticleEnergyTerms::chunk_count(state.ranges.owned_begin, state.ranges.owned_end);
+  }
+  void remember_velocities(const ParticleState& state, std::size_t first, std::size_t last) {
+    terms_.remember_velocities(state, first, last);
+  }
+  void remember_free_velocities(const ParticleState& state, std::size_t first, std::size_t last) {
+    terms_.remember_free_velocities(state, first, last);
+  }
+  void book_chunk(const stepper::StepContext& context, const ParticleState& state, const Inertia& inertia,
+                  const ParticleForces& forces, std::size_t chunk) {
+    terms_.book_chunk(context, state, inertia, forces, owned_begin_, owned_end_, chunk);
+  }
+  void finish_step() {
+    if constexpr (distributed) {
+      kinetic_ = Sum();
+      for (std::size_t i = owned_begin_; i < owned_end_; ++i) {
+        external_work_.add(terms_.external()[i]);
+        damping_work_.add(terms_.damping()[i]);
+        kinetic_.add(terms_.kinetic()[i]);
+      }
+    } else {
+      const ParticleEnergyTerms::Sums sums = terms_.total();
+      external_work_ += sums.external;
+      damping_work_ += sums.damping;
+      kinetic_ = sums.kinetic;
+    }
+  }
+
+  // The internal work of one force evaluation: serially its sum over the
+  // points (InternalForceAssembler::internal_work); distributed, the points
+  // this rank owns (owned[p] != 0; a redundant copy's work is booked by its owner).
+  template <class Assembler>
+  void book_internal_work(const Assembler& assembler, const std::vector<char>& owned) {
+    previous_internal_ = internal_;
+    if constexpr (distributed) {
+      const std::vector<double>& work = assembler.work_increments();
+      for (std::size_t p = 0; p < work.size(); ++p)
+        if (owned[p]) internal_.add(work[p]);
+    } else {
+      internal_ += assembler.internal_work();
+    }
+  }
+
+  // After a static solve (solver/static_solution.hpp, one process): the
+  // shell at rest holding `elastic`, booked as work the loads did, so the
+  // balance of a run that follows starts at zero.
+  void restart_at_rest(double elastic) {
+    static_assert(!distributed, "restart_at_rest: one process only");
+    previous_internal_ = internal_ = elastic;
+    external_work_ = elastic;
+    damping_work_ = 0.0;
+    kinetic_ = 0.0;
+  }
+
+  // The books (over all processes: collective), with the elastic energy now
+  // held and the energy the fracture released (this process's shares).
+  EnergyReport report(const Domain& domain, const Sum& elastic, const Sum& released) const {
+    std::array<double, 7> total{};
+    if constexpr (distributed)
+      total = domain.totals(std::array<const Sum*, 7>{&kinetic_, &internal_, &previous_internal_, &external_work_,
+                                                      &damping_work_, &elastic, &released});
+    else
+      total = {kinetic_, internal_, previous_internal_, external_work_, damping_work_, elastic, released};
+    EnergyReport report;
+    report.kinetic = total[0];
+    report.internal = total[1];
+    report.elastic = total[5];
+    report.plastic_dissipation = total[1] - total[5];
+    report.external_work = total[3];
+    report.damping_work = total[4];
+    report.released_by_fracture = total[6];
+    report.balance_ = total[0] + 0.5 * (total[2] + total[1]) + total[4] - total[3];
+    return report;
+  }
+
+  // Checkpoints (solver/checkpoint.hpp): the books (distributed: this rank's
+  // accumulators, exactly). The per-particle terms and remembered velocities
+  // are rewritten by every step before use.
+  template <class Writer>
+  void save(Writer& out) const {
+    if constexpr (distributed) {
+      for (const Sum* sum : {&internal_, &previous_internal_, &external_work_, &damping_work_, &kinetic_})
+        out(sum->raw());
+    } else {
+      out(previous_internal_, internal_, external_work_, damping_work_, kinetic_);
+    }
+  }
+  template <class Reader>
+  void load(Reader& in) {
+    if constexpr (distributed) {
+      for (Sum* sum : {&internal_, &previous_internal_, &external_work_, &damping_work_, &kinetic_}) {
+        typename Sum::Raw raw{};
+        in(raw);
+        *sum = Sum::from_raw(raw);
+      }
+    } else {
+      in(previous_internal_, internal_, external_work_, damping_work_, kinetic_);
+    }
+  }
+
+  // Stops the run when the balance is lost (balance_lost), naming the
+  // particle of largest kinetic energy (ties: the lowest global id; over all
+  // processes, which decide alike on the reduced books). Collective.
+  void check_balance(const Domain& domain, const StepTime& at, const EnergyReport& e) const {
     if (!balance_lost(at, e, monitoring_, round_off_energy_)) return;
     const std::vector<double>& kinetic = terms_.kinetic();
     long long particle = -1;
-    double energy = 0.0;
-    if (!kinetic.empty()) {
-      const auto largest = std::max_element(kinetic.begin(), kinetic.end());
-      particle = largest - kinetic.begin();
-      energy = *largest;
-    }
-    detail::fail_unstable(at, balance_lost_message(e, particle, energy));
+    double energy = -1.0;
+    for (std::size_t i = 0; i < kinetic.size(); ++i)
+      if (kinetic[i] > energy) {
+        energy = kinetic[i];
+        particle = domain.global_of(i);
+      }
+    const std::pair<long long, double> largest = domain.largest({particle, energy});
+    detail::fail_unstable(at, balance_lost_message(e, largest.first, largest.first >= 0 ? largest.second : 0.0));
   }
 
  private:
   MonitoringOptions monitoring_;
   double round_off_energy_;
-  double previous_internal_energy_ = 0.0, internal_energy_ = 0.0;
-  double external_work_ = 0.0, damping_work_ = 0.0, kinetic_energy_ = 0.0;
+  Sum previous_internal_{}, internal_{}, external_work_{}, damping_work_{}, kinetic_{};
+  std::size_t owned_begin_ = 0, owned_end_ = 0;
   ParticleEnergyTerms terms_;
 };
 

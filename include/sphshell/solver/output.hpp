@@ -50,7 +50,9 @@
 #include <sphshell/io/output_directory.hpp>
 #include <sphshell/io/pvd_collection.hpp>
 #include <sphshell/io/vtu_writer.hpp>
+#include <sphshell/solver/integration_points.hpp>
 #include <sphshell/solver/options.hpp>
+#include <sphshell/solver/particles.hpp>
 #include <sphshell/solver/section_states.hpp>
 
 #include <algorithm>
@@ -145,6 +147,9 @@ struct StressPointProbe {
   }
 };
 
+template <class Solver>
+class FramePiece;
+
 // Holds the schedule and the open files; every member that reads the run takes
 // the solver (any type with the Solver's public accessors).
 template <int OutputPoints>
@@ -172,6 +177,9 @@ class SolverOutput {
       lock_ = std::make_unique<io::DirectoryLock>(options_.output_directory, "output_directory");
     }
   }
+
+  // Probes added before a checkpoint is loaded continue their files from it.
+  void check_can_load() const {}
 
   // A probe on a file a loaded checkpoint recorded continues that file (no
   // header, no row now: the file has both).
@@ -326,10 +334,10 @@ class SolverOutput {
     const std::string stress_file = series_path("stress_points_" + std::string(number) + ".vtu");
     const std::string crack_file = series_path("cracks_" + std::string(number) + ".vtu");
     const io::VtuFormat format{options_.frame_encoding, options_.frame_precision};
-    const FramePoints points = frame_points(solver);
-    io::write_vtu(particle_file, particle_grid(solver, points), format);
-    io::write_vtu(stress_file, stress_point_grid(solver, points), format);
-    if constexpr (with_cracks) io::write_vtu(crack_file, crack_grid(solver), format);
+    const FramePiece<Solver> piece(solver, options_.frame_coordinates);
+    io::write_vtu(particle_file, piece.particle_grid(), format);
+    io::write_vtu(stress_file, piece.stress_point_grid(), format);
+    if constexpr (with_cracks) io::write_vtu(crack_file, piece.crack_grid(), format);
     // Every file of the frame is complete before any collection lists it.
     particle_collection_->stage(solver.time(), particle_file);
     stress_point_collection_->stage(solver.time(), stress_file);
@@ -494,17 +502,6 @@ class SolverOutput {
     for (const fs::path& file : later) io::remove_file(file.string());
   }
 
-  // The points of a frame and what was added to the reference to get them,
-  // and how each stress point is drawn: the active ones whose cell no crack
-  // cuts as that cell (`drawn`), the active ones whose cell a crack cuts as a
-  // vertex at the stress point (`cut`), both in index order.
-  struct FramePoints {
-    std::vector<Vector3> particles;
-    std::vector<Vector3> particle_displacement;
-    std::vector<int> drawn;
-    std::vector<int> cut;
-  };
-
   bool writes_frames() const { return !options_.output_directory.empty() && options_.output_interval > 0.0; }
   bool deformed() const { return options_.frame_coordinates == FrameCoordinates::deformed; }
 
@@ -552,208 +549,20 @@ class SolverOutput {
     open.file.write_row(std::visit([&](const auto& probe) { return probe.row(solver); }, open.probe));
   }
 
-  static io::PointField vector_field(const std::string& name, const std::vector<Vector3>& values) {
-    io::PointField field{name, 3, {}};
-    field.values.reserve(3 * values.size());
-    for (const Vector3& v : values) field.values.insert(field.values.end(), {v.x(), v.y(), v.z()});
-    return field;
-  }
-
-  std::string note(const std::string& what, double time) const {
+ public:
+  // The note at the top of a frame file: what it draws, at which time, and where its points sit.
+  static std::string frame_note(const std::string& what, double time, bool deformed) {
     std::ostringstream text;
     text.precision(17);
     text << "sphshell frame, t = " << time << " s: " << what << "\n     Points: "
-         << (deformed() ? "the deformed (current) positions. The point array displacement (current minus reference "
+         << (deformed ? "the deformed (current) positions. The point array displacement (current minus reference "
                           "position) is for colouring: Warp By Vector would apply it a second time."
                         : "the reference positions. Warp By Vector with the point array displacement (scale 1) "
                           "shows the deformed shell.");
     return text.str();
   }
 
-  template <class Solver>
-  FramePoints frame_points(const Solver& solver) const {
-    const std::size_t n = solver.particle_count();
-    FramePoints points;
-    points.particle_displacement.resize(n);
-    for (std::size_t i = 0; i < n; ++i) points.particle_displacement[i] = solver.displacement(static_cast<int>(i));
-    points.particles = deformed() ? solver.positions() : solver.model().particle_position;
-    const bool with_cells = !solver.model().cells().empty();
-    for (std::size_t p = 0; p < solver.stress_point_count(); ++p) {
-      const int s = static_cast<int>(p);
-      if (solver.is_removed(s)) continue;
-      (with_cells && is_cut(solver, p) ? points.cut : points.drawn).push_back(s);
-    }
-    return points;
-  }
-
-  // Whether a crack runs through stress point p's cell: p no longer sees one
-  // of its corners (the crack policy's visibility, in the reference
-  // configuration, as for the shape functions). Drawn whole, such a cell
-  // would bridge the crack, a slit between particle rows would not show.
-  template <class Solver>
-  static bool is_cut(const Solver& solver, std::size_t p) {
-    if constexpr (Solver::crack_type::enabled) {
-      const auto& crack = solver.crack();
-      if (crack.segments().empty()) return false;
-      const ShellModel& model = solver.model();
-      const TangentFrame frame = tangent_frame(model.stress_point_normal[p]);
-      for (const int corner : model.cells()[p])
-        if (!crack.visible(model.stress_point_position[p], model.particle_position[std::size_t(corner)], frame))
-          return true;
-    }
-    (void)solver;
-    (void)p;
-    return false;
-  }
-
-  // The drawn stress points' cells (triangles, quads) over the particles.
-  template <class Solver>
-  static void add_drawn_cells(const Solver& solver, const FramePoints& points, io::VtuCells& cells,
-                              std::vector<char>* covered) {
-    const std::vector<Cell>& model_cells = solver.model().cells();
-    for (const int s : points.drawn) {
-      const Cell& cell = model_cells[std::size_t(s)];
-      cells.add_polygon(cell.begin(), cell.end());
-      if (covered)
-        for (const int corner : cell) (*covered)[std::size_t(corner)] = 1;
-    }
-  }
-
-  template <class Solver>
-  io::VtuGrid particle_grid(const Solver& solver, const FramePoints& points) const {
-    const std::size_t n = solver.particle_count();
-    io::VtuGrid grid;
-    grid.time = solver.time();
-    grid.points = points.particles;
-    std::vector<char> covered(n, 0);
-    if (!solver.model().cells().empty()) add_drawn_cells(solver, points, grid.cells, &covered);
-    for (std::size_t i = 0; i < n; ++i)
-      if (!covered[i]) grid.cells.add_vertex(static_cast<int>(i));
-    std::vector<Vector3> rotation_values(n);
-    for (std::size_t i = 0; i < n; ++i) rotation_values[i] = solver.rotation(static_cast<int>(i));
-    grid.point_fields = {vector_field("displacement", points.particle_displacement),
-                         vector_field("velocity", solver.velocities()), vector_field("rotation", rotation_values),
-                         vector_field("director", solver.directors())};
-    if constexpr (Solver::crack_type::enabled) {
-      io::PointField fragment{"fragment", 1, {}, {}, io::FieldValues::integer};
-      for (std::size_t i = 0; i < n; ++i) fragment.values.push_back(solver.is_fragment(static_cast<int>(i)) ? 1 : 0);
-      grid.point_fields.push_back(fragment);
-    }
-    grid.note = note(solver.model().cells().empty()
-                         ? "the particles, one vertex cell each (the model has no cells)."
-                         : "the particles with the cells of the active stress points over them, but for cells a "
-                           "crack cuts (a particle no such cell holds is a vertex cell); particle data as point "
-                           "data.",
-                     solver.time());
-    return grid;
-  }
-
-  // Per active stress point: one array per integral-point quantity with a
-  // component per thickness output point (named by position, ζ ascending),
-  // the resultants, the wall thickness and the stress point's index.
-  template <class Solver>
-  io::VtuGrid stress_point_grid(const Solver& solver, const FramePoints& points) const {
-    const std::size_t m = solver.stress_point_count();
-    const ShellModel& model = solver.model();
-    const bool with_cells = !model.cells().empty();
-    io::VtuGrid grid;
-    grid.time = solver.time();
-    // Cell data follow the cells: the drawn stress points, then the cut ones.
-    std::vector<int> active = points.drawn;
-    active.insert(active.end(), points.cut.begin(), points.cut.end());
-    const std::vector<Vector3> current = solver.stress_point_positions();
-    if (with_cells) {
-      grid.points = points.particles;
-      add_drawn_cells(solver, points, grid.cells, nullptr);
-      std::vector<Vector3> displacement = points.particle_displacement;
-      for (const int s : points.cut) {
-        grid.cells.add_vertex(static_cast<int>(grid.points.size()));
-        grid.points.push_back(deformed() ? current[std::size_t(s)] : model.stress_point_position[std::size_t(s)]);
-        displacement.push_back(current[std::size_t(s)] - model.stress_point_position[std::size_t(s)]);
-      }
-      grid.point_fields = {vector_field("displacement", displacement)};
-    } else {
-      std::vector<Vector3> displacement(m);
-      for (std::size_t s = 0; s < m; ++s) displacement[s] = current[s] - model.stress_point_position[s];
-      grid.points = deformed() ? current : model.stress_point_position;
-      for (const int s : active) grid.cells.add_vertex(s);
-      grid.point_fields = {vector_field("displacement", displacement)};
-    }
-    const std::vector<std::string> names = thickness_point_names<typename Solver::rule_type>();
-    for (const IntegralPointQuantityInfo& info : integral_point_quantities) {
-      if (info.needs_damage_law && !Solver::material_type::has_damage) continue;
-      io::CellField field{info.name, output_points, {}, names};
-      field.values.reserve(active.size() * output_points);
-      for (const int s : active)
-        for (int k = 0; k < output_points; ++k) field.values.push_back(solver.integral_point_quantity(info.quantity, s, k));
-      grid.cell_fields.push_back(std::move(field));
-    }
-    io::CellField membrane{"membrane_force", 3, {}, {"Nxx", "Nyy", "Nxy"}};
-    io::CellField moment{"bending_moment", 3, {}, {"Mxx", "Myy", "Mxy"}};
-    io::CellField thickness{"thickness", 1, {}};
-    io::CellField index{"stress_point", 1, {}, {}, io::FieldValues::integer};
-    for (const int s : active) {
-      for (int c = 0; c < 3; ++c) {
-        membrane.values.push_back(solver.membrane_force(s)[c]);
-        moment.values.push_back(solver.bending_moment(s)[c]);
-      }
-      thickness.values.push_back(model.stress_point_thickness(std::size_t(s)));
-      index.values.push_back(s);
-    }
-    grid.cell_fields.push_back(std::move(membrane));
-    grid.cell_fields.push_back(std::move(moment));
-    grid.cell_fields.push_back(std::move(thickness));
-    grid.cell_fields.push_back(std::move(index));
-    const std::string heights =
-        " Through-thickness points are named by their height zeta along the director as a fraction of the wall "
-        "thickness d: bottom (zeta < 0, the side the director points away from) to top (zeta > 0).";
-    grid.note = note((with_cells ? std::string("one cell per active stress point over its corner particles (the "
-                                               "first points are the particles); a removed stress point has no "
-                                               "cell, so cracks show as gaps; a stress point whose cell a crack "
-                                               "cuts is a vertex cell at its own position (points after the "
-                                               "particles), so slits show too; stress-point data as cell data.")
-                                 : std::string("the stress points, a vertex cell per active one (the model has no "
-                                               "cells); stress-point data as cell data.")) +
-                         heights,
-                     solver.time());
-    return grid;
-  }
-
-  // The crack segments as a line set: a damaged stress point's crack point
-  // follows the interpolated motion of the stress point, a pre-crack point the
-  // displacement of its nearest particle.
-  template <class Solver>
-  io::VtuGrid crack_grid(const Solver& solver) const {
-    const auto& crack = solver.crack();
-    const std::vector<Vector3>& reference = crack.points();
-    std::vector<Vector3> current(reference.size());
-    std::vector<char> placed(reference.size(), 0);
-    const std::vector<Vector3> stress_positions = solver.stress_point_positions();
-    for (std::size_t p = 0; p < solver.stress_point_count(); ++p) {
-      const int k = crack.crack_point_of_stress_point(static_cast<int>(p));
-      if (k >= 0) {
-        current[k] = stress_positions[p];
-        placed[k] = 1;
-      }
-    }
-    for (std::size_t k = 0; k < current.size(); ++k)
-      if (!placed[k]) current[k] = reference[k] + solver.displacement(solver.model().nearest_particle(reference[k]));
-    std::vector<Vector3> displacement(reference.size());
-    for (std::size_t k = 0; k < reference.size(); ++k) displacement[k] = current[k] - reference[k];
-    io::VtuGrid grid;
-    grid.time = solver.time();
-    grid.points = deformed() ? current : reference;
-    io::CellField crack_id{"crack_id", 1, {}, {}, io::FieldValues::integer};
-    for (const auto& segment : crack.segments()) {
-      grid.cells.add_line(segment.start_point, segment.end_point);
-      crack_id.values.push_back(segment.crack_id);
-    }
-    grid.point_fields = {vector_field("displacement", displacement)};
-    grid.cell_fields = {crack_id};
-    grid.note = note("the crack segments as lines (crack_id per segment).", solver.time());
-    return grid;
-  }
-
+ private:
   OutputOptions options_;
   std::ostream* notes_ = nullptr;
   std::string directory_key_;                // identity_of(output_directory), "" without one
@@ -765,6 +574,252 @@ class SolverOutput {
   double next_frame_time_ = 0.0;
   double next_probe_time_ = 0.0;
   std::vector<ProbeRecord> restored_probes_;  // probe files of a loaded checkpoint, not yet added again
+};
+
+
+// The grids of one frame drawn from a solver's share (solver.hpp; the
+// Solver's friend): this process's particles and the active stress points
+// it owns, serially all of them; a distributed run writes one piece per
+// process (mpi/distributed_output.hpp). The shell is drawn as its cells
+// (ShellModel::cells()), corners numbered in the piece's particles (a
+// piece's particles are the process's local ones: owned, then ghosts, so a
+// cell at the share's edge has its corners), with cracks as gaps (see the
+// header comment).
+template <class Solver>
+class FramePiece {
+ public:
+  FramePiece(const Solver& solver, FrameCoordinates coordinates)
+      : s_(solver), deformed_(coordinates == FrameCoordinates::deformed) {
+    const ShellModel& model = s_.model();
+    with_cells_ = !model.cells().empty();
+    for (const std::size_t row : s_.domain_.owned_stress_rows()) {
+      const Drawn point{s_.domain_.global_stress_point(row), row,
+                        s_.points_->point(PointGroup::stress_points, row)};
+      owned_.push_back(point);
+      if (!s_.states_->active(point.point)) continue;
+      (with_cells_ && (is_cut(point.stress_point) || !corners_local(point.stress_point)) ? cut_ : drawn_)
+          .push_back(point);
+    }
+    const std::size_t n = s_.domain_.local_count();
+    particles_.resize(n);
+    displacement_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      displacement_[i] = s_.particles_.position[i] - s_.reference_position_[i];
+      particles_[i] = deformed_ ? s_.particles_.position[i] : s_.reference_position_[i];
+    }
+  }
+
+  // The particles with the cells of the drawn stress points over them (a
+  // particle it owns that no drawn cell holds is a vertex cell), particle
+  // data as point data; distributed, with each point's global_id.
+  io::VtuGrid particle_grid() const {
+    const std::size_t n = particles_.size();
+    io::VtuGrid grid;
+    grid.time = s_.time();
+    grid.points = particles_;
+    std::vector<char> covered(n, 0);
+    if (with_cells_) add_drawn_cells(grid.cells, &covered);
+    for (std::size_t i = 0; i < s_.domain_.owned_count(); ++i)
+      if (!covered[i]) grid.cells.add_vertex(static_cast<int>(i));
+    std::vector<Vector3> rotation(n);
+    for (std::size_t i = 0; i < n; ++i)
+      rotation[i] = rotation_vector(s_.reference_normal_[i], s_.particles_.director[i]);
+    grid.point_fields = {vector_field("displacement", displacement_),
+                         vector_field("velocity", s_.particles_.velocity), vector_field("rotation", rotation),
+                         vector_field("director", s_.particles_.director)};
+    if constexpr (Solver::crack_type::enabled) {
+      io::PointField fragment{"fragment", 1, {}, {}, io::FieldValues::integer};
+      for (std::size_t i = 0; i < n; ++i)
+        fragment.values.push_back(s_.fracture_.is_fragment(static_cast<std::size_t>(s_.domain_.global_of(i))) ? 1 : 0);
+      grid.point_fields.push_back(fragment);
+    }
+    if constexpr (Solver::domain_type::is_distributed) {
+      io::PointField id{"global_id", 1, {}, {}, io::FieldValues::integer};
+      for (std::size_t i = 0; i < n; ++i) id.values.push_back(s_.domain_.global_of(i));
+      grid.point_fields.push_back(id);
+    }
+    grid.note = note(with_cells_ ? "the particles with the cells of the active stress points over them, but for cells "
+                                   "a crack cuts (a particle no such cell holds is a vertex cell); particle data as "
+                                   "point data."
+                                 : "the particles, one vertex cell each (the model has no cells).");
+    return grid;
+  }
+
+  // Per active stress point: one array per integral-point quantity with a
+  // component per thickness output point (named by position, ζ ascending),
+  // the resultants, the wall thickness and the stress point's index.
+  io::VtuGrid stress_point_grid() const {
+    const ShellModel& model = s_.model();
+    io::VtuGrid grid;
+    grid.time = s_.time();
+    // Cell data follow the cells: the drawn stress points, then the cut ones.
+    std::vector<Drawn> active = drawn_;
+    active.insert(active.end(), cut_.begin(), cut_.end());
+    if (with_cells_) {
+      grid.points = particles_;
+      add_drawn_cells(grid.cells, nullptr);
+      std::vector<Vector3> displacement = displacement_;
+      for (const Drawn& point : cut_) {
+        const Vector3 current = s_.stress_point_position(point.row);
+        const Vector3& reference = model.stress_point_position[point.stress_point];
+        grid.cells.add_vertex(static_cast<int>(grid.points.size()));
+        grid.points.push_back(deformed_ ? current : reference);
+        displacement.push_back(current - reference);
+      }
+      grid.point_fields = {vector_field("displacement", displacement)};
+    } else {
+      // The stress points it owns, removed ones too; a vertex cell at each active one.
+      std::vector<Vector3> displacement;
+      for (std::size_t k = 0; k < owned_.size(); ++k) {
+        const Vector3 current = s_.stress_point_position(owned_[k].row);
+        const Vector3& reference = model.stress_point_position[owned_[k].stress_point];
+        grid.points.push_back(deformed_ ? current : reference);
+        displacement.push_back(current - reference);
+        if (s_.states_->active(owned_[k].point)) grid.cells.add_vertex(static_cast<int>(k));
+      }
+      grid.point_fields = {vector_field("displacement", displacement)};
+    }
+    constexpr int output_points = Solver::output_points;
+    const std::vector<std::string> names = thickness_point_names<typename Solver::rule_type>();
+    for (const IntegralPointQuantityInfo& info : integral_point_quantities) {
+      if (info.needs_damage_law && !Solver::material_type::has_damage) continue;
+      io::CellField field{info.name, output_points, {}, names};
+      field.values.reserve(active.size() * output_points);
+      for (const Drawn& point : active)
+        for (int k = 0; k < output_points; ++k) field.values.push_back(s_.states_->quantity(info.quantity, point.point, k));
+      grid.cell_fields.push_back(std::move(field));
+    }
+    io::CellField membrane{"membrane_force", 3, {}, {"Nxx", "Nyy", "Nxy"}};
+    io::CellField moment{"bending_moment", 3, {}, {"Mxx", "Myy", "Mxy"}};
+    io::CellField thickness{"thickness", 1, {}};
+    io::CellField index{"stress_point", 1, {}, {}, io::FieldValues::integer};
+    for (const Drawn& point : active) {
+      for (int c = 0; c < 3; ++c) {
+        membrane.values.push_back(s_.states_->membrane_force(point.point)[c]);
+        moment.values.push_back(s_.states_->bending_moment(point.point)[c]);
+      }
+      thickness.values.push_back(model.stress_point_thickness(point.stress_point));
+      index.values.push_back(static_cast<int>(point.stress_point));
+    }
+    grid.cell_fields.push_back(std::move(membrane));
+    grid.cell_fields.push_back(std::move(moment));
+    grid.cell_fields.push_back(std::move(thickness));
+    grid.cell_fields.push_back(std::move(index));
+    const std::string heights =
+        " Through-thickness points are named by their height zeta along the director as a fraction of the wall "
+        "thickness d: bottom (zeta < 0, the side the director points away from) to top (zeta > 0).";
+    grid.note = note((with_cells_ ? std::string("one cell per active stress point over its corner particles (the "
+                                                "first points are the particles); a removed stress point has no "
+                                                "cell, so cracks show as gaps; a stress point whose cell a crack "
+                                                "cuts is a vertex cell at its own position (points after the "
+                                                "particles), so slits show too; stress-point data as cell data.")
+                                  : std::string("the stress points, a vertex cell per active one (the model has no "
+                                                "cells); stress-point data as cell data.")) +
+                     heights);
+    return grid;
+  }
+
+  // The crack segments as a line set, whole (collective; a distributed run's
+  // process 0 writes it): a damaged stress point's crack point follows the
+  // interpolated motion of the stress point, a pre-crack point the
+  // displacement of its nearest particle; their owners place them.
+  io::VtuGrid crack_grid() const {
+    const auto& crack = s_.crack();
+    const ShellModel& model = s_.model();
+    const std::vector<Vector3>& reference = crack.points();
+    std::vector<std::pair<std::size_t, Vector3>> mine;
+    std::vector<char> from_stress_point(reference.size(), 0);
+    for (std::size_t q = 0; q < model.stress_point_count(); ++q) {
+      const int k = crack.crack_point_of_stress_point(static_cast<int>(q));
+      if (k >= 0) from_stress_point[static_cast<std::size_t>(k)] = 1;
+    }
+    for (const Drawn& point : owned_) {
+      const int k = crack.crack_point_of_stress_point(static_cast<int>(point.stress_point));
+      if (k >= 0) mine.push_back({static_cast<std::size_t>(k), s_.stress_point_position(point.row)});
+    }
+    for (std::size_t k = 0; k < reference.size(); ++k) {
+      if (from_stress_point[k]) continue;
+      const int nearest = model.nearest_particle(reference[k]);
+      if (!s_.domain_.owns(nearest)) continue;
+      const auto i = static_cast<std::size_t>(s_.domain_.local_of(static_cast<std::size_t>(nearest)));
+      mine.push_back({k, reference[k] + displacement_[i]});
+    }
+    const std::vector<Vector3> current = s_.domain_.assembled(reference.size(), mine);
+    std::vector<Vector3> displacement(reference.size());
+    for (std::size_t k = 0; k < reference.size(); ++k) displacement[k] = current[k] - reference[k];
+    io::VtuGrid grid;
+    grid.time = s_.time();
+    grid.points = deformed_ ? current : reference;
+    io::CellField crack_id{"crack_id", 1, {}, {}, io::FieldValues::integer};
+    for (const auto& segment : crack.segments()) {
+      grid.cells.add_line(segment.start_point, segment.end_point);
+      crack_id.values.push_back(segment.crack_id);
+    }
+    grid.point_fields = {vector_field("displacement", displacement)};
+    grid.cell_fields = {crack_id};
+    grid.note = note("the crack segments as lines (crack_id per segment).");
+    return grid;
+  }
+
+ private:
+  // A stress point of the piece: its index, its local stress-point row and its local point.
+  struct Drawn {
+    std::size_t stress_point, row, point;
+  };
+
+  std::string note(const std::string& what) const {
+    return SolverOutput<Solver::output_points>::frame_note(what, s_.time(), deformed_);
+  }
+  static io::PointField vector_field(const std::string& name, const std::vector<Vector3>& values) {
+    io::PointField field{name, 3, {}};
+    field.values.reserve(3 * values.size());
+    for (const Vector3& v : values) field.values.insert(field.values.end(), {v.x(), v.y(), v.z()});
+    return field;
+  }
+
+  // Whether a crack runs through stress point q's cell: q no longer sees one
+  // of its corners (the crack policy's visibility, in the reference
+  // configuration, as for the shape functions). Drawn whole, such a cell
+  // would bridge the crack, a slit between particle rows would not show.
+  bool is_cut(std::size_t q) const {
+    if constexpr (Solver::crack_type::enabled) {
+      const auto& crack = s_.crack();
+      if (crack.segments().empty()) return false;
+      const ShellModel& model = s_.model();
+      const TangentFrame frame = tangent_frame(model.stress_point_normal[q]);
+      for (const int corner : model.cells()[q])
+        if (!crack.visible(model.stress_point_position[q], model.particle_position[std::size_t(corner)], frame))
+          return true;
+    }
+    (void)q;
+    return false;
+  }
+  // Whether every corner of q's cell is a particle of the piece (always, serially).
+  bool corners_local(std::size_t q) const {
+    for (const int corner : s_.model().cells()[q])
+      if (s_.domain_.local_of(static_cast<std::size_t>(corner)) < 0) return false;
+    return true;
+  }
+  // The drawn stress points' cells (triangles, quads) over the piece's particles.
+  void add_drawn_cells(io::VtuCells& cells, std::vector<char>* covered) const {
+    const std::vector<Cell>& model_cells = s_.model().cells();
+    for (const Drawn& point : drawn_) {
+      const Cell& cell = model_cells[point.stress_point];
+      std::array<int, 4> corners{};
+      for (std::size_t c = 0; c < cell.size(); ++c)
+        corners[c] = static_cast<int>(s_.domain_.local_of(static_cast<std::size_t>(cell[c])));
+      const int* end = corners.data() + cell.size();
+      cells.add_polygon(corners.data(), end);
+      if (covered)
+        for (const int* corner = corners.data(); corner != end; ++corner) (*covered)[std::size_t(*corner)] = 1;
+    }
+  }
+
+  const Solver& s_;
+  bool deformed_;
+  bool with_cells_ = false;
+  std::vector<Drawn> owned_, drawn_, cut_;
+  std::vector<Vector3> particles_, displacement_;
 };
 
 }  // namespace sphshell::solver
