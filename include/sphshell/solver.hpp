@@ -288,6 +288,8 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
           forces_.external[i] *= load_factor;
           forces_.external_moment[i] *= load_factor;
         }
+        // Equilibrium is quasi-static: no strain rate (rate-dependent laws at their static limit).
+        assembler_->set_time_step(std::numeric_limits<double>::infinity());
         assembler_->compute(now(), particles_, *points_, *states_, forces_);
       };
       auto save = [&] {
@@ -458,6 +460,8 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
   // failing point stops every process with its global index.
   void compute_internal_forces(Packing packing = Packing::needed) {
     domain_.exchange({&particles_.position, &particles_.director});
+    // The strain increments of this pass span one step (rate-dependent laws).
+    assembler_->set_time_step(time_step_);
     std::optional<domain::Failure> failure;
     try {
       if (packing == Packing::done_by_particle_pass)

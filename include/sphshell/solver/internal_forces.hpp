@@ -184,9 +184,9 @@ class InternalForceAssembler {
 
   // The time step that the strain increments of the next compute() span,
   // passed to rate-dependent laws (material.hpp, UpdateContext); other laws
-  // never read it. Set by the particle pass that moved the particles
-  // (solver/particle_pass.hpp) before every step's compute_packed(); until
-  // then it is NaN, which a rate-dependent law refuses as soon as it flows.
+  // never read it. The Solver sets it before every force pass: the step's
+  // Δt, or infinity for a static solution (quasi-static, no strain rate).
+  // Until then it is NaN, which a rate-dependent law refuses as soon as it flows.
   void set_time_step(double time_step) { update_context_.time_step = time_step; }
   double time_step() const { return update_context_.time_step; }
 
@@ -199,7 +199,8 @@ class InternalForceAssembler {
   std::size_t failed_point() const { return failed_point_; }
 
   // Work of the generalized stresses over the last update, per point (zero
-  // for inactive points), for the distributed ledger (mpi/distributed_ledger.hpp).
+  // for inactive points): a distributed run books the owned points' exactly
+  // (solver/energy_ledger.hpp, EnergyBooks).
   const std::vector<double>& work_increments() const { return work_increment_; }
 
   // Strains of point p's current gradients against its reference (the

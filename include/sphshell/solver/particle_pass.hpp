@@ -64,12 +64,7 @@ struct ParticlePass {
     if (loads_in_pass) loads.start_step(context.at.time);
     constraints.prepare();
     ledger.start_step(particles);
-    if (packer) {
-      packer->start_packing(particles.size());
-      // The configuration moves by one time step here: the strain increments
-      // of the force pass that follows span it (rate-dependent laws).
-      packer->set_time_step(time_step);
-    }
+    if (packer) packer->start_packing(particles.size());
     const std::size_t end = particles.ranges.owned_end;
     std::atomic<std::size_t> load_failure{end}, state_failure{end};
     std::mutex condition_mutex;
