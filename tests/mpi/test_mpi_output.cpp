@@ -103,9 +103,25 @@ TEST_CASE("Distributed frames and probes", "[mpi][output]") {
     CHECK_THROWS_WITH(distributed.add_stress_point_probe(directory + "/other.csv",
                                                          static_cast<int>(model.stress_point_count())),
                       Catch::Contains("stress point index"));
+    // A probe on a file the run writes itself (a frame's piece, a .pvtu, a
+    // collection, the lock file) is an Error on every rank.
+    for (const std::string frame_like : {"particles_000001_r0.vtu", "stress_points_000002.pvtu", "particles.pvd",
+                                         ".sphshell.lock"})
+      CHECK_THROWS_WITH(distributed.add_particle_probe(distributed_options.output_directory + "/" + frame_like, 3),
+                        Catch::Contains("output_directory") && Catch::Contains("give the probe a file of its own"));
     // The folder is this solver's while it lives: a second one there is an Error on every rank.
     CHECK_THROWS_WITH(Distributed(comm, model, {210e9, 0.3}, distributed_options),
                       Catch::Contains(distributed_options.output_directory) && Catch::Contains("in use"));
+    {
+      // A probe on any rank's checkpoint file (checkpoint_path + ".rank<r>") is an Error on every rank.
+      SolverOptions checkpointed = options;
+      checkpointed.checkpoint_path = directory + "/run.ckpt";
+      checkpointed.checkpoint_every_steps = 10;
+      Distributed other(comm, model, {210e9, 0.3}, checkpointed);
+      const std::string last_rank = std::to_string(comm.size() - 1);
+      CHECK_THROWS_WITH(other.add_particle_probe(checkpointed.checkpoint_path + ".rank" + last_rank, 3),
+                        Catch::Contains("is rank " + last_rank + "'s checkpoint file"));
+    }
     distributed.run_until(end_time);
     CHECK(distributed.positions() == serial_positions);
   }

@@ -6,7 +6,9 @@
 #include <sphshell/approx/mls.hpp>
 #include <sphshell/kernel/cubic_spline.hpp>
 #include <sphshell/material/elastic.hpp>
+#include <sphshell/material/cowper_symonds.hpp>
 #include <sphshell/material/j2_plasticity.hpp>
+#include <sphshell/material/johnson_cook.hpp>
 #include <sphshell/mpi/distributed_solver.hpp>
 #include <sphshell/shell/spherical_cap_ogrid.hpp>
 #include <sphshell/solver.hpp>
@@ -136,6 +138,31 @@ TEST_CASE("Distributed plate, J2 plasticity: bitwise the serial Solver", "[mpi][
       [](Serial<material::J2Plasticity>& s) { clamped_pressure(s, 5e6); },
       [](Distributed<material::J2Plasticity>& s) { clamped_pressure(s, 5e6); }, &plastic);
   CHECK(plastic > 0.0);  // the plate yielded
+}
+
+TEST_CASE("Distributed plate, rate-dependent laws: bitwise the serial Solver", "[mpi][solver][rate]") {
+  // The step's time step reaches the laws on every rank as it does serially:
+  // Johnson-Cook with adiabatic heating, and Cowper-Symonds.
+  SolverOptions options;
+  options.density = 7850.0;
+  material::JohnsonCook::Parameters johnson_cook{steel_E, steel_nu, steel_yield, 500e6, 0.3, 0.014, 1.0, 1.0,
+                                                 293.0, 1793.0, 293.0};
+  johnson_cook.taylor_quinney = 0.9;
+  johnson_cook.density = 7850.0;
+  johnson_cook.specific_heat = 477.0;
+  johnson_cook.D1 = 10.0;  // no failure within the run
+  double plastic = 0.0;
+  compare_runs<material::JohnsonCook>(
+      "plate 21x21 Johnson-Cook", plate(), johnson_cook, options, 300,
+      [](Serial<material::JohnsonCook>& s) { clamped_pressure(s, 5e6); },
+      [](Distributed<material::JohnsonCook>& s) { clamped_pressure(s, 5e6); }, &plastic);
+  CHECK(plastic > 0.0);
+  plastic = 0.0;
+  compare_runs<material::CowperSymonds>(
+      "plate 21x21 Cowper-Symonds", plate(), {steel_E, steel_nu, steel_yield, steel_Ep, 40.4, 5.0}, options, 300,
+      [](Serial<material::CowperSymonds>& s) { clamped_pressure(s, 5e6); },
+      [](Distributed<material::CowperSymonds>& s) { clamped_pressure(s, 5e6); }, &plastic);
+  CHECK(plastic > 0.0);
 }
 
 TEST_CASE("Distributed conditions and loads of every kind, by set name: bitwise the serial Solver",

@@ -38,6 +38,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -130,6 +131,27 @@ class DistributedFrames {
   }
 
   std::string path(const std::string& file) const { return options_.output_directory + "/" + file; }
+  // What a file would be to this output directory: a frame's piece or
+  // parallel file, a collection ("particles…", "stress_points…" or
+  // "cracks…" ending in .vtu, .pvtu or .pvd, or those with .tmp), or the
+  // lock file; "" for none of them.
+  std::string file_use(const std::string& file_path) const {
+    if (!enabled()) return "";
+    const std::filesystem::path file(io::identity_of(file_path));
+    if (file.parent_path().string() != io::identity_of(options_.output_directory)) return "";
+    std::string name = file.filename().string();
+    if (name == io::DirectoryLock::file_name)
+      return "the lock file of output_directory '" + options_.output_directory + "'";
+    auto ends_with = [&](const std::string& tail) {
+      return name.size() >= tail.size() && name.compare(name.size() - tail.size(), tail.size(), tail) == 0;
+    };
+    if (ends_with(".tmp")) name.resize(name.size() - 4);
+    for (const std::string series : {"particles", "stress_points", "cracks"})
+      if (name.compare(0, series.size(), series) == 0 && (ends_with(".vtu") || ends_with(".pvtu") || ends_with(".pvd")))
+        return "named like a frame file (a piece, a .pvtu or a collection of the series) of output_directory '" +
+               options_.output_directory + "'";
+    return "";
+  }
   static std::string frame_number(long frame) {
     char number[32];
     std::snprintf(number, sizeof number, "%06ld", frame);
@@ -245,6 +267,20 @@ class DistributedOutput {
       if (open.path == csv_path)
         throw Error("sphshell: probe file '" + csv_path + "' is already the file of another probe; give each probe "
                     "a file of its own");
+    // Files the run writes itself: every rank's checkpoint file and the frames.
+    const std::string key = io::identity_of(csv_path);
+    if (!options_.checkpoint_path.empty())
+      for (int rank = 0; rank < solver.domain_.size(); ++rank) {
+        const std::string checkpoint =
+            std::decay_t<decltype(solver.domain_)>::checkpoint_file_of(options_.checkpoint_path, rank);
+        if (key == io::identity_of(checkpoint))
+          throw Error("sphshell: probe file '" + csv_path + "' is rank " + std::to_string(rank) +
+                      "'s checkpoint file '" + checkpoint + "' (checkpoint_path '" + options_.checkpoint_path +
+                      "'; the checkpoint would replace it); give the probe a file of its own");
+      }
+    const std::string use = frames_.file_use(csv_path);
+    if (!use.empty())
+      throw Error("sphshell: probe file '" + csv_path + "' is " + use + "; give the probe a file of its own");
     DistributedProbe added;
     added.path = csv_path;
     if constexpr (std::is_same_v<Probe, StressProbe>) {

@@ -232,7 +232,11 @@ class Domain {
   bool first_process_decides(bool value) const {
     return comm_->all_gather(static_cast<char>(value ? 1 : 0)).front() != 0;
   }
-  std::string checkpoint_file(const std::string& path) const { return path + ".rank" + std::to_string(rank()); }
+  std::string checkpoint_file(const std::string& path) const { return checkpoint_file_of(path, rank()); }
+  // The file of checkpoint `path` that process `process` writes and reads.
+  static std::string checkpoint_file_of(const std::string& path, int process) {
+    return path + ".rank" + std::to_string(process);
+  }
 
   // The ghosts' copies of the given per-particle fields, from their owners.
   void exchange(const std::vector<std::vector<Vector3>*>& fields) {
