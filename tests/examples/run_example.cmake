@@ -6,13 +6,16 @@
 # (and write nothing).
 # EXPECT_AT_LEAST lists pairs "text|minimum": the output must hold a line
 # "text <number>" with number ≥ minimum.
-# EXPECT_OUTPUT lists texts that standard output must contain.
+# EXPECT_OUTPUT lists texts that standard output must contain, FORBID_OUTPUT
+# texts it must not contain, EXPECT_ERRORS texts standard error must contain
+# (results on stdout, progress on stderr).
 # EXPECT_HELP lists the options --help must describe, as "--name" or
 # "--name=default": the help must list exactly these (besides -h, --help),
 # each with "(default: ...)", that default when given.
 #   cmake -DEXAMPLE=<exe> -DARGUMENTS="a|b|c" -DWORK_DIR=<dir> -DOUTPUTS="x.csv|y.svg"
 #         [-DEXPECT_ERROR=text] [-DEXPECT_AT_LEAST="text|minimum|..."]
-#         [-DEXPECT_OUTPUT="text|..."] [-DEXPECT_HELP="--a=1|--b|..."] -P run_example.cmake
+#         [-DEXPECT_OUTPUT="text|..."] [-DFORBID_OUTPUT="text|..."] [-DEXPECT_ERRORS="text|..."]
+#         [-DEXPECT_HELP="--a=1|--b|..."] -P run_example.cmake
 cmake_minimum_required(VERSION 3.16)  # IN_LIST, and the policies of the project
 string(REPLACE "|" ";" arguments "${ARGUMENTS}")
 string(REPLACE "|" ";" outputs "${OUTPUTS}")
@@ -57,6 +60,24 @@ if(DEFINED EXPECT_OUTPUT)
     string(FIND "${output}" "${text}" position)
     if(position EQUAL -1)
       message(FATAL_ERROR "${EXAMPLE} ${arguments} did not print '${text}'\n${output}")
+    endif()
+  endforeach()
+endif()
+if(DEFINED FORBID_OUTPUT)
+  string(REPLACE "|" ";" forbidden_texts "${FORBID_OUTPUT}")
+  foreach(text IN LISTS forbidden_texts)
+    string(FIND "${output}" "${text}" position)
+    if(NOT position EQUAL -1)
+      message(FATAL_ERROR "${EXAMPLE} ${arguments} printed '${text}' on standard output\n${output}")
+    endif()
+  endforeach()
+endif()
+if(DEFINED EXPECT_ERRORS)
+  string(REPLACE "|" ";" expected_texts "${EXPECT_ERRORS}")
+  foreach(text IN LISTS expected_texts)
+    string(FIND "${errors}" "${text}" position)
+    if(position EQUAL -1)
+      message(FATAL_ERROR "${EXAMPLE} ${arguments} did not print '${text}' on standard error\n${errors}")
     endif()
   endforeach()
 endif()
