@@ -14,6 +14,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 using namespace sphshell;
@@ -475,78 +476,38 @@ TEST_CASE("Rate-dependent laws: bad parameters are refused by name", "[material]
     INFO(expected);
     CHECK_THROWS_WITH(JohnsonCook(p), Catch::Contains(expected));
   };
-  JohnsonCook::Parameters p = steel_4340();
+  const JohnsonCook::Parameters p = steel_4340();
   CHECK_NOTHROW(JohnsonCook(p));
-  {
-    auto q = p;
-    q.A = 0.0;
-    refuses(q, "parameter A = 0");
-    q.A = -1.0;
-    refuses(q, "parameter A = -1");
+  using Change = void (*)(JohnsonCook::Parameters&);
+  const std::vector<std::pair<Change, const char*>> bad_parameters{
+      {[](JohnsonCook::Parameters& q) { q.A = 0.0; }, "parameter A = 0"},
+      {[](JohnsonCook::Parameters& q) { q.A = -1.0; }, "parameter A = -1"},
+      {[](JohnsonCook::Parameters& q) { q.B = -1.0; }, "parameter B = -1"},
+      {[](JohnsonCook::Parameters& q) { q.n = 0.0; }, "parameter n = 0"},
+      {[](JohnsonCook::Parameters& q) { q.reference_strain_rate = 0.0; }, "parameter reference_strain_rate = 0"},
+      {[](JohnsonCook::Parameters& q) { q.melting_temperature = q.reference_temperature; },
+       "parameter melting_temperature = 293"},
+      {[](JohnsonCook::Parameters& q) { q.C = -0.01; }, "parameter C = -0.01"},
+      {[](JohnsonCook::Parameters& q) { q.m = 0.0; }, "parameter m = 0"},
+      {[](JohnsonCook::Parameters& q) { q.taylor_quinney = 0.9, q.density = 7850.0, q.specific_heat = 0.0; },
+       "parameter density*specific_heat = 0"},
+      {[](JohnsonCook::Parameters& q) { q.taylor_quinney = 0.9, q.density = -7850.0, q.specific_heat = 477.0; },
+       "parameter density*specific_heat = -"},
+      {[](JohnsonCook::Parameters& q) { q.taylor_quinney = 1.5; }, "parameter taylor_quinney = 1.5"},
+      {[](JohnsonCook::Parameters& q) { q.taylor_quinney = -0.1; }, "parameter taylor_quinney = -0.1"},
+      {[](JohnsonCook::Parameters& q) { q.initial_temperature = 250.0; }, "parameter initial_temperature = 250"},
+      {[](JohnsonCook::Parameters& q) { q.D1 = -3.0; }, "parameter D1 + D2*exp(D3*triaxiality) ="},
+      {[](JohnsonCook::Parameters& q) { q.E = 0.0; }, "parameter E = 0"}};
+  for (const auto& [change, expected] : bad_parameters) {
+    JohnsonCook::Parameters q = p;
+    change(q);
+    refuses(q, expected);
   }
   {
-    auto q = p;
-    q.B = -1.0;
-    refuses(q, "parameter B = -1");
-  }
-  {
-    auto q = p;
-    q.n = 0.0;
-    refuses(q, "parameter n = 0");
-  }
-  {
-    auto q = p;
-    q.reference_strain_rate = 0.0;
-    refuses(q, "parameter reference_strain_rate = 0");
-  }
-  {
-    auto q = p;
-    q.melting_temperature = q.reference_temperature;
-    refuses(q, "parameter melting_temperature = 293");
-  }
-  {
-    auto q = p;
-    q.C = -0.01;
-    refuses(q, "parameter C = -0.01");
-  }
-  {
-    auto q = p;
-    q.m = 0.0;
-    refuses(q, "parameter m = 0");
-  }
-  {
-    auto q = p;
-    q.taylor_quinney = 0.9;
-    q.density = 7850.0;
-    q.specific_heat = 0.0;
-    refuses(q, "parameter density*specific_heat = 0");
-    q.density = -7850.0;
-    q.specific_heat = 477.0;
-    refuses(q, "parameter density*specific_heat = -");
-    q.density = 7850.0;
+    // Heating with a positive ρ·cp is accepted.
+    JohnsonCook::Parameters q = p;
+    q.taylor_quinney = 0.9, q.density = 7850.0, q.specific_heat = 477.0;
     CHECK_NOTHROW(JohnsonCook(q));
-  }
-  {
-    auto q = p;
-    q.taylor_quinney = 1.5;
-    refuses(q, "parameter taylor_quinney = 1.5");
-    q.taylor_quinney = -0.1;
-    refuses(q, "parameter taylor_quinney = -0.1");
-  }
-  {
-    auto q = p;
-    q.initial_temperature = 250.0;
-    refuses(q, "parameter initial_temperature = 250");
-  }
-  {
-    auto q = p;
-    q.D1 = -3.0;
-    refuses(q, "parameter D1 + D2*exp(D3*triaxiality) =");
-  }
-  {
-    auto q = p;
-    q.E = 0.0;
-    refuses(q, "parameter E = 0");
   }
   const CowperSymonds::Parameters cs{210e9, 0.3, 235e6, 1e9, 40.4, 5.0};
   CHECK_NOTHROW(CowperSymonds(cs));
