@@ -101,13 +101,15 @@ const std::vector<StrainVoigt> coarse_stream = tension_shear_stream(3e-5);
 // elastic (the yield test only), as most points of a run are most of the time.
 const std::vector<StrainVoigt> elastic_stream = tension_shear_stream(5e-9);
 
-template <class Law>
-void run_stream(benchmark::State& benchmark_state, const Law& law, const typename Law::State& start,
-                const std::vector<StrainVoigt>& increments, const ReturnMapOptions& options) {
-  typename Law::State state = start;
+// One update per iteration along `increments`, the state back at `start`
+// after each pass; update(state, increment) is the law's call being timed.
+template <class State, class Update>
+void stream_updates(benchmark::State& benchmark_state, const State& start,
+                    const std::vector<StrainVoigt>& increments, Update&& update) {
+  State state = start;
   std::size_t index = 0;
   for (auto _ : benchmark_state) {
-    auto result = law.update(state, increments[index], options);
+    auto result = update(state, increments[index]);
     benchmark::DoNotOptimize(result);
     benchmark::DoNotOptimize(state);
     if (++index == increments.size()) {
@@ -119,21 +121,22 @@ void run_stream(benchmark::State& benchmark_state, const Law& law, const typenam
 }
 
 template <class Law>
+void run_stream(benchmark::State& benchmark_state, const Law& law, const typename Law::State& start,
+                const std::vector<StrainVoigt>& increments, const ReturnMapOptions& options) {
+  stream_updates(benchmark_state, start, increments,
+                 [&](typename Law::State& state, const StrainVoigt& increment) {
+                   return law.update(state, increment, options);
+                 });
+}
+
+template <class Law>
 void run_rate_stream(benchmark::State& benchmark_state, const Law& law, const typename Law::State& start,
                      const std::vector<StrainVoigt>& increments) {
-  typename Law::State state = start;
   const UpdateContext context{rate_time_step};
-  std::size_t index = 0;
-  for (auto _ : benchmark_state) {
-    auto result = law.update(state, increments[index], context);
-    benchmark::DoNotOptimize(result);
-    benchmark::DoNotOptimize(state);
-    if (++index == increments.size()) {
-      index = 0;
-      state = start;
-    }
-  }
-  benchmark_state.SetItemsProcessed(benchmark_state.iterations());
+  stream_updates(benchmark_state, start, increments,
+                 [&](typename Law::State& state, const StrainVoigt& increment) {
+                   return law.update(state, increment, context);
+                 });
 }
 
 ReturnMapOptions options_with(ReturnMapForm form, InitialGuess guess,
