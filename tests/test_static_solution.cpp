@@ -373,3 +373,26 @@ TEST_CASE("A static solve that cannot reach its tolerance keeps its best state a
     CHECK(plate.centre_deflection() == Approx(reachable.centre_deflection()).epsilon(1e-3));
   }
 }
+
+TEST_CASE("The automatic relaxation budget grows with the particles per side and the slenderness",
+          "[static][budget]") {
+  // √κ ln(1/tol) with √κ = L²/(s min(s, d)) (solver/static_solution.hpp), at least 200 000; here
+  // for square plates of side 1 m (L = √2 m, s = 1/(n − 1) m).
+  auto expected = [](int n, double d, double tolerance) {
+    const double s = 1.0 / (n - 1);
+    return std::max(200000.0, std::ceil(2.0 / (s * std::min(s, d)) * std::log(1.0 / tolerance)));
+  };
+  auto budget = [](int n, double d, double tolerance) {
+    return static_cast<double>(
+        solver::automatic_relaxation_steps(ShellModel::rectangular_plate(1.0, 1.0, n, n, d), tolerance));
+  };
+  // Small and thick: the floor.
+  CHECK(budget(11, 0.02, 1e-6) == 200000.0);
+  // The plate of the issue (51 x 51, L/d = 500, tolerance 1e-8): about 9.2e5 steps.
+  CHECK(budget(51, 0.002, 1e-8) == Approx(expected(51, 0.002, 1e-8)).epsilon(1e-9));
+  CHECK(budget(51, 0.002, 1e-8) == Approx(2.0 / (0.02 * 0.002) * std::log(1e8)).epsilon(1e-5));
+  // Twice the particles per side at a thickness below the spacing: twice the budget.
+  CHECK(budget(101, 0.002, 1e-8) == Approx(2.0 * budget(51, 0.002, 1e-8)).epsilon(0.01));
+  // Twice as slender: twice the budget.
+  CHECK(budget(51, 0.001, 1e-8) == Approx(2.0 * budget(51, 0.002, 1e-8)).epsilon(0.01));
+}
