@@ -8,6 +8,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <sstream>
@@ -187,7 +188,7 @@ TEST_CASE("Static elastica: an end moment rolls the cantilever into a half circl
   CHECK(std::abs(x) <= 0.02 * Strip::L);
   CHECK(w == Approx(-2 * Strip::L / M_PI).epsilon(0.02));
   REQUIRE(!seen.empty());
-  CHECK(seen.back().load_step == 7);
+  CHECK(seen.back().load_step == 8);  // 1-based: the eighth of eight
   CHECK(seen.back().load_factor == 1.0);
   CHECK(seen.back().residual <= parameters.tolerance);
 }
@@ -212,10 +213,14 @@ TEST_CASE("Static elastica: a cantilever under end shear against the shooting el
 }
 
 TEST_CASE("Static solve errors name the cause", "[static][errors]") {
-  SECTION("a free plate has a rigid-body mode") {
+  SECTION("a free plate has a rigid-body mode, and is left as it was") {
     PlateSolver free(ShellModel::rectangular_plate(1.0, 1.0, 9, 9, 0.02), {210e9, 0.3}, Plate::options());
     free.add_uniform_pressure(free.model().all_particles(), 1e3);
+    for (int k = 0; k < 5; ++k) free.step();
+    const Vector3 moved = free.displacement(0);
+    REQUIRE(moved.norm() > 0.0);
     CHECK_THROWS_WITH(free.solve_static(), Catch::Contains("free rigid-body mode"));
+    CHECK(free.displacement(0) == moved);
   }
   SECTION("a plate held at one edge against z only can still slide in its plane") {
     PlateSolver sliding(ShellModel::rectangular_plate(1.0, 1.0, 9, 9, 0.02), {210e9, 0.3}, Plate::options());
@@ -225,7 +230,6 @@ TEST_CASE("Static solve errors name the cause", "[static][errors]") {
     CHECK_THROWS_WITH(sliding.solve_static(), Catch::Contains("free rigid-body mode"));
   }
   Plate plate(50);
-  const Vector3 start = plate.solver.displacement(0);
   SECTION("load factors must increase") {
     solver::StaticParameters p;
     p.load_factors = {0.5, 0.5};
@@ -241,16 +245,27 @@ TEST_CASE("Static solve errors name the cause", "[static][errors]") {
     p.tolerance = 0.0;
     CHECK_THROWS_WITH(plate.solver.solve_static(p), Catch::Contains("StaticParameters::tolerance"));
   }
-  SECTION("an exhausted budget names it, the residual and the load factor, and leaves the solver as it was") {
+  SECTION("an exhausted budget names it, the method, the residual and the load step") {
     solver::StaticParameters p;
     p.mass = solver::StaticMass::particle_bound;
     p.max_relaxation_steps = 10;
     p.load_factors = {0.7};
     CHECK_THROWS_WITH(plate.solver.solve_static(p), Catch::Contains("max_relaxation_steps = 10") &&
-                                                         Catch::Contains("load factor 0.7") &&
-                                                         Catch::Contains("residual"));
-    CHECK(plate.solver.displacement(0) == start);
-    CHECK(plate.coefficient() == 0.0);
+                                                         Catch::Contains("StaticMass::particle_bound") &&
+                                                         Catch::Contains("load step 1 of 1 (load factor 0.7)") &&
+                                                         Catch::Contains("lowest residual"));
+    CHECK_THROWS_AS(plate.solver.solve_static(p), solver::StaticNotConverged);
+  }
+  SECTION("bad parameters leave the solver as it was, also after a solve") {
+    solver::StaticParameters tangent;
+    tangent.mass = solver::StaticMass::tangent;
+    plate.solver.solve_static(tangent);
+    const Vector3 solved = plate.solver.displacement(plate.solver.model().set("centre")[0]);
+    REQUIRE(solved.z() < 0.0);
+    solver::StaticParameters bad;
+    bad.max_relaxation_steps = 0;
+    CHECK_THROWS_WITH(plate.solver.solve_static(bad), Catch::Contains("max_relaxation_steps = 0"));
+    CHECK(plate.solver.displacement(plate.solver.model().set("centre")[0]) == solved);
   }
   SECTION("loads that are off at load_time") {
     PlateSolver ramped(ShellModel::rectangular_plate(1.0, 1.0, 9, 9, 0.02), {210e9, 0.3}, Plate::options());
@@ -278,4 +293,106 @@ TEST_CASE("The static solve writes a progress line to the chosen stream", "[stat
   INFO(lines.str());
   CHECK(lines.str().find("static load step 1/1") != std::string::npos);
   CHECK(lines.str().find("residual") != std::string::npos);
+}
+
+namespace {
+
+// An 11 x 11 clamped plate (L/d = 50, linear) under q = 1 kPa.
+struct SmallPlate {
+  PlateSolver solver;
+  SmallPlate() : solver(ShellModel::rectangular_plate(1.0, 1.0, 11, 11, 0.02), {210e9, 0.3}, Plate::options()) {
+    solver.clamp(solver.model().set("boundary"));
+    solver.add_uniform_pressure(solver.model().all_particles(), 1e3, time_function::Step{}, PressureDirection::fixed);
+  }
+  double centre_deflection() const { return solver.displacement(solver.model().set("centre")[0]).z(); }
+};
+
+}  // namespace
+
+TEST_CASE("A static solve that cannot reach its tolerance keeps its best state and says where it is",
+          "[static][errors]") {
+  for (const solver::StaticMass mass : {solver::StaticMass::tangent, solver::StaticMass::particle_bound}) {
+    const bool newton = mass == solver::StaticMass::tangent;
+    INFO((newton ? "Newton" : "dynamic relaxation"));
+    // A separate solve of the same plate at a tolerance it reaches.
+    SmallPlate reachable;
+    solver::StaticParameters parameters;
+    parameters.mass = mass;
+    parameters.tolerance = 1e-8;
+    const solver::StaticResult reference = reachable.solver.solve_static(parameters);
+    REQUIRE(reference.converged);
+    REQUIRE(reference.residual <= 1e-8);
+    CHECK(reference.load_step == 1);
+
+    // The same plate asked for a residual below round-off, with a budget
+    // longer than the reachable solve needed (so the last state is not the one kept).
+    SmallPlate plate;
+    parameters.tolerance = 1e-15;
+    if (newton)
+      parameters.max_newton_iterations = reference.iteration + 3;
+    else
+      parameters.max_relaxation_steps = 2 * reference.iteration;
+    std::vector<solver::StaticIteration> seen;
+    std::string message;
+    solver::StaticResult kept;
+    try {
+      plate.solver.solve_static(parameters, [&](const solver::StaticIteration& it) { seen.push_back(it); });
+      FAIL("a tolerance of 1e-15 was reached");
+    } catch (const solver::StaticNotConverged& e) {
+      message = e.what();
+      kept = e.result();
+    }
+    INFO(message);
+    REQUIRE(!seen.empty());
+    // The observer's lowest residual is the event the Error names, numbered the same way.
+    const auto best = std::min_element(seen.begin(), seen.end(), [](const auto& a, const auto& b) {
+      return a.residual < b.residual;
+    });
+    CHECK(best->load_step == 1);
+    CHECK(best->load_steps == 1);
+    CHECK(kept.load_step == best->load_step);
+    CHECK(kept.iteration == best->iteration);
+    CHECK(kept.residual == best->residual);
+    CHECK(kept.load_factor == 1.0);
+    CHECK_FALSE(kept.converged);
+    CHECK(kept.residual <= 1e-8);
+    std::ostringstream residual_text;
+    residual_text.precision(6);
+    residual_text << best->residual;
+    CHECK_THAT(message, Catch::Contains("load step " + std::to_string(best->load_step) + " of 1 (load factor 1)") &&
+                            Catch::Contains("lowest residual |r|/|lambda f_ext| = " + residual_text.str()) &&
+                            Catch::Contains("at iteration " + std::to_string(best->iteration) + " of the load step") &&
+                            Catch::Contains(newton ? "StaticMass::tangent" : "StaticMass::particle_bound") &&
+                            Catch::Contains("left at that lowest-residual state"));
+    // The solver holds the best state, not the start: the reachable solve's deflection.
+    REQUIRE(reachable.centre_deflection() < 0.0);
+    CHECK(plate.centre_deflection() == Approx(reachable.centre_deflection()).epsilon(1e-6));
+    // At rest, and it steps on from there.
+    CHECK(plate.solver.energy().kinetic == 0.0);
+    for (int k = 0; k < 20; ++k) plate.solver.step();
+    CHECK(plate.centre_deflection() == Approx(reachable.centre_deflection()).epsilon(1e-3));
+  }
+}
+
+TEST_CASE("The automatic relaxation budget grows with the particles per side and the slenderness",
+          "[static][budget]") {
+  // √κ ln(1/tol) with √κ = L²/(s min(s, d)) (solver/static_solution.hpp), at least 200 000; here
+  // for square plates of side 1 m (L = √2 m, s = 1/(n − 1) m).
+  auto expected = [](int n, double d, double tolerance) {
+    const double s = 1.0 / (n - 1);
+    return std::max(200000.0, std::ceil(2.0 / (s * std::min(s, d)) * std::log(1.0 / tolerance)));
+  };
+  auto budget = [](int n, double d, double tolerance) {
+    return static_cast<double>(
+        solver::automatic_relaxation_steps(ShellModel::rectangular_plate(1.0, 1.0, n, n, d), tolerance));
+  };
+  // Small and thick: the floor.
+  CHECK(budget(11, 0.02, 1e-6) == 200000.0);
+  // The plate of the issue (51 x 51, L/d = 500, tolerance 1e-8): about 9.2e5 steps.
+  CHECK(budget(51, 0.002, 1e-8) == Approx(expected(51, 0.002, 1e-8)).epsilon(1e-9));
+  CHECK(budget(51, 0.002, 1e-8) == Approx(2.0 / (0.02 * 0.002) * std::log(1e8)).epsilon(1e-5));
+  // Twice the particles per side at a thickness below the spacing: twice the budget.
+  CHECK(budget(101, 0.002, 1e-8) == Approx(2.0 * budget(51, 0.002, 1e-8)).epsilon(0.01));
+  // Twice as slender: twice the budget.
+  CHECK(budget(51, 0.001, 1e-8) == Approx(2.0 * budget(51, 0.002, 1e-8)).epsilon(0.01));
 }

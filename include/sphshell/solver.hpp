@@ -262,9 +262,12 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
   // "Static solutions"). After it the solver holds the equilibrium at rest
   // (velocities zero, energy books restarted at it) and can step on from there.
   // observer(const solver::StaticIteration&) is called after every iteration.
-  // An Error (no convergence within the budget, a free rigid-body mode, bad
-  // parameters) leaves the solver as it was before the call. A distributed
-  // run has none yet: an Error on every process.
+  // A load step that exhausts its budget throws solver::StaticNotConverged
+  // (an Error) and leaves the solver at that step's lowest-residual state, at
+  // rest with its forces and energy books restarted there (the exception's
+  // result() describes it); any other Error (a free rigid-body mode, bad
+  // parameters, a singular tangent) leaves the solver as it was before the
+  // call. A distributed run has none yet: an Error on every process.
   template <class Observer>
   solver::StaticResult solve_static(const solver::StaticParameters& parameters, Observer&& observer) {
     latch_.check();
@@ -305,6 +308,12 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
         forces_current_ = true;
         ledger_->restart_at_rest(energy().elastic);
         return result;
+      } catch (const solver::StaticNotConverged&) {
+        // The solve left the failed load step's best state with its material
+        // state and internal forces; the books restart at rest there.
+        forces_current_ = true;
+        ledger_->restart_at_rest(energy().elastic);
+        throw;
       } catch (...) {
         particles_ = start;
         *states_ = start_states;

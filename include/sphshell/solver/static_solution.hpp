@@ -28,6 +28,15 @@
 // load step starts from the material state of the last converged step, so a
 // load step is one increment of the law (backward Euler over the step) and
 // the answer depends on the load stepping as a plastic path does.
+//
+// Numbering, the same in StaticIteration, StaticResult, the progress lines
+// and every Error: load steps count from 1 (load step k has λ =
+// load_factors[k − 1]); iteration k of a load step is the state after k
+// iterations (Newton iterations or relaxation steps) of it, 0 its start.
+//
+// A load step that exhausts its budget stops with StaticNotConverged (an
+// Error): the solver is left at the state of the lowest residual that load
+// step reached, which the exception's result() describes.
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/frame.hpp>
@@ -50,6 +59,7 @@
 #include <cstddef>
 #include <iostream>
 #include <limits>
+#include <optional>
 #include <ostream>
 #include <sstream>
 #include <string>
@@ -80,9 +90,12 @@ struct StaticParameters {
   StaticMass mass = StaticMass::particle_bound;
   StaticDamping damping = StaticDamping::viscous;
   // Budgets per load step: Newton iterations (StaticMass::tangent) and
-  // relaxation steps (StaticMass::particle_bound). An exhausted budget is an Error.
+  // relaxation steps (StaticMass::particle_bound). An exhausted budget is a
+  // StaticNotConverged Error that leaves the solver at the step's best state.
   long max_newton_iterations = 40;
-  long max_relaxation_steps = 200000;
+  // Unset: automatic_relaxation_steps(model, tolerance), which grows with the
+  // model's stiffness spread (see there); a value given is used as it is.
+  std::optional<long> max_relaxation_steps;
   // The time (s) at which the loads' time functions are evaluated; NaN: the
   // solver's current time (a Step load from t = 0 is on at t = 0; a Ramp is
   // not: give a load_time after its rise).
@@ -95,20 +108,40 @@ struct StaticParameters {
   long progress_interval = 0;
 };
 
-// What the observer sees after every iteration.
+// What the observer sees after every iteration (numbering: see the header comment).
 struct StaticIteration {
-  int load_step = 0;       // 0-based
-  int load_steps = 0;
+  int load_step = 0;       // 1-based: load step k has λ = load_factors[k − 1]
+  int load_steps = 0;      // how many there are
   double load_factor = 0.0;
-  long iteration = 0;      // within the load step; 0 is the state the step starts from
+  long iteration = 0;      // within the load step: the state after this many iterations (0: the step's start)
   double residual = 0.0;   // ‖r‖ / ‖λ f_ext‖
 };
 
+// The state the solve left the solver in: the last load step's equilibrium,
+// or (in StaticNotConverged::result()) the best state of the load step that
+// exhausted its budget.
 struct StaticResult {
   long iterations = 0;         // over all load steps (Newton iterations or relaxation steps)
   long force_evaluations = 0;  // internal-force evaluations, the cost
-  double residual = 0.0;       // ‖r‖ / ‖λ f_ext‖ at the end
-  double load_factor = 0.0;    // the last one
+  double residual = 0.0;       // ‖r‖ / ‖λ f_ext‖ of the state held
+  double load_factor = 0.0;    // λ of the load step of the state held
+  int load_step = 0;           // 1-based number of that load step
+  long iteration = 0;          // the iteration of that load step whose state is held (0: the step's start)
+  bool converged = false;      // whether that state meets the tolerance
+};
+
+// A load step exhausted its budget. The message names the method, the budget,
+// the load step (number and λ), the lowest residual reached and its iteration;
+// the solver is left at that lowest-residual state (particles and directors,
+// the material state and internal forces of it, at rest, energy books
+// restarted there), and result() describes it.
+class StaticNotConverged : public Error {
+ public:
+  StaticNotConverged(const std::string& message, const StaticResult& kept) : Error(message), kept_(kept) {}
+  const StaticResult& result() const { return kept_; }
+
+ private:
+  StaticResult kept_;
 };
 
 // Whether a law's stress follows from the strain alone (no history), so the
@@ -134,8 +167,9 @@ inline void validate(const StaticParameters& p) {
   detail::require_open_interval("StaticParameters::tolerance", p.tolerance, 0.0, 1.0);
   if (p.max_newton_iterations < 1)
     detail::invalid_parameter("StaticParameters::max_newton_iterations", p.max_newton_iterations, "must be >= 1");
-  if (p.max_relaxation_steps < 1)
-    detail::invalid_parameter("StaticParameters::max_relaxation_steps", p.max_relaxation_steps, "must be >= 1");
+  if (p.max_relaxation_steps && *p.max_relaxation_steps < 1)
+    detail::invalid_parameter("StaticParameters::max_relaxation_steps", *p.max_relaxation_steps,
+                              "must be >= 1 (or unset for the automatic budget)");
   detail::require_open_interval("StaticParameters::perturbation", p.perturbation, 0.0, 1e-2);
   if (p.progress_interval < 0)
     detail::invalid_parameter("StaticParameters::progress_interval", p.progress_interval, "must be >= 0");
@@ -392,16 +426,41 @@ void check_rigid_body_modes(const std::vector<std::vector<int>>& parts, const Pa
   }
 }
 
+// The automatic relaxation budget (see automatic_relaxation_steps).
+inline constexpr double relaxation_steps_per_condition = 1.0;
+inline constexpr long least_relaxation_steps = 200000;
+
 }  // namespace static_detail
+
+// The relaxation budget per load step when StaticParameters::max_relaxation_steps
+// is unset. With the Gershgorin masses the stiffest mode of M⁻¹K has a
+// frequency of about 1 per pseudo step, so reducing the residual by the factor
+// tolerance takes O(√κ ln(1/tolerance)) steps, κ the ratio of the stiffest to
+// the softest mode (Underwood 1983). On a shell of extent L, largest spacing s
+// and least thickness d the softest mode bends over L (stiffness ∝ E d³/L⁴),
+// the stiffest shears or stretches over one spacing (∝ E d/s²) or bends over
+// it (∝ E d³/s⁴), so √κ ≈ L²/(s min(s, d)): the budget grows with the
+// particles per side and with the slenderness. The factor 1 is about 12 times
+// the steps the 21 × 21 clamped plate at L/d = 50 needed (docs/method.md,
+// "Static solutions"); the floor is the budget the validation cases were run with.
+inline long automatic_relaxation_steps(const ShellModel& model, double tolerance) {
+  Vector3 lower = model.particle_position.front(), upper = lower;
+  for (const Vector3& x : model.particle_position) lower = lower.cwiseMin(x), upper = upper.cwiseMax(x);
+  const double extent = (upper - lower).norm(), spacing = model.maximum_spacing();
+  const double root_condition = extent * extent / (spacing * std::min(spacing, model.minimum_thickness()));
+  const double steps = static_detail::relaxation_steps_per_condition * root_condition * std::log(1.0 / tolerance);
+  if (!(steps < static_cast<double>(std::numeric_limits<long>::max() / 2))) return std::numeric_limits<long>::max() / 2;
+  return std::max(static_detail::least_relaxation_steps, static_cast<long>(std::ceil(steps)));
+}
 
 // The Newton step K dq = r: a sparse LDLᵀ of the symmetric part when the
 // tangent is symmetric to finite-difference accuracy (conservative loads on
 // an elastic or path-dependent law), else a sparse LU; an Error when the
 // tangent is singular. (A template for the reason given above free_directions.)
 template <class SparseMatrix>
-Eigen::VectorXd newton_step(const SparseMatrix& K, const Eigen::VectorXd& r, int step, double lambda) {
+Eigen::VectorXd newton_step(const SparseMatrix& K, const Eigen::VectorXd& r, int load_step, double lambda) {
   auto singular = [&] {
-    return Error("sphshell: static solve: the tangent stiffness is singular at load step " + std::to_string(step + 1) +
+    return Error("sphshell: static solve: the tangent stiffness is singular at load step " + std::to_string(load_step) +
                  " (load factor " + number_text(lambda) +
                  "): the model has a mechanism, or it buckled; add supports or take smaller load steps");
   };
@@ -541,9 +600,19 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
   std::ostream& progress = system.progress_stream ? *system.progress_stream : std::clog;
   const auto wall_start = std::chrono::steady_clock::now();
   const int steps = static_cast<int>(parameters.load_factors.size());
+  const long relaxation_budget = parameters.max_relaxation_steps
+                                     ? *parameters.max_relaxation_steps
+                                     : automatic_relaxation_steps(model, parameters.tolerance);
+  auto stop_at_rest = [&] {
+    for (std::size_t i = 0; i < n; ++i) {
+      particles.velocity[i].setZero();
+      particles.angular_velocity[i].setZero();
+    }
+  };
   system.save_material();
   for (int step = 0; step < steps; ++step) {
     const double lambda = parameters.load_factors[static_cast<std::size_t>(step)];
+    const int load_step = step + 1;  // the numbering of every message
     basis = make_basis(particles, system.constraints);
     residual(lambda);
     const double load = external.norm();
@@ -554,36 +623,64 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
                                 "the loads are zero on the free degrees of freedom at that time: a static solve "
                                 "needs a load (add_pressure, add_point_force, ...) switched on at load_time");
     long iteration = 0;
+    // The lowest-residual state of this load step: kept if the budget runs out.
+    std::vector<Vector3> best_position = particles.position, best_director = particles.director;
+    double best_relative = std::numeric_limits<double>::infinity();
+    long best_iteration = 0;
     auto report = [&](double relative) {
-      observer(StaticIteration{step, steps, lambda, iteration, relative});
+      observer(StaticIteration{load_step, steps, lambda, iteration, relative});
+      if (relative < best_relative) {
+        best_relative = relative;
+        best_iteration = iteration;
+        best_position = particles.position;
+        best_director = particles.director;
+      }
       if (parameters.progress_interval > 0 && iteration % parameters.progress_interval == 0) {
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
         std::ostringstream line;
         line.precision(4);
-        line << "static load step " << step + 1 << "/" << steps << "  lambda = " << lambda << "  iteration "
+        line << "static load step " << load_step << "/" << steps << "  lambda = " << lambda << "  iteration "
              << iteration << "  residual " << relative << " (tolerance " << parameters.tolerance << ")  "
              << result.force_evaluations << " force evaluations in " << seconds << " s\n";
         progress << line.str() << std::flush;
       }
     };
-    auto fail_budget = [&](const char* budget, long value, double relative) {
+    // The budget ran out: back to the step's lowest-residual state, its
+    // material state and internal forces recomputed, at rest; then the Error.
+    auto fail_budget = [&](const char* method, const char* budget, long value, bool automatic, double last) {
+      particles.position = best_position;
+      particles.director = best_director;
+      basis = make_basis(particles, system.constraints);
+      residual(lambda);
+      stop_at_rest();
+      StaticResult kept = result;
+      kept.residual = best_relative;
+      kept.load_factor = lambda;
+      kept.load_step = load_step;
+      kept.iteration = best_iteration;
+      kept.converged = false;
       std::ostringstream message;
       message.precision(6);
-      message << "sphshell: static solve did not converge within the budget StaticParameters::" << budget << " = "
-              << value << " at load step " << step + 1 << " of " << steps << " (load factor " << lambda
-              << "): residual " << relative << " of the load, tolerance " << parameters.tolerance
-              << "; raise the budget, take smaller load steps, or check the supports and loads";
-      throw Error(message.str());
+      message << "sphshell: static solve (" << method << ") did not converge within the budget StaticParameters::"
+              << budget << " = " << value << (automatic ? " (automatic)" : "") << " at load step " << load_step
+              << " of " << steps << " (load factor " << lambda << "): the lowest residual |r|/|lambda f_ext| = "
+              << best_relative << " (tolerance " << parameters.tolerance << ") was reached at iteration "
+              << best_iteration << " of the load step (" << last << " at iteration " << iteration
+              << "); the solver is left at that lowest-residual state, at rest (StaticNotConverged::result() "
+                 "describes it), not at the start of the solve; raise the budget or the tolerance, take smaller "
+                 "load steps, or check the supports and loads";
+      throw StaticNotConverged(message.str(), kept);
     };
     double relative = r.norm() / load;
     report(relative);
     if (parameters.mass == StaticMass::tangent) {
       while (!(relative <= parameters.tolerance)) {
         if (iteration >= parameters.max_newton_iterations)
-          fail_budget("max_newton_iterations", parameters.max_newton_iterations, relative);
+          fail_budget("Newton, StaticMass::tangent", "max_newton_iterations", parameters.max_newton_iterations,
+                      false, relative);
         const Eigen::VectorXd r0 = r;
         const SparseMatrix K = tangent(lambda, r0);
-        const Eigen::VectorXd dq = newton_step(K, r0, step, lambda);
+        const Eigen::VectorXd dq = newton_step(K, r0, load_step, lambda);
         // Backtracking: the longest of 1, 1/2, 1/4, ... that lowers ‖r‖, else the best tried.
         const std::vector<Vector3> x0 = particles.position, d0 = particles.director;
         double best_norm = std::numeric_limits<double>::infinity(), best_scale = 1.0, scale = 1.0;
@@ -630,8 +727,9 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
       Eigen::VectorXd velocity = Eigen::VectorXd::Zero(basis.size), moved = Eigen::VectorXd::Zero(basis.size);
       double kinetic_before = 0.0;
       while (!(relative <= parameters.tolerance)) {
-        if (iteration >= parameters.max_relaxation_steps)
-          fail_budget("max_relaxation_steps", parameters.max_relaxation_steps, relative);
+        if (iteration >= relaxation_budget)
+          fail_budget("dynamic relaxation, StaticMass::particle_bound", "max_relaxation_steps", relaxation_budget,
+                      !parameters.max_relaxation_steps, relative);
         if (parameters.damping == StaticDamping::kinetic) {
           velocity += r.cwiseQuotient(mass);
         } else {
@@ -664,11 +762,11 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
     system.save_material();
     result.residual = relative;
     result.load_factor = lambda;
+    result.load_step = load_step;
+    result.iteration = iteration;
+    result.converged = true;
   }
-  for (std::size_t i = 0; i < n; ++i) {
-    particles.velocity[i].setZero();
-    particles.angular_velocity[i].setZero();
-  }
+  stop_at_rest();
   return result;
 }
 
