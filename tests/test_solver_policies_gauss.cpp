@@ -4,24 +4,15 @@
 
 using namespace sphshell;
 
-namespace {
 using Approximation = approx::MLS<kernel::CubicSpline>;
-
-template <class Rule>
-void every_material(const std::string& rule) {
-  using test_support::run_policy_smoke_test;
-  run_policy_smoke_test<Approximation, Rule, material::Elastic>(rule + " / elastic");
-  run_policy_smoke_test<Approximation, Rule, material::J2Plasticity>(rule + " / J2");
-  run_policy_smoke_test<Approximation, Rule, material::LemaitreDamage>(rule + " / damage");
-}
-}  // namespace
+using test_support::run_with_every_material;
 
 TEST_CASE("Every Gauss rule runs with every material", "[solver][policies]") {
-  every_material<thickness::Gauss<1>>("Gauss<1>");
-  every_material<thickness::Gauss<2>>("Gauss<2>");
-  every_material<thickness::Gauss<3>>("Gauss<3>");
-  every_material<thickness::Gauss<4>>("Gauss<4>");
-  every_material<thickness::Gauss<5>>("Gauss<5>");
-  every_material<thickness::Gauss<6>>("Gauss<6>");
-  every_material<thickness::Gauss<7>>("Gauss<7>");
+  run_with_every_material<Approximation, thickness::Gauss<1>>("Gauss<1>");
+  run_with_every_material<Approximation, thickness::Gauss<2>>("Gauss<2>");
+  run_with_every_material<Approximation, thickness::Gauss<3>>("Gauss<3>");
+  run_with_every_material<Approximation, thickness::Gauss<4>>("Gauss<4>");
+  run_with_every_material<Approximation, thickness::Gauss<5>>("Gauss<5>");
+  run_with_every_material<Approximation, thickness::Gauss<6>>("Gauss<6>");
+  run_with_every_material<Approximation, thickness::Gauss<7>>("Gauss<7>");
 }

@@ -6,21 +6,10 @@
 
 using namespace sphshell;
 
-namespace {
-template <class Approximation>
-void every_material_and_model(const std::string& approximation) {
-  using test_support::run_policy_smoke_test;
-  run_policy_smoke_test<Approximation, thickness::Gauss<5>, material::Elastic>(approximation + " / Gauss<5> / elastic");
-  run_policy_smoke_test<Approximation, thickness::Gauss<5>, material::J2Plasticity>(approximation + " / Gauss<5> / J2");
-  run_policy_smoke_test<Approximation, thickness::Gauss<5>, material::LemaitreDamage>(approximation + " / Gauss<5> / damage");
-  run_policy_smoke_test<Approximation, thickness::Global, material::Elastic>(approximation + " / Global / elastic");
-  run_policy_smoke_test<Approximation, thickness::Global, material::J2Plasticity>(approximation + " / Global / J2");
-  run_policy_smoke_test<Approximation, thickness::Global, material::LemaitreDamage>(approximation + " / Global / damage");
-}
-}  // namespace
+using test_support::run_with_every_material_and_model;
 
 TEST_CASE("NSPH with every kernel runs with every material", "[solver][policies]") {
-  every_material_and_model<approx::NSPH<kernel::CubicSpline>>("NSPH<CubicSpline>");
-  every_material_and_model<approx::NSPH<kernel::WendlandC2>>("NSPH<WendlandC2>");
-  every_material_and_model<approx::NSPH<kernel::QuinticSpline>>("NSPH<QuinticSpline>");
+  run_with_every_material_and_model<approx::NSPH<kernel::CubicSpline>>("NSPH<CubicSpline>");
+  run_with_every_material_and_model<approx::NSPH<kernel::WendlandC2>>("NSPH<WendlandC2>");
+  run_with_every_material_and_model<approx::NSPH<kernel::QuinticSpline>>("NSPH<QuinticSpline>");
 }

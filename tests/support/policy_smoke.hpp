@@ -136,4 +136,20 @@ void run_policy_smoke_test(const std::string& label) {
   check_yielding_plate_runs<Approximation, Rule, Material>(label);
 }
 
+// The smoke test of one approximation and thickness rule with each material
+// law; `label` names the pair ("MLS<CubicSpline> / Gauss<5>").
+template <class Approximation, class Rule>
+void run_with_every_material(const std::string& label) {
+  run_policy_smoke_test<Approximation, Rule, material::Elastic>(label + " / elastic");
+  run_policy_smoke_test<Approximation, Rule, material::J2Plasticity>(label + " / J2");
+  run_policy_smoke_test<Approximation, Rule, material::LemaitreDamage>(label + " / damage");
+}
+
+// An approximation with every material, through the thickness (Gauss<5>) and by resultants (Global).
+template <class Approximation>
+void run_with_every_material_and_model(const std::string& approximation) {
+  run_with_every_material<Approximation, thickness::Gauss<5>>(approximation + " / Gauss<5>");
+  run_with_every_material<Approximation, thickness::Global>(approximation + " / Global");
+}
+
 }  // namespace sphshell::test_support
