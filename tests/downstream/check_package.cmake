@@ -33,21 +33,38 @@ if(CXX_COMPILER MATCHES "(g\\+\\+|clang\\+\\+)")
   set(compiler_flags -Wall -Wextra -Wpedantic)
 endif()
 
+# find_package-simd: the find_package consumer of a package configured with
+# SPHSHELL_SIMD=AUTO; the consumer must target the set the package chose.
+set(simd_option "")
+if(CONSUMER STREQUAL "find_package-simd")
+  set(simd_option -DSPHSHELL_SIMD=AUTO)
+endif()
+
 if(CONSUMER MATCHES "^find_package" OR CONSUMER STREQUAL "pkg-config")
   run_step(${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${WORK_DIR}/sphshell-build -G ${GENERATOR}
            -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
            -DSPHSHELL_BUILD_TESTS=OFF -DSPHSHELL_BUILD_EXAMPLES=OFF -DSPHSHELL_BUILD_BENCHMARKS=OFF
-           -DCMAKE_INSTALL_PREFIX=${WORK_DIR}/prefix)
+           -DCMAKE_INSTALL_PREFIX=${WORK_DIR}/prefix ${simd_option})
   run_step(${CMAKE_COMMAND} --install ${WORK_DIR}/sphshell-build)
   # Relocatability: the consumer sees the prefix only through CMAKE_PREFIX_PATH
   # or PKG_CONFIG_PATH, after the installed tree has been moved.
   file(RENAME ${WORK_DIR}/prefix ${WORK_DIR}/moved-prefix)
 endif()
 
-if(CONSUMER STREQUAL "find_package")
+if(CONSUMER STREQUAL "find_package" OR CONSUMER STREQUAL "find_package-simd")
+  set(expected_simd "")
+  if(CONSUMER STREQUAL "find_package-simd")
+    file(STRINGS ${WORK_DIR}/sphshell-build/CMakeCache.txt chosen REGEX "^SPHSHELL_SIMD_CHOSEN:")
+    string(REGEX REPLACE "^[^=]*=" "" chosen "${chosen}")
+    if(chosen STREQUAL "" OR chosen STREQUAL "NONE")
+      message(FATAL_ERROR "SPHSHELL_SIMD=AUTO chose '${chosen}': no x86 vector set to check")
+    endif()
+    set(expected_simd -DEXPECTED_SIMD=${chosen})
+  endif()
   run_step(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/downstream -B ${WORK_DIR}/downstream-build
            -G ${GENERATOR} -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
-           -DCMAKE_PREFIX_PATH=${WORK_DIR}/moved-prefix -DEXPECTED_VERSION=${EXPECTED_VERSION})
+           -DCMAKE_PREFIX_PATH=${WORK_DIR}/moved-prefix -DEXPECTED_VERSION=${EXPECTED_VERSION}
+           ${expected_simd})
   run_step(${CMAKE_COMMAND} --build ${WORK_DIR}/downstream-build)
   run_step(${WORK_DIR}/downstream-build/downstream)
 elseif(CONSUMER STREQUAL "find_package-mpi")

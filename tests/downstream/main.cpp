@@ -4,6 +4,7 @@
 // MAJOR.MINOR.PATCH and equal SPHSHELL_EXPECTED_VERSION (the project's version,
 // passed by the check). Built with SPHSHELL_INCLUDE_ONLY it stands for a
 // source tree used through -I<sphshell>/include alone, which has no version.
+#include <sphshell/core/simd.hpp>
 #include <sphshell/sphshell.hpp>
 
 #include <iostream>
@@ -28,6 +29,16 @@ int main() {
   }
 #endif
   std::cout << "sphshell " << SPHSHELL_VERSION_STRING << '\n';
+#endif
+  // The instruction set the compiler targets here must be the one the package
+  // was configured with: the flags reached this consumer through the target.
+#ifdef SPHSHELL_EXPECTED_SIMD
+  if (std::string(sphshell::simd::instruction_set()) != SPHSHELL_EXPECTED_SIMD) {
+    std::cout << "instruction set " << sphshell::simd::instruction_set() << ", package configured for "
+              << SPHSHELL_EXPECTED_SIMD << '\n';
+    return 1;
+  }
+  std::cout << "instruction set " << sphshell::simd::instruction_set() << '\n';
 #endif
   try {
     sphshell::detail::require_positive("E", -1.0);
