@@ -141,6 +141,10 @@ struct JohnsonCook {
     // ε̇* per unit Δε̄p; 0 in the quasi-static limit.
     const double rate_per_increment = 1.0 / (context.time_step * parameters_.reference_strain_rate);
     const double eps_p_n = state.eps_p;
+    // A + Bε̄pⁿ and ln ε̇* (0 below ε̇* = 1) at the last Δε̄p the return evaluated,
+    // which is the one it returns: the hardening of the next elastic limit and
+    // the damage's rate term reuse them instead of a second pow() and log().
+    double hardening_at_return = parameters_.A, log_rate_at_return = 0.0;
     const auto flow = [&](double increment) {
       const double eps_p = eps_p_n + increment;
       const double power = std::pow(eps_p, parameters_.n);
@@ -150,8 +154,11 @@ struct JohnsonCook {
                                                  : parameters_.n * parameters_.B * std::pow(eps_p, parameters_.n - 1.0);
       const double rate = increment * rate_per_increment;
       const bool rate_active = rate > 1.0;  // ln ε̇* taken as 0 below ε̇* = 1
-      const double rate_factor = rate_active ? 1.0 + parameters_.C * std::log(rate) : 1.0;
+      const double log_rate = rate_active ? std::log(rate) : 0.0;
+      const double rate_factor = rate_active ? 1.0 + parameters_.C * log_rate : 1.0;
       const double rate_slope = rate_active ? parameters_.C / increment : 0.0;
+      hardening_at_return = hardening;
+      log_rate_at_return = log_rate;
       return return_map::FlowStressValue{
           increment, 1.0, hardening * rate_factor * thermal,
           (hardening_slope * rate_factor + hardening * rate_slope) * thermal};
@@ -162,17 +169,16 @@ struct JohnsonCook {
     const return_map::FlowStressSolution solution =
         return_map::solve_flow_stress(constants_, trial, flow, std::sqrt(trial_squared) - quasi_static, guess);
     const double increment = solution.plastic_strain_increment;
-    const double rate = increment * rate_per_increment;
 
     state.eps_p = eps_p_n + increment;
     state.sigma_y = solution.flow_stress;
     state.strain_rate = increment / context.time_step;
-    state.D += increment / failure_strain(triaxiality(solution.stress), rate, homologous);
+    state.D += increment / failure_strain_from_log_rate(triaxiality(solution.stress), log_rate_at_return, homologous);
     if (heating_ > 0.0) {
       state.temperature += heating_ * solution.flow_stress * increment;
       state.thermal_softening = thermal_factor(homologous_temperature(state.temperature));
     }
-    state.yield_stress = strain_hardening(state.eps_p) * state.thermal_softening;
+    state.yield_stress = hardening_at_return * state.thermal_softening;  // (A + B ε̄pⁿ)(1 − T*ᵐ) at ε̄p,n+1
     if (state.D >= 1.0 || state.temperature >= parameters_.melting_temperature) {
       state.failed = true;
       state.stress.setZero();
@@ -199,7 +205,10 @@ struct JohnsonCook {
   }
   // εf of the 1985 paper at σ*, ε̇* and T* (ln ε̇* taken as 0 for ε̇* < 1).
   double failure_strain(double triaxiality, double rate, double homologous) const {
-    const double log_rate = rate > 1.0 ? std::log(rate) : 0.0;
+    return failure_strain_from_log_rate(triaxiality, rate > 1.0 ? std::log(rate) : 0.0, homologous);
+  }
+  // The same with ln ε̇* given (0 for ε̇* ≤ 1).
+  double failure_strain_from_log_rate(double triaxiality, double log_rate, double homologous) const {
     return (parameters_.D1 + parameters_.D2 * std::exp(parameters_.D3 * triaxiality)) *
            (1.0 + parameters_.D4 * log_rate) * (1.0 + parameters_.D5 * homologous);
   }
