@@ -218,3 +218,69 @@ TEST_CASE("More ranks than particles is an Error on every rank", "[mpi][errors]"
   CHECK(message == "sphshell: invalid parameter rank count = " + std::to_string(comm.size()) +
                        " (exceeds the particle count 3: every rank must own at least one particle)");
 }
+
+TEST_CASE("Distributed probes continue across a restart, added before or after loading", "[mpi][output]") {
+  const mpi::Communicator comm;
+  namespace fs = std::filesystem;
+  const std::string directory = "mpi_probe_restart_np" + std::to_string(comm.size());
+  if (comm.is_root()) {
+    fs::remove_all(directory);
+    fs::create_directories(directory + "/serial");
+  }
+  comm.barrier();
+  const ShellModel model = ShellModel::rectangular_plate(0.5, 0.5, 21, 21, 0.01);
+  SolverOptions options;
+  options.density = 7850.0;
+  // What the last rank owns first: a probe whose file another rank than the first writes.
+  int particle = 0, stress_point = 0;
+  {
+    Distributed layout_only(comm, model, {210e9, 0.3}, options);
+    const mpi::RankLayout& layout = layout_only.layout();
+    int first_owned = -1;
+    for (std::size_t k = 0; k < layout.computed[0].size() && first_owned < 0; ++k)
+      if (layout.computed_is_owned[0][k]) first_owned = static_cast<int>(layout.computed[0][k]);
+    particle = comm.all_gather(layout.owned.front()).back();
+    stress_point = comm.all_gather(first_owned).back();
+  }
+  auto loaded = [&](auto& solver) {
+    solver.clamp(model.set("boundary"));
+    solver.add_uniform_pressure(model.all_particles(), 5e5);
+  };
+  const std::string particle_csv = directory + "/particle.csv", stress_csv = directory + "/stress_point.csv";
+  const std::string serial_particle = directory + "/serial/particle_" + std::to_string(comm.rank()) + ".csv";
+  const std::string serial_stress = directory + "/serial/stress_point_" + std::to_string(comm.rank()) + ".csv";
+  const int steps_before = 30, steps_after = 40;
+  {
+    // The reference: one serial run of all the steps.
+    Serial serial(model, {210e9, 0.3}, options);
+    loaded(serial);
+    serial.add_particle_probe(serial_particle, particle);
+    serial.add_stress_point_probe(serial_stress, stress_point);
+    for (int n = 0; n < steps_before + steps_after; ++n) serial.step();
+  }
+  const std::string checkpoint = directory + "/run.ckpt";
+  {
+    // The run that saves, then steps on past the checkpoint (its rows after it are dropped on restart).
+    Distributed original(comm, model, {210e9, 0.3}, options);
+    loaded(original);
+    original.add_particle_probe(particle_csv, particle);
+    original.add_stress_point_probe(stress_csv, stress_point);
+    for (int n = 0; n < steps_before; ++n) original.step();
+    original.save_checkpoint(checkpoint);
+    for (int n = 0; n < 10; ++n) original.step();
+  }
+  {
+    // One probe added before loading, the other after: both continue their files.
+    Distributed restarted(comm, model, {210e9, 0.3}, options);
+    loaded(restarted);
+    restarted.add_particle_probe(particle_csv, particle);
+    restarted.load_checkpoint(checkpoint);
+    restarted.add_stress_point_probe(stress_csv, stress_point);
+    for (int n = 0; n < steps_after; ++n) restarted.step();
+  }
+  comm.barrier();
+  const std::string serial_rows = file_text(serial_particle), serial_stress_rows = file_text(serial_stress);
+  CHECK(std::count(serial_rows.begin(), serial_rows.end(), '\n') > 10);
+  CHECK(file_text(particle_csv) == serial_rows);
+  CHECK(file_text(stress_csv) == serial_stress_rows);
+}
