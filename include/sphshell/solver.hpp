@@ -89,16 +89,6 @@
 #include <vector>
 
 namespace sphshell {
-namespace solver {
-// The output part, which depends on the domain: one process's files, or
-// pieces per process (mpi/distributed_solver.hpp gives mpi::Domain's).
-template <class Domain>
-struct DomainParts {
-  template <int OutputPoints>
-  using Output = SolverOutput<OutputPoints>;
-};
-}  // namespace solver
-
 template <class Approx, class Rule, class Material, class Crack = crack::None,
           class Stepper = stepper::CentralDifference, class Domain = domain::Serial>
 class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, Crack, Stepper, Domain>>,
@@ -377,10 +367,9 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
   }
 
  private:
-  using Parts = solver::DomainParts<Domain>;
   using Ledger = solver::EnergyBooks<Domain>;
   using Fracture = solver::FractureManager<Crack, Domain>;
-  using Output = typename Parts::template Output<output_points>;
+  using Output = solver::SolverOutput<output_points>;
   friend Output;
   friend class solver::CheckpointIO<Solver>;
   friend class solver::FramePiece<Solver>;
@@ -421,12 +410,8 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
       assembler_.emplace(options_.nonlinear, *points_);
       ledger_.emplace(options_.monitoring(), law_.youngs_modulus(), solver::shell_volume(model_));
     });
-    if constexpr (distributed) {
-      domain_.plan_halo();
-      output_.emplace(domain_.communicator(), options_.output(), Crack::enabled);
-    } else {
-      output_.emplace(options_.output(), options_.progress_stream);
-    }
+    if constexpr (distributed) domain_.plan_halo();
+    output_.emplace(domain_, options_.output(), options_.progress_stream);
   } catch (const std::bad_alloc&) {
     throw Error("sphshell: out of memory building the solver (std::bad_alloc): " + solver::memory_estimate_text());
   }

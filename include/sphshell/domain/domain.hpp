@@ -18,7 +18,11 @@
 //   bool first_process_decides(bool) const
 //       process 0's value on every process (a decision one clock takes);
 //   std::string checkpoint_file(const std::string& path) const
-//       the file of checkpoint `path` this process writes and reads.
+//       the file of checkpoint `path` this process writes and reads;
+//   static std::string checkpoint_file_of(path, int process),
+//   static std::string piece_file_of(const std::string& frame, int process)
+//       process `process`'s checkpoint file, and its file of a frame (the
+//       output part: solver/output.hpp).
 
 #include <exception>
 #include <optional>
@@ -50,7 +54,9 @@ struct has_domain_members<
                    decltype(std::declval<const D&>().agree(std::optional<Failure>())),
                    decltype(std::declval<const D&>().collectively(NoBody{})),
                    decltype(std::declval<const D&>().first_process_decides(true)),
-                   decltype(std::declval<const D&>().checkpoint_file(std::string()))>> : std::true_type {};
+                   decltype(std::declval<const D&>().checkpoint_file(std::string())),
+                   decltype(D::checkpoint_file_of(std::string(), 0)), decltype(D::piece_file_of(std::string(), 0))>>
+    : std::true_type {};
 }  // namespace detail
 
 template <class D>
@@ -61,7 +67,7 @@ constexpr bool check_domain() {
   static_assert(is_domain_v<D>,
                 "not a domain part: it needs is_distributed, rank(), size(), is_root(), "
                 "agree(std::optional<domain::Failure>), collectively(body), first_process_decides(bool) and "
-                "checkpoint_file(path) (domain/domain.hpp); use domain::Serial or mpi::Domain");
+                "checkpoint_file(path), checkpoint_file_of(path, process), piece_file_of(frame, process) (domain/domain.hpp); use domain::Serial or mpi::Domain");
   return is_domain_v<D>;
 }
 

@@ -52,6 +52,9 @@ class Serial {
   }
   bool first_process_decides(bool value) const { return value; }
   std::string checkpoint_file(const std::string& path) const { return path; }
+  static std::string checkpoint_file_of(const std::string& path, int) { return path; }
+  // A frame's file ("particles_000003" → "particles_000003.vtu"): the whole frame.
+  static std::string piece_file_of(const std::string& frame, int) { return frame + ".vtu"; }
 
   // The share: everything, numbered as in the model.
   template <class Model>

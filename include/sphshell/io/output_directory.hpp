@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <optional>
 #include <sphshell/core/error.hpp>
 #include <string>
 #include <system_error>
@@ -39,25 +40,34 @@ inline std::string identity_of(const std::string& path) {
 }
 
 // A frame file of this library's series: particles, stress_points or
-// cracks, then "_<digits>.vtu" or ".pvd", optionally ".tmp" (a write cut
-// short by a kill).
-inline bool is_frame_file(std::string name) {
-  const std::string temporary = ".tmp";
-  if (name.size() > temporary.size() && name.compare(name.size() - temporary.size(), temporary.size(), temporary) == 0)
-    name.resize(name.size() - temporary.size());
+// cracks, then "_<number>.vtu", a distributed run's piece
+// "_<number>_r<rank>.vtu" and parallel file "_<number>.pvtu", or ".pvd",
+// each optionally ".tmp" (a write cut short by a kill). The frame's number
+// (its digits), "" for a collection; nothing for a file of no series.
+inline std::optional<std::string> frame_file_digits(std::string name) {
+  auto ends_with = [](const std::string& text, const std::string& tail) {
+    return text.size() > tail.size() && text.compare(text.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  auto digits_only = [](const std::string& text) {
+    return !text.empty() && std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
+  };
+  if (ends_with(name, ".tmp")) name.resize(name.size() - 4);
   for (const std::string series : {"particles", "stress_points", "cracks"}) {
     if (name.compare(0, series.size(), series) != 0) continue;
     const std::string rest = name.substr(series.size());
-    if (rest == ".pvd") return true;
-    const std::string extension = ".vtu";
-    if (rest.size() > 1 + extension.size() && rest[0] == '_' &&
-        rest.compare(rest.size() - extension.size(), extension.size(), extension) == 0) {
-      const std::string digits = rest.substr(1, rest.size() - 1 - extension.size());
-      if (std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; })) return true;
+    if (rest == ".pvd") return std::string();
+    for (const std::string extension : {".vtu", ".pvtu"}) {
+      if (rest.empty() || rest[0] != '_' || !ends_with(rest, extension)) continue;
+      std::string number = rest.substr(1, rest.size() - 1 - extension.size());
+      const std::size_t piece = number.find("_r");
+      if (extension == ".vtu" && piece != std::string::npos && digits_only(number.substr(piece + 2)))
+        number.resize(piece);
+      if (digits_only(number)) return number;
     }
   }
-  return false;
+  return std::nullopt;
 }
+inline bool is_frame_file(const std::string& name) { return frame_file_digits(name).has_value(); }
 
 // Removes an earlier run's frame file; a failure is an Error with the reason.
 inline void remove_file(const std::string& path) {

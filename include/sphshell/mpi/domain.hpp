@@ -237,6 +237,10 @@ class Domain {
   static std::string checkpoint_file_of(const std::string& path, int process) {
     return path + ".rank" + std::to_string(process);
   }
+  // Process `process`'s piece of a frame ("particles_000003" → "particles_000003_r2.vtu").
+  static std::string piece_file_of(const std::string& frame, int process) {
+    return frame + "_r" + std::to_string(process) + ".vtu";
+  }
 
   // The ghosts' copies of the given per-particle fields, from their owners.
   void exchange(const std::vector<std::vector<Vector3>*>& fields) {

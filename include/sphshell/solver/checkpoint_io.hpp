@@ -87,7 +87,6 @@ class CheckpointIO {
     const std::string file_path = checkpoint_file(path);
     std::optional<io::BinaryReader> reader;
     s.domain_.collectively([&] {
-      s.output_->check_can_load();
       reader.emplace(checkpoint::read_file(file_path, policies()));
       checkpoint::Identity file;
       checkpoint::read_section(*reader, "IDNT", [&] { (*reader)(file); });

@@ -1,9 +1,15 @@
 #pragma once
 // The solver's output: ParaView frames (particles, stress points and, with a
 // crack policy, crack segments, each series in a .pvd collection) on the
-// output schedule and at the end of every run_until, and CSV probes. Output is
-// an observer: it reads the Solver's public accessors, so it holds no state of
-// the run but its own schedule and files.
+// output schedule and at the end of every run_until, and CSV probes. It
+// reads the run through the solver (its friend) and the domain part's share
+// (domain/domain.hpp), so it holds no state of the run but its own schedule
+// and files. A distributed run writes each frame in pieces, one per process
+// (particles_N_rR.vtu, stress_points_N_rR.vtu: its local particles, with
+// global_id, and the cells of the stress points it owns), and the first
+// process a .pvtu naming the pieces and the whole cracks_N.vtu; the
+// collections list the .pvtu files. A probe's file is written by the
+// process that owns what it probes.
 //
 // A frame draws the shell as its cells (ShellModel::cells(): the quads or
 // triangles whose centres are the stress points), so ParaView's default
@@ -33,7 +39,7 @@
 // run of this library can have written (a folder, a number past any frame's)
 // is kept and named on the notes stream (MonitoringOptions::progress_stream).
 //
-// Kill safety: a frame's .vtu files are written (each atomically) before the
+// Kill safety: a frame's files are written (each atomically) before the
 // three collections are rewritten together (io::write_together), so at any
 // moment the collections list the same frames and every listed file is
 // complete, but for the microseconds of the final atomic swaps.
@@ -48,6 +54,7 @@
 #include <sphshell/io/csv_probe.hpp>
 #include <sphshell/io/directory_lock.hpp>
 #include <sphshell/io/output_directory.hpp>
+#include <sphshell/io/output_file.hpp>
 #include <sphshell/io/pvd_collection.hpp>
 #include <sphshell/io/vtu_writer.hpp>
 #include <sphshell/solver/integration_points.hpp>
@@ -64,6 +71,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <string>
@@ -151,70 +159,89 @@ template <class Solver>
 class FramePiece;
 
 // Holds the schedule and the open files; every member that reads the run takes
-// the solver (any type with the Solver's public accessors).
+// the solver (its friend: the members read the process's share through the
+// solver's domain part, solver.domain_).
 template <int OutputPoints>
 class SolverOutput {
  public:
   static constexpr int output_points = OutputPoints;
   using StressProbe = StressPointProbe<output_points>;
 
-  // Creates the output directory at once, so that a path that cannot be one
-  // fails before the run rather than at its first frame, and takes it (its
-  // lock file) for this solver. Notes on kept files go to `notes` (std::clog
-  // when null).
-  explicit SolverOutput(const OutputOptions& options, std::ostream* notes = nullptr)
+  // Collective: the first process creates the output directory at once, so
+  // that a path that cannot be one fails before the run rather than at its
+  // first frame, and takes it (its lock file) for this solver. Notes on kept
+  // files go to `notes` (std::clog when null).
+  template <class Domain>
+  SolverOutput(const Domain& domain, const OutputOptions& options, std::ostream* notes = nullptr)
       : options_(options), notes_(notes) {
-    if (!options_.output_directory.empty()) {
-      io::make_directory(options_.output_directory, "", "output_directory");
+    if (options_.output_directory.empty()) return;
+    domain.collectively([&] {
+      if (domain.is_root()) io::make_directory(options_.output_directory, "", "output_directory");
+    });
+    domain.collectively([&] {
       directory_key_ = io::identity_of(options_.output_directory);
       if (directory_key_.size() > 1 && directory_key_.back() == '/') directory_key_.pop_back();
       if (!options_.checkpoint_path.empty()) {
-        const std::string use = output_file_use(options_.checkpoint_path);
+        const std::string use = output_file_use(domain.checkpoint_file(options_.checkpoint_path));
         if (!use.empty())
           detail::invalid_parameter("checkpoint_path", options_.checkpoint_path,
                                     "it is " + use + "; give the checkpoint a file of its own");
       }
-      lock_ = std::make_unique<io::DirectoryLock>(options_.output_directory, "output_directory");
-    }
+      if (domain.is_root()) lock_ = std::make_unique<io::DirectoryLock>(options_.output_directory, "output_directory");
+    });
   }
 
-  // Probes added before a checkpoint is loaded continue their files from it.
-  void check_can_load() const {}
-
-  // A probe on a file a loaded checkpoint recorded continues that file (no
-  // header, no row now: the file has both).
+  // Every process registers the probe; the one that owns what it probes
+  // writes its file. A probe on a file a loaded checkpoint recorded continues
+  // that file (no header, no row now: the file has both).
   template <class Probe, class Solver>
   void add_probe(const std::string& csv_path, Probe probe, const Solver& solver) {
+    const auto& domain = solver.domain_;
     const std::string key = io::identity_of(csv_path);
     for (const OpenProbe& open : probes_)
       if (open.key == key)
         throw Error("sphshell: probe file '" + csv_path + "' is already the file of another probe (added as '" +
-                    open.file.path() + "'); give each probe a file of its own");
-    if (!options_.checkpoint_path.empty() && key == io::identity_of(options_.checkpoint_path))
-      throw Error("sphshell: probe file '" + csv_path + "' is the checkpoint_path '" + options_.checkpoint_path +
-                  "' (the checkpoint would replace it); give the probe a file of its own");
+                    open.path + "'); give each probe a file of its own");
+    // Files the run writes itself: every process's checkpoint file and the frames.
+    if (!options_.checkpoint_path.empty())
+      for (int process = 0; process < domain.size(); ++process) {
+        const std::string file = domain.checkpoint_file_of(options_.checkpoint_path, process);
+        if (key == io::identity_of(file))
+          throw Error("sphshell: probe file '" + csv_path + "' is " +
+                      (domain.is_distributed ? "rank " + std::to_string(process) + "'s" : std::string("the")) +
+                      " checkpoint file '" + file + "' (checkpoint_path '" + options_.checkpoint_path +
+                      "'; the checkpoint would replace it); give the probe a file of its own");
+      }
     const std::string use = output_file_use(csv_path);
     if (!use.empty())
       throw Error("sphshell: probe file '" + csv_path + "' is " + use + "; give the probe a file of its own");
-    create_parent_directory(csv_path);
     if constexpr (std::is_same_v<Probe, StressProbe>)
       probe.point_names = thickness_point_names<typename Solver::rule_type>();
-    const ProbeVariant variant{std::move(probe)};
+    OpenProbe open{csv_path, key, ProbeVariant{std::move(probe)}, std::nullopt, 0};
+    if (const auto* particle = std::get_if<ParticleProbe>(&open.probe)) {
+      if (!domain.owns(particle->particle)) return probes_.push_back(std::move(open));
+    } else {
+      const long row = domain.owned_stress_row(static_cast<std::size_t>(std::get<StressProbe>(open.probe).stress_point));
+      if (row < 0) return probes_.push_back(std::move(open));
+      open.local_point = solver.points_->point(PointGroup::stress_points, static_cast<std::size_t>(row));
+    }
+    create_parent_directory(csv_path);
     for (auto record = restored_probes_.begin(); record != restored_probes_.end(); ++record)
       if (record->key == key) {
-        check_same_probe(*record, variant, csv_path);
-        probes_.push_back(OpenProbe{io::CsvProbe(csv_path, columns_of(variant), record->written), variant, key});
+        check_same_probe(*record, open.probe, csv_path);
+        open.file.emplace(csv_path, columns_of(open.probe), record->written);
         restored_probes_.erase(record);
-        return;
+        return probes_.push_back(std::move(open));
       }
-    probes_.push_back(OpenProbe{io::CsvProbe(csv_path, columns_of(variant)), variant, key});
-    write_probe(probes_.back(), solver);
+    open.file.emplace(csv_path, columns_of(open.probe));
+    write_probe(open, solver);
+    probes_.push_back(std::move(open));
   }
 
   // Checkpoints (solver/checkpoint.hpp): the schedule (frames written, the
   // latest frame's step, the next frame and probe times), the frame series
-  // (the collections' entries) and each probe's file (path, what it probes,
-  // its length and content hash).
+  // (the collections' entries, on the first process) and each probe file
+  // this process writes (path, what it probes, its length and content hash).
   template <class Writer>
   void save(Writer& out) const {
     out(static_cast<std::int64_t>(frames_written_), static_cast<std::int64_t>(last_frame_step_), next_frame_time_,
@@ -228,11 +255,12 @@ class SolverOutput {
         out(collection ? entries_of(*collection) : std::vector<SeriesEntry>{});
     std::vector<ProbeRecord> records;
     for (const OpenProbe& open : probes_) {
+      if (!open.file) continue;
       ProbeRecord record;
       record.key = open.key;
       record.kind = static_cast<std::uint32_t>(open.probe.index());
       record.index = probed_index(open.probe);
-      record.written = open.file.written();
+      record.written = open.file->written();
       records.push_back(record);
     }
     out(records);
@@ -265,24 +293,23 @@ class SolverOutput {
     stress_point_collection_.reset();
     crack_collection_.reset();
     frames_written_ = 0;
-    const bool same_directory =
-        !options_.output_directory.empty() && directory == io::identity_of(options_.output_directory);
-    if (series && same_directory) {
+    // A series is recorded once a frame was written (serially; distributed, by the first process).
+    if (!options_.output_directory.empty() && directory == io::identity_of(options_.output_directory)) {
       frames_written_ = static_cast<long>(frames);
-      restore_series(entries, Solver::crack_type::enabled);
+      if (series) restore_series(entries, Solver::crack_type::enabled);
     }
     restored_probes_ = records;
     for (OpenProbe& open : probes_) {
+      if (!open.file) continue;  // another process's
       auto record = std::find_if(restored_probes_.begin(), restored_probes_.end(),
                                  [&](const ProbeRecord& r) { return r.key == open.key; });
-      const std::string path = open.file.path();
       if (record == restored_probes_.end()) {
-        open.file = io::CsvProbe(path, columns_of(open.probe));  // a probe new to the run: starts now
+        open.file.emplace(open.path, columns_of(open.probe));  // a probe new to the run: starts now
         write_probe(open, solver);
         continue;
       }
-      check_same_probe(*record, open.probe, path);
-      open.file = io::CsvProbe(path, columns_of(open.probe), record->written);
+      check_same_probe(*record, open.probe, open.path);
+      open.file.emplace(open.path, columns_of(open.probe), record->written);
       restored_probes_.erase(record);
     }
   }
@@ -309,7 +336,8 @@ class SolverOutput {
     }
     const double probe_tolerance = schedule_tolerance * solver.time_step();
     if (!probes_.empty() && time >= next_probe_time_ - probe_tolerance) {
-      for (OpenProbe& probe : probes_) write_probe(probe, solver);
+      for (OpenProbe& probe : probes_)
+        if (probe.file) write_probe(probe, solver);
       next_probe_time_ = time + options_.probe_interval;
     }
   }
@@ -321,32 +349,53 @@ class SolverOutput {
     if (writes_frames() && last_frame_step_ != solver.steps()) write_frame(solver);
   }
 
-  // One frame now, whatever the schedule.
+  // One frame now, whatever the schedule (collective). Serially its files
+  // are particles_N.vtu, stress_points_N.vtu and, with cracks, cracks_N.vtu;
+  // distributed, each process writes its pieces (particles_N_rR.vtu,
+  // stress_points_N_rR.vtu), then the first process a .pvtu naming the pieces
+  // of each and the whole cracks_N.vtu. The collections list the frame once
+  // every file of it is complete.
   template <class Solver>
   void write_frame(const Solver& solver) {
     if (options_.output_directory.empty())
       detail::invalid_parameter("output_directory", "(empty)", "set it to write ParaView frames");
+    const auto& domain = solver.domain_;
     constexpr bool with_cracks = Solver::crack_type::enabled;
-    if (!particle_collection_) start_series(with_cracks);
-    char number[32];
-    std::snprintf(number, sizeof number, "%06ld", frames_written_);
-    const std::string particle_file = series_path("particles_" + std::string(number) + ".vtu");
-    const std::string stress_file = series_path("stress_points_" + std::string(number) + ".vtu");
-    const std::string crack_file = series_path("cracks_" + std::string(number) + ".vtu");
+    char digits[32];
+    std::snprintf(digits, sizeof digits, "%06ld", frames_written_);
+    const std::string number(digits);
     const io::VtuFormat format{options_.frame_encoding, options_.frame_precision};
     const FramePiece<Solver> piece(solver, options_.frame_coordinates);
-    io::write_vtu(particle_file, piece.particle_grid(), format);
-    io::write_vtu(stress_file, piece.stress_point_grid(), format);
-    if constexpr (with_cracks) io::write_vtu(crack_file, piece.crack_grid(), format);
-    // Every file of the frame is complete before any collection lists it.
-    particle_collection_->stage(solver.time(), particle_file);
-    stress_point_collection_->stage(solver.time(), stress_file);
-    std::vector<const io::PvdCollection*> collections{particle_collection_.get(), stress_point_collection_.get()};
-    if constexpr (with_cracks) {
-      crack_collection_->stage(solver.time(), crack_file);
-      collections.push_back(crack_collection_.get());
-    }
-    io::write_together(collections);
+    std::array<io::VtuGrid, 2> grids{piece.particle_grid(), piece.stress_point_grid()};
+    io::VtuGrid cracks;
+    if constexpr (with_cracks) cracks = piece.crack_grid();  // collective
+    domain.collectively([&] {
+      if (domain.is_root() && !particle_collection_) start_series(with_cracks);
+    });
+    const std::array<std::string, 2> frames{"particles_" + number, "stress_points_" + number};
+    domain.collectively([&] {
+      for (std::size_t k = 0; k < grids.size(); ++k)
+        io::write_vtu(series_path(domain.piece_file_of(frames[k], domain.rank())), grids[k], format);
+    });
+    domain.collectively([&] {
+      if (!domain.is_root()) return;
+      std::array<std::string, 3> listed;
+      for (std::size_t k = 0; k < grids.size(); ++k) {
+        listed[k] = series_path(domain.is_distributed ? frames[k] + ".pvtu" : domain.piece_file_of(frames[k], 0));
+        if (domain.is_distributed) write_pvtu(listed[k], frames[k], domain, grids[k]);
+      }
+      listed[2] = series_path("cracks_" + number + ".vtu");
+      if (with_cracks) io::write_vtu(listed[2], cracks, format);
+      // Every file of the frame is complete before any collection lists it.
+      particle_collection_->stage(solver.time(), listed[0]);
+      stress_point_collection_->stage(solver.time(), listed[1]);
+      std::vector<const io::PvdCollection*> collections{particle_collection_.get(), stress_point_collection_.get()};
+      if (with_cracks) {
+        crack_collection_->stage(solver.time(), listed[2]);
+        collections.push_back(crack_collection_.get());
+      }
+      io::write_together(collections);
+    });
     ++frames_written_;
     last_frame_step_ = solver.steps();
   }
@@ -365,12 +414,15 @@ class SolverOutput {
 
   using ProbeVariant = std::variant<ParticleProbe, StressProbe>;
 
-  // A CSV file, the probe that fills it and the file's identity (its
-  // absolute, normalized path) to keep two probes off one file.
+  // A probe: its CSV file as added and its identity (the absolute,
+  // normalized path, to keep two probes off one file), what it probes, and,
+  // on the process that owns that, the open file (and a stress point's local
+  // point).
   struct OpenProbe {
-    io::CsvProbe file;
+    std::string path, key;
     ProbeVariant probe;
-    std::string key;
+    std::optional<io::CsvProbe> file;
+    std::size_t local_point;
   };
 
   // A probe file as a checkpoint recorded it: kind 0 a particle probe, 1 a
@@ -445,21 +497,14 @@ class SolverOutput {
   // The frames number files with a long: digits past one are no frame's.
   static constexpr long unreadable_number = -2;
 
-  // The number N of a frame file "<series>_N.vtu" (or its .tmp), -1 for any
-  // other name, unreadable_number for digits no long holds.
-  static long frame_number(std::string name) {
-    if (!io::is_frame_file(name)) return -1;
-    const std::string temporary = ".tmp", extension = ".vtu";
-    if (name.size() > temporary.size() && name.compare(name.size() - temporary.size(), temporary.size(), temporary) == 0)
-      name.resize(name.size() - temporary.size());
-    if (name.size() <= extension.size() || name.compare(name.size() - extension.size(), extension.size(), extension) != 0)
-      return -1;  // a collection
-    name.resize(name.size() - extension.size());
-    const std::size_t underscore = name.rfind('_');
-    const std::string digits = name.substr(underscore + 1);  // is_frame_file vouches they are digits
+  // The number N of a frame file "<series>_N.vtu" (a piece, a .pvtu, or
+  // their .tmp), -1 for any other name, unreadable_number for digits no long holds.
+  static long frame_number(const std::string& name) {
+    const std::optional<std::string> digits = io::frame_file_digits(name);
+    if (!digits || digits->empty()) return -1;  // no frame file, or a collection
     long number = 0;
-    const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), number);
-    if (error != std::errc() || end != digits.data() + digits.size()) return unreadable_number;
+    const auto [end, error] = std::from_chars(digits->data(), digits->data() + digits->size(), number);
+    if (error != std::errc() || end != digits->data() + digits->size()) return unreadable_number;
     return number;
   }
 
@@ -503,7 +548,6 @@ class SolverOutput {
   }
 
   bool writes_frames() const { return !options_.output_directory.empty() && options_.output_interval > 0.0; }
-  bool deformed() const { return options_.frame_coordinates == FrameCoordinates::deformed; }
 
   std::string series_path(const std::string& name) const { return options_.output_directory + "/" + name; }
 
@@ -544,9 +588,68 @@ class SolverOutput {
     for (const fs::path& file : stale) io::remove_file(file.string());
   }
 
+  // What ParticleProbe and StressPointProbe read, of what this process owns
+  // (particles by their global number; the probed stress point's local point).
+  template <class Solver>
+  struct OwnedView {
+    const Solver& solver;
+    std::size_t local_point;
+    struct Field {
+      const std::vector<Vector3>& local;
+      const OwnedView& view;
+      const Vector3& operator[](int global) const { return local[view.local(global)]; }
+    };
+    double time() const { return solver.time(); }
+    Field velocities() const { return {solver.particles_.velocity, *this}; }
+    std::size_t local(int global) const {
+      return static_cast<std::size_t>(solver.domain_.local_of(static_cast<std::size_t>(global)));
+    }
+    Vector3 displacement(int global) const {
+      return solver.particles_.position[local(global)] - solver.reference_position_[local(global)];
+    }
+    Vector3 rotation(int global) const {
+      return rotation_vector(solver.reference_normal_[local(global)], solver.particles_.director[local(global)]);
+    }
+    double integral_point_quantity(IntegralPointQuantity quantity, int, int k) const {
+      return solver.states_->quantity(quantity, local_point, k);
+    }
+  };
   template <class Solver>
   static void write_probe(OpenProbe& open, const Solver& solver) {
-    open.file.write_row(std::visit([&](const auto& probe) { return probe.row(solver); }, open.probe));
+    const OwnedView<Solver> view{solver, open.local_point};
+    open.file->write_row(std::visit([&](const auto& probe) { return probe.row(view); }, open.probe));
+  }
+
+  // The parallel file of one frame: its pieces and the arrays they hold
+  // (names, types and components as `layout`, a piece, has them).
+  template <class Domain>
+  void write_pvtu(const std::string& file_path, const std::string& frame, const Domain& domain,
+                  const io::VtuGrid& layout) const {
+    const std::string real = options_.frame_precision == io::VtuPrecision::float32 ? "Float32" : "Float64";
+    auto array = [&](std::ostream& out, const io::Field& field) {
+      out << "      <PDataArray type=\"" << (field.kind == io::FieldValues::integer ? "Int32" : real) << "\" Name=\""
+          << field.name << "\"";
+      if (field.components > 1) out << " NumberOfComponents=\"" << field.components << "\"";
+      out << "/>\n";
+    };
+    io::detail::ReplacingOutputFile file(file_path);
+    std::ostream& out = file.stream();
+    out << "<?xml version=\"1.0\"?>\n"
+        << "<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
+        << "  <PUnstructuredGrid GhostLevel=\"0\">\n"
+        << "    <PPointData>\n";
+    for (const io::PointField& field : layout.point_fields) array(out, field);
+    out << "    </PPointData>\n"
+        << "    <PCellData>\n";
+    for (const io::CellField& field : layout.cell_fields) array(out, field);
+    out << "    </PCellData>\n"
+        << "    <PPoints>\n"
+        << "      <PDataArray type=\"" << real << "\" Name=\"Points\" NumberOfComponents=\"3\"/>\n"
+        << "    </PPoints>\n";
+    for (int r = 0; r < domain.size(); ++r) out << "    <Piece Source=\"" << domain.piece_file_of(frame, r) << "\"/>\n";
+    out << "  </PUnstructuredGrid>\n"
+        << "</VTKFile>\n";
+    file.commit();
   }
 
  public:
@@ -566,8 +669,9 @@ class SolverOutput {
   OutputOptions options_;
   std::ostream* notes_ = nullptr;
   std::string directory_key_;                // identity_of(output_directory), "" without one
-  std::unique_ptr<io::DirectoryLock> lock_;  // held while the solver lives
+  std::unique_ptr<io::DirectoryLock> lock_;  // the first process's, held while the solver lives
   std::vector<OpenProbe> probes_;
+  // The first process's.
   std::unique_ptr<io::PvdCollection> particle_collection_, stress_point_collection_, crack_collection_;
   long frames_written_ = 0;
   long last_frame_step_ = -1;  // the step of the latest frame; -1 before the first
@@ -580,7 +684,7 @@ class SolverOutput {
 // The grids of one frame drawn from a solver's share (solver.hpp; the
 // Solver's friend): this process's particles and the active stress points
 // it owns, serially all of them; a distributed run writes one piece per
-// process (mpi/distributed_output.hpp). The shell is drawn as its cells
+// process. The shell is drawn as its cells
 // (ShellModel::cells()), corners numbered in the piece's particles (a
 // piece's particles are the process's local ones: owned, then ghosts, so a
 // cell at the share's edge has its corners), with cracks as gaps (see the
