@@ -35,6 +35,7 @@
 
 #include <sphshell/approx/approx.hpp>
 #include <sphshell/approx/memory_estimate.hpp>
+#include <sphshell/contact/body_set.hpp>
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/parallel.hpp>
 #include <sphshell/core/types.hpp>
@@ -177,6 +178,38 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
       this->check_stress_point(stress_point);
       output_->add_probe(csv_path, typename Output::StressProbe{stress_point}, *this);
     });
+  }
+  // A rigid body (contact/rigid_body.hpp) in penalty contact with the shell
+  // (contact/penalty.hpp: k = s m / Δt², offsets of half the thickness,
+  // Coulomb friction); a free body moves under the contact's reaction. The
+  // run's time step is kept. Returns the body's id for rigid_body() and
+  // add_rigid_body_probe(). One process only: a distributed run refuses.
+  template <class Shape, class Motion>
+  contact::RigidBodyId add_rigid_body(contact::RigidBody<Shape, Motion> body,
+                                      const contact::PenaltyOptions& contact_options = {}) {
+    if constexpr (distributed) {
+      domain_.collectively([&] {
+        throw Error("sphshell: add_rigid_body: a distributed run has no rigid bodies yet (the contact reactions "
+                    "are not summed over the processes); run the impact on one process");
+      });
+      return 0;
+    } else {
+      latch_.check();
+      if (this->periodic_checkpoints())
+        detail::invalid_parameter("checkpoint_path", options_.checkpoint_path,
+                                  "a run with rigid bodies cannot be checkpointed yet: set checkpoint_every_steps "
+                                  "and checkpoint_every_seconds to 0");
+      if (body_thickness_.empty())
+        for (std::size_t i = 0; i < particles_.size(); ++i) body_thickness_.push_back(model_.particle_thickness(i));
+      return bodies_.add(std::move(body), contact_options, contact_particles(), time_step_);
+    }
+  }
+  std::size_t rigid_body_count() const { return bodies_.size(); }
+  // A body's position, velocities and the contact load of the last step.
+  contact::RigidBodyState rigid_body(contact::RigidBodyId id) const { return bodies_.state(id); }
+  // CSV time history of a body (contact/body_set.hpp): now and after every step.
+  void add_rigid_body_probe(const std::string& csv_path, contact::RigidBodyId id) {
+    bodies_.add_probe(csv_path, id, time_);
   }
   // Writes one ParaView frame now (particles, stress points and cracks),
   // whatever the output interval; requires output_directory. Collective.
@@ -362,7 +395,9 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
                    ? states_->stored_energy(p, points_->membrane_bending_weight(p), points_->shear_weight(p))
                    : 0.0;
       });
-      return ledger_->report(domain_, stored, fracture_.released_energy());
+      EnergyReport report = ledger_->report(domain_, stored, fracture_.released_energy());
+      if (!bodies_.empty()) report.add_rigid_bodies(bodies_.energy());
+      return report;
     }
   }
 
@@ -374,6 +409,10 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
   friend class solver::CheckpointIO<Solver>;
   friend class solver::FramePiece<Solver>;
   StepTime now() const { return {steps_, time_}; }
+  contact::ContactParticles contact_particles() {
+    return {particles_.position, particles_.director, particles_.velocity, particles_.angular_velocity,
+            inertia_.mass,       body_thickness_};
+  }
 
   void set_up(const typename Domain::Weights& weights) try {
     domain_.collectively([&] {
@@ -483,9 +522,13 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
     if (!loads_in_pass) apply_loads(context.at, failure);
     stop_if_alone(failure);
     // The particle pass over the owned particles (solver/particle_pass.hpp).
+    if (!bodies_.empty())
+      bodies_.prepare(contact_particles(), forces_.external, forces_.external_moment, time_step_,
+                      ledger_->chunk_count(particles_));
     solver::ParticlePass<Ledger, Stepper> pass{
         loads_,   load_context_at(context.at.time), constraints_, reference_position_, time_step_, *ledger_,
-        stepper_, particles_, inertia_, forces_, distributed ? nullptr : &*assembler_};
+        stepper_, particles_, inertia_, forces_, distributed ? nullptr : &*assembler_,
+        bodies_.empty() ? nullptr : &bodies_};
     const solver::ParticlePassFailures failed = pass.run(context, loads_in_pass);
     if (failed.load < domain_.owned_count()) keep_first(failure, non_finite_load(context.at, failed.load));
     if (failed.condition_error) {
@@ -499,8 +542,10 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
     }
     stop_if_alone(failure);
     ledger_->finish_step();  // a failed step's terms never reach the books
+    if (!bodies_.empty()) bodies_.finish_step(context.at, time_step_, context.velocity_step);
     ++steps_;
     time_ = start_time_ + static_cast<double>(steps_) * time_step_;  // t = t0 + n Δt, never summed
+    bodies_.write_probes(time_);
     forces_current_ = false;
     if (failed.state < domain_.owned_count()) keep_first(failure, this->non_finite_state(now(), failed.state));
     domain_.agree(failure);
@@ -530,6 +575,8 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
   double time_ = 0.0;
   long steps_ = 0;
   bool forces_current_ = false;
+  contact::RigidBodySet bodies_;
+  std::vector<double> body_thickness_;  // each particle's thickness, for the contact offsets
   solver::StepLatch latch_;  // the error that stopped step(); later steps refuse with it
 };
 

@@ -3,8 +3,9 @@
 // message; periodic checkpoints are written by every rank and a restart from
 // them continues bitwise; a checkpoint of the other kind of run or of another
 // rank count, and a set name the model does not have, are each an Error
-// naming it on every rank.
+// naming it on every rank; a rigid body (not distributed yet) is refused alike.
 #include <sphshell/approx/mls.hpp>
+#include <sphshell/contact/sphere.hpp>
 #include <sphshell/kernel/cubic_spline.hpp>
 #include <sphshell/material/elastic.hpp>
 #include <sphshell/mpi/distributed_solver.hpp>
@@ -251,4 +252,18 @@ TEST_CASE("Checkpoints of the other kind of run or another rank count, unknown s
   CHECK(by_name.displacement(by_name.model().nearest_particle(Vector3(0.25, 0.25, 0.0))).norm() > 0.0);
   comm.all_gather(0);
   if (comm.is_root()) std::filesystem::remove_all(folder);
+}
+
+TEST_CASE("A rigid body in a distributed run: an Error naming the feature on every rank, the run usable",
+          "[mpi][solver][contact][errors]") {
+  const mpi::Communicator comm;
+  Distributed distributed(comm, plate(), steel, steel_options());
+  distributed.clamp("boundary");
+  contact::RigidKinematics above;
+  above.position = Vector3(0.25, 0.25, 0.1);
+  const contact::RigidBody<contact::Sphere, contact::Fixed> sphere(contact::Sphere(0.05), contact::Fixed{}, above);
+  CHECK_THROWS_WITH(distributed.add_rigid_body(sphere),
+                    Catch::Contains("add_rigid_body") && Catch::Contains("distributed run has no rigid bodies"));
+  CHECK(distributed.rigid_body_count() == 0);
+  CHECK_NOTHROW(distributed.step());
 }

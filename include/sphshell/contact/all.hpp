@@ -1,6 +1,7 @@
 #pragma once
 // Every part of the contact family.
 
+#include <sphshell/contact/body_set.hpp>
 #include <sphshell/contact/contact.hpp>
 #include <sphshell/contact/cylinder.hpp>
 #include <sphshell/contact/penalty.hpp>

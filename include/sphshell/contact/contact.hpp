@@ -1,6 +1,6 @@
 #pragma once
 // The contact family: rigid bodies and the penalty contact of shell particles
-// against them. These parts stand alone; the Solver does not call them yet.
+// against them; body_set.hpp is how the Solver steps them (add_rigid_body).
 //
 // A rigid shape describes a surface in its body frame (the body's centre at
 // the origin) and provides

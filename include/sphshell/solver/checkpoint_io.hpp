@@ -40,6 +40,10 @@ class CheckpointIO {
     using Stepper = typename Solver::stepper_type;
     const std::uint64_t stamp = s.domain_.save_stamp();
     s.domain_.collectively([&] {
+      // The bodies' state and contact history are not in the file format.
+      if (s.rigid_body_count() > 0)
+        sphshell::detail::invalid_parameter("checkpoint of a run with rigid bodies", s.rigid_body_count(),
+                                  "bodies cannot be checkpointed yet: save a run without rigid bodies");
       using checkpoint::write_section;
       io::BinaryWriter out;
       write_section(out, "IDNT", [&] { out(identity()); });

@@ -36,10 +36,30 @@ struct EnergyReport {
   double external_work = 0.0;        // loads and prescribed motions
   double damping_work = 0.0;         // removed by mass-proportional damping
   double released_by_fracture = 0.0; // elastic energy held by integration points when they were removed (part of plastic_dissipation)
+  // Rigid bodies and their contact (contact/body_set.hpp); all zero in a run without bodies.
+  double rigid_body_kinetic = 0.0;     // the bodies' kinetic energy
+  double contact_energy = 0.0;         // held by the contact springs
+  double friction_dissipation = 0.0;   // dissipated by contact friction
+  double contact_work_on_shell = 0.0;  // the contact forces' work on the shell (part of external_work)
+  double rigid_body_work = 0.0;        // put into the bodies from outside the contact (initial motion, gravity, drives)
   // kinetic + internal + damping − external, zero up to the time-discretization
   // error. The leapfrog velocities live at half steps, so the internal energy
   // enters at the half step too (the mean of its two neighbouring values).
+  // With rigid bodies, that of the whole system (contact/body_set.hpp):
+  // + contact_work_on_shell + rigid_body_kinetic + contact_energy
+  // + friction_dissipation − rigid_body_work.
   double balance() const { return balance_; }
+
+  // The bodies' and contacts' terms, into the report and its balance.
+  template <class ContactEnergy>
+  void add_rigid_bodies(const ContactEnergy& energy) {
+    rigid_body_kinetic = energy.body_kinetic;
+    contact_energy = energy.spring;
+    friction_dissipation = energy.friction_dissipation;
+    contact_work_on_shell = energy.shell_contact_work;
+    rigid_body_work = energy.body_work;
+    balance_ += contact_work_on_shell + rigid_body_kinetic + contact_energy + friction_dissipation - rigid_body_work;
+  }
 
   double balance_ = 0.0;
 };
@@ -191,7 +211,8 @@ struct EnergyLedger {
   // energies are above round-off.
   static bool balance_lost(const StepTime& at, const EnergyReport& e, const MonitoringOptions& monitoring,
                            double round_off_energy) {
-    const double scale = std::max({std::abs(e.external_work), e.kinetic, std::abs(e.internal)});
+    const double scale =
+        std::max({std::abs(e.external_work), e.kinetic, std::abs(e.internal), e.rigid_body_kinetic});
     return at.step >= first_checked_step && scale > round_off_energy &&
            std::abs(e.balance()) > monitoring.energy_tolerance * scale;
   }

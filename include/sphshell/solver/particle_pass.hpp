@@ -10,7 +10,9 @@
 // after the other took nine parallel regions, each costing two threads more
 // than the part's work on the paper's plate (docs/performance.md). Serial
 // loads (user pressure functions, detail::Load::serial) are applied by the
-// caller before the pass.
+// caller before the pass. The rigid bodies' contact (contact/body_set.hpp),
+// when the run has bodies, adds its loads after the chunk's loads and books
+// its work after the chunk's energy terms; the bodies move after the pass.
 //
 // Nothing is thrown: the pass returns what failed, for the caller to report
 // as the parts would one after the other (a non-finite load at the lowest
@@ -18,6 +20,7 @@
 // then the lowest particle with a non-finite state) — at once in a serial
 // run, through the agreement with global ids in a distributed one.
 
+#include <sphshell/contact/body_set.hpp>
 #include <sphshell/core/parallel.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/shell/constraints.hpp>
@@ -45,7 +48,8 @@ struct ParticlePassFailures {
 
 // The parts the pass works on. ledger: the energy books' chunk interface
 // (EnergyLedger, or the distributed one); packer: null when the gathers need
-// particles the pass does not step (a distributed run's ghosts).
+// particles the pass does not step (a distributed run's ghosts); bodies: null
+// when the run has no rigid bodies (prepared by the caller otherwise).
 template <class Ledger, class Stepper>
 struct ParticlePass {
   ExternalLoads& loads;
@@ -59,6 +63,7 @@ struct ParticlePass {
   const Inertia& inertia;
   const ParticleForces& forces;
   InternalForceAssembler* packer;
+  contact::RigidBodySet* bodies;
 
   ParticlePassFailures run(const stepper::StepContext& context, bool loads_in_pass) {
     if (loads_in_pass) loads.start_step(context.at.time);
@@ -75,6 +80,7 @@ struct ParticlePass {
         const std::size_t i = loads.apply_range(load_context, first, last);
         if (i < last) parallel::keep_lowest(load_failure, i);
       }
+      if (bodies) bodies->load_chunk(chunk, first, last);
       ledger.remember_velocities(particles, first, last);
       stepper.advance_velocities(context, particles, inertia, forces, first, last);
       ledger.remember_free_velocities(particles, first, last);
@@ -87,6 +93,7 @@ struct ParticlePass {
                            }
                          });
       ledger.book_chunk(context, particles, inertia, forces, chunk);
+      if (bodies) bodies->book_chunk(chunk, first, last, context.velocity_step);
       stepper.advance_configuration(context, particles, first, last);
       for (std::size_t i = first; i < last; ++i)
         if (!all_finite(particles.position[i], particles.director[i], particles.velocity[i],

@@ -1,0 +1,348 @@
+#pragma once
+// The rigid bodies of a run and their penalty contact with the shell, as the
+// Solver steps them (Solver::add_rigid_body).
+//
+// Each body is kept with its own PenaltyContact behind one small interface,
+// so bodies of any shape and motion (a prescribed motion's callables are
+// template parameters) sit side by side. The interface is called once per
+// body per chunk of particles; the loop over a chunk's particles is the
+// concrete PenaltyContact::compute_range of that body's type, with no
+// indirect call per particle.
+//
+// In a step, at configuration n (solver/particle_pass.hpp):
+//   prepare()     before the particle pass;
+//   load_chunk()  in the pass, after the loads and before the stepper's
+//                 velocity update: every body's contact with the chunk's
+//                 particles, added to their external forces and moments,
+//                 and the chunk's sums (reaction on the body, spring energy,
+//                 friction dissipation) kept in that chunk's slot;
+//   book_chunk()  in the pass, after the energy books' chunk: the work of the
+//                 contact forces on the chunk's particles over the step, as
+//                 the books count external work, f · Δt_v (v^{n−½} + v^{n+½})/2
+//                 (and the moments' with ω);
+//   finish_step() after the pass: the slots summed in chunk order (the same
+//                 bits for any thread count), the reaction put on each body,
+//                 the body advanced (RigidBody::advance) and the energy terms
+//                 booked.
+//
+// The spring energy is reported at n+½, where the books' kinetic energies
+// are: the springs' ½ k δ² at n less the contact's work over the step's second
+// half, f^n · Δt_v (v^{n+½} − v_body^{n+½})/2 summed over the contacts.
+//
+// Energy (EnergyReport): the contact forces on the particles are external
+// loads of the shell, so the shell's books count their work W_cs as external
+// work. The whole system — shell, bodies and contact springs — balances
+//   shell balance + W_cs + K_b + E_spring + D_friction − W_b = 0,
+// K_b the bodies' kinetic energy, E_spring the energy the contact springs
+// hold, D_friction what slip dissipated, and W_b the work put into the bodies
+// from outside the contact: their initial kinetic energy, gravity's work
+// (free bodies, m g · Δt_v v̄) and, for a fixed or prescribed body, the work
+// of what drives it (its kinetic energy change less the contact's work on it).
+// The contact work of the pair, W_cs + the contact's work on the bodies,
+// equals −ΔE_spring − D_friction: the books' force-at-n times mean-velocity
+// sums and the spring's trapezoidal sums differ only by their end term, the
+// second half above.
+
+#include <sphshell/contact/penalty.hpp>
+#include <sphshell/contact/rigid_body.hpp>
+#include <sphshell/core/error.hpp>
+#include <sphshell/core/types.hpp>
+
+#include <cmath>
+#include <cstddef>
+#include <fstream>
+#include <iomanip>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace sphshell::contact {
+
+// A body's index in its run, in the order added.
+using RigidBodyId = std::size_t;
+
+// What a run reports of one body after a step: position and orientation at
+// the new configuration n+1, velocities at n+½ (the central difference's
+// half step), the contact load it received in the step (at configuration n)
+// and the impulse received since the start.
+struct RigidBodyState {
+  RigidKinematics kinematics;
+  Vector3 contact_force = Vector3::Zero();
+  Vector3 contact_moment = Vector3::Zero();  // about the body's centre
+  Vector3 contact_impulse = Vector3::Zero();
+  std::size_t contacts = 0;    // particles in contact in the step
+  double kinetic_energy = 0.0;  // ½ m |v|² + ½ ω · I ω (free bodies; 0 for others)
+};
+
+// The bodies' and contacts' energy terms (see the header comment).
+struct ContactEnergy {
+  double body_kinetic = 0.0;           // K_b
+  double spring = 0.0;                 // E_spring, at configuration n of the last step
+  double friction_dissipation = 0.0;   // D_friction, summed over the steps
+  double shell_contact_work = 0.0;     // W_cs, summed over the steps (part of the shell's external work)
+  double body_work = 0.0;              // W_b, summed over the steps
+};
+
+namespace detail {
+
+// One body with its contact; the solver's interface to it.
+class BodyContact {
+ public:
+  virtual ~BodyContact() = default;
+  virtual void prepare(std::size_t chunk_count) = 0;
+  // Particles [first, last) of chunk `chunk`: their loads into loads(), the sums into the chunk's slot.
+  virtual void compute_range(const ContactParticles& particles, double time_step, std::size_t chunk,
+                             std::size_t first, std::size_t last) = 0;
+  // The slots summed in chunk order, the body moved: returns the step's
+  // sums, the work put into the body from outside the contact and the
+  // contact's work on it over the step's second half.
+  virtual ContactStepResult finish_step(const StepTime& at, double time_step, double velocity_step,
+                                        double& body_work, double& contact_second_half) = 0;
+  virtual RigidBodyState state() const = 0;
+  const ParticleContactLoads& loads() const { return loads_; }
+
+ protected:
+  ParticleContactLoads loads_;
+};
+
+template <class Shape, class Motion>
+class BodyContactOf final : public BodyContact {
+ public:
+  BodyContactOf(RigidBody<Shape, Motion> body, const PenaltyOptions& options, const ContactParticles& particles,
+                double time_step)
+      : body_(std::move(body)), contact_(options) {
+    contact_.prepare(particles, time_step, loads_);
+  }
+
+  void prepare(std::size_t chunk_count) override { slots_.assign(chunk_count, ContactStepResult{}); }
+
+  void compute_range(const ContactParticles& particles, double time_step, std::size_t chunk, std::size_t first,
+                     std::size_t last) override {
+    slots_[chunk] = contact_.compute_range(particles, body_, time_step, loads_, first, last);
+  }
+
+  ContactStepResult finish_step(const StepTime& at, double time_step, double velocity_step, double& body_work,
+                                double& contact_second_half) override {
+    ContactStepResult total;
+    for (const ContactStepResult& slot : slots_) PenaltyContact::accumulate(total, slot);
+    const Vector3 old_velocity = body_.velocity();
+    const Vector3 old_angular_velocity = body_.angular_velocity();
+    const double old_kinetic = kinetic_energy();
+    body_.clear_contact_load();
+    body_.add_contact_load(total.body_force, total.body_moment);
+    body_.advance(at, time_step);
+    contacts_ = total.contacts;
+    // The contact's work on the body over the step, as the books count a particle's.
+    contact_second_half =
+        0.5 * velocity_step * (total.body_force.dot(body_.velocity()) + total.body_moment.dot(body_.angular_velocity()));
+    const double contact_work =
+        0.5 * velocity_step * (total.body_force.dot(old_velocity) + total.body_moment.dot(old_angular_velocity)) +
+        contact_second_half;
+    if constexpr (Motion::free) {
+      body_work = velocity_step * body_.motion().mass() *
+                  body_.motion().gravity().dot(0.5 * (old_velocity + body_.velocity()));
+    } else {
+      body_work = kinetic_energy() - old_kinetic - contact_work;
+    }
+    return total;
+  }
+
+  RigidBodyState state() const override {
+    RigidBodyState state;
+    state.kinematics = body_.kinematics();
+    state.contact_force = body_.contact_force();
+    state.contact_moment = body_.contact_moment();
+    state.contact_impulse = body_.contact_impulse();
+    state.contacts = contacts_;
+    state.kinetic_energy = kinetic_energy();
+    return state;
+  }
+
+  // ½ m |v|² + ½ Σ I_k ω_k² (body frame); a body that is not free has no mass here.
+  double kinetic_energy() const {
+    if constexpr (Motion::free) {
+      double energy = 0.5 * body_.motion().mass() * body_.velocity().squaredNorm();
+      if constexpr (RigidBody<Shape, Motion>::rotates) {
+        const Vector3 omega = body_.orientation().conjugate() * body_.angular_velocity();
+        energy += 0.5 * body_.motion().principal_inertia().dot(omega.cwiseProduct(omega));
+      }
+      return energy;
+    } else {
+      return 0.0;
+    }
+  }
+
+  const RigidBody<Shape, Motion>& body() const { return body_; }
+
+ private:
+  RigidBody<Shape, Motion> body_;
+  PenaltyContact contact_;
+  std::vector<ContactStepResult> slots_;
+  std::size_t contacts_ = 0;
+};
+
+}  // namespace detail
+
+class RigidBodySet {
+ public:
+  bool empty() const { return bodies_.empty(); }
+  std::size_t size() const { return bodies_.size(); }
+
+  // A body in contact with the particles (the whole shell, one process).
+  // Refuses a body whose surface lies deeper in the shell than a particle's
+  // half thickness (the contact would throw the particle out at once).
+  template <class Shape, class Motion>
+  RigidBodyId add(RigidBody<Shape, Motion> body, const PenaltyOptions& options, const ContactParticles& particles,
+                  double time_step) {
+    validate(options);
+    for (std::size_t i = 0; i < particles.position.size(); ++i) {
+      const double gap = body.proximity(particles.position[i]).gap;
+      if (gap < -0.5 * particles.thickness[i])
+        sphshell::detail::invalid_parameter(
+            "rigid body " + std::to_string(bodies_.size()) + " initial gap at particle " + std::to_string(i), gap,
+            "must be at least minus half the thickness (" + std::to_string(-0.5 * particles.thickness[i]) +
+                " m): the body starts inside the shell");
+    }
+    auto pair = std::make_unique<detail::BodyContactOf<Shape, Motion>>(std::move(body), options, particles, time_step);
+    energy_.body_work += pair->kinetic_energy();  // the initial kinetic energy is put in from outside
+    energy_.body_kinetic += pair->kinetic_energy();
+    bodies_.push_back(std::move(pair));
+    old_velocity_.resize(particles.position.size());
+    old_angular_velocity_.resize(particles.position.size());
+    return bodies_.size() - 1;
+  }
+
+  // Before the particle pass: the particles (the solver's arrays), where the
+  // contact loads go, and the pass's chunk count.
+  void prepare(const ContactParticles& particles, std::vector<Vector3>& external_force,
+               std::vector<Vector3>& external_moment, double time_step, std::size_t chunk_count) {
+    particles_ = std::make_unique<ContactParticles>(particles);
+    external_force_ = &external_force;
+    external_moment_ = &external_moment;
+    time_step_ = time_step;
+    for (auto& body : bodies_) body->prepare(chunk_count);
+    shell_work_slots_.assign(chunk_count, HalfStepWork{});
+  }
+
+  // In the pass, after the chunk's loads: the bodies' contact loads added to them.
+  void load_chunk(std::size_t chunk, std::size_t first, std::size_t last) noexcept {
+    const ContactParticles& particles = *particles_;
+    for (std::size_t i = first; i < last; ++i) {
+      old_velocity_[i] = particles.velocity[i];
+      old_angular_velocity_[i] = particles.angular_velocity[i];
+    }
+    for (auto& body : bodies_) {
+      body->compute_range(particles, time_step_, chunk, first, last);
+      const ParticleContactLoads& loads = body->loads();
+      for (std::size_t i = first; i < last; ++i) {
+        (*external_force_)[i] += loads.force[i];
+        (*external_moment_)[i] += loads.moment[i];
+      }
+    }
+  }
+
+  // In the pass, after the velocities are final (kinematic conditions imposed):
+  // the contact forces' work on the chunk's particles over the step.
+  void book_chunk(std::size_t chunk, std::size_t first, std::size_t last, double velocity_step) noexcept {
+    const ContactParticles& particles = *particles_;
+    HalfStepWork work;
+    for (const auto& body : bodies_) {
+      const ParticleContactLoads& loads = body->loads();
+      for (std::size_t i = first; i < last; ++i) {
+        work.first_half += 0.5 * velocity_step *
+                           (loads.force[i].dot(old_velocity_[i]) + loads.moment[i].dot(old_angular_velocity_[i]));
+        work.second_half += 0.5 * velocity_step *
+                            (loads.force[i].dot(particles.velocity[i]) +
+                             loads.moment[i].dot(particles.angular_velocity[i]));
+      }
+    }
+    shell_work_slots_[chunk] = work;
+  }
+
+  // After the pass (which did not fail): the bodies move, the books add the step.
+  void finish_step(const StepTime& at, double time_step, double velocity_step) {
+    double spring = 0.0, kinetic = 0.0, second_half = 0.0;
+    for (auto& body : bodies_) {
+      double body_work = 0.0, body_second_half = 0.0;
+      const ContactStepResult result = body->finish_step(at, time_step, velocity_step, body_work, body_second_half);
+      spring += result.spring_energy;
+      second_half += body_second_half;
+      energy_.friction_dissipation += result.friction_dissipation;
+      energy_.body_work += body_work;
+      kinetic += body->state().kinetic_energy;
+    }
+    for (const HalfStepWork& work : shell_work_slots_) {
+      energy_.shell_contact_work += work.first_half + work.second_half;
+      second_half += work.second_half;
+    }
+    // The springs' energy at n+½, where the books' kinetic energies are: the
+    // energy at n less the contact's work over the step's second half.
+    energy_.spring = spring - second_half;
+    energy_.body_kinetic = kinetic;
+  }
+
+  const ContactEnergy& energy() const { return energy_; }
+
+  RigidBodyState state(RigidBodyId id) const {
+    check(id);
+    return bodies_[id]->state();
+  }
+
+  // CSV time history of one body: written now and after every step.
+  void add_probe(const std::string& csv_path, RigidBodyId id, double time) {
+    check(id);
+    Probe probe{id, std::ofstream(csv_path)};
+    if (!probe.file)
+      sphshell::detail::invalid_parameter("rigid body probe path", csv_path, "must be a file that can be written");
+    probe.file << "# rigid body " << id
+               << ": t (s); centre x, y, z at t (m); velocity at t - dt/2 (m/s); contact force and impulse "
+                  "received (N, N s); particles in contact\n"
+               << "t,x,y,z,vx,vy,vz,fx,fy,fz,impulse_x,impulse_y,impulse_z,contacts\n"
+               << std::setprecision(17);
+    probes_.push_back(std::move(probe));
+    write_probe(probes_.back(), time);
+  }
+  void write_probes(double time) {
+    for (Probe& probe : probes_) write_probe(probe, time);
+  }
+
+ private:
+  struct Probe {
+    RigidBodyId id;
+    std::ofstream file;
+  };
+  void write_probe(Probe& probe, double time) const {
+    const RigidBodyState s = bodies_[probe.id]->state();
+    const Vector3& x = s.kinematics.position;
+    const Vector3& v = s.kinematics.velocity;
+    probe.file << time << ',' << x.x() << ',' << x.y() << ',' << x.z() << ',' << v.x() << ',' << v.y() << ','
+               << v.z() << ',' << s.contact_force.x() << ',' << s.contact_force.y() << ',' << s.contact_force.z()
+               << ',' << s.contact_impulse.x() << ',' << s.contact_impulse.y() << ',' << s.contact_impulse.z() << ','
+               << s.contacts << '\n';
+    probe.file.flush();
+  }
+  void check(RigidBodyId id) const {
+    if (id >= bodies_.size())
+      sphshell::detail::invalid_parameter("rigid body id", id,
+                                          "must be below the number of bodies added (" +
+                                              std::to_string(bodies_.size()) + ")");
+  }
+
+  std::vector<std::unique_ptr<detail::BodyContact>> bodies_;
+  std::unique_ptr<ContactParticles> particles_;  // the solver's arrays, this step
+  std::vector<Vector3>* external_force_ = nullptr;
+  std::vector<Vector3>* external_moment_ = nullptr;
+  double time_step_ = 0.0;
+  std::vector<Vector3> old_velocity_, old_angular_velocity_;
+  // The contact forces' work on a chunk's particles over the halves of the
+  // step, f^n · Δt_v v^{n−½}/2 and f^n · Δt_v v^{n+½}/2.
+  struct HalfStepWork {
+    double first_half = 0.0, second_half = 0.0;
+  };
+  std::vector<HalfStepWork> shell_work_slots_;
+  ContactEnergy energy_;
+  std::vector<Probe> probes_;
+};
+
+}  // namespace sphshell::contact
