@@ -30,3 +30,4 @@
 #include <sphshell/shell/model.hpp>
 #include <sphshell/shell/spherical_cap_ogrid.hpp>
 #include <sphshell/solver.hpp>
+#include <sphshell/statics/all.hpp>

@@ -1,0 +1,9 @@
+#pragma once
+// Every part of the static analysis family (statics/statics.hpp states the contract).
+#include <sphshell/statics/statics.hpp>
+
+#include <sphshell/statics/buckling.hpp>
+#include <sphshell/statics/conditions.hpp>
+#include <sphshell/statics/path_following.hpp>
+#include <sphshell/statics/stability.hpp>
+#include <sphshell/statics/tangent.hpp>

@@ -1,0 +1,425 @@
+#pragma once
+// Equilibrium paths of an elastic shell model by Newton's method on the
+// assembled tangent (statics/tangent.hpp), the load factor λ scaling the dead
+// loads of the Conditions:
+//
+// - linear_solve: one Newton step from the reference state, K u = λ f, the
+//   linear theory's answer (the whole solution of a linear solver).
+// - solve_to (load control): load steps, a full Newton iteration per step (the
+//   tangent re-assembled at every iteration), a step halved when its
+//   iteration diverges.
+// - solve_to_displacement (displacement control, Batoz & Dhatt, IJNME 14
+//   (1979) 1262–1267): one displacement Σ w_j u_j · e is prescribed step by
+//   step and λ is an unknown of each Newton iteration, so the path is followed
+//   through limit points of the load (a snap-through).
+// - arc_length_step (Riks, IJSS 15 (1979) 529–551, in its hyperplane form):
+//   each step moves the particles a given length along the path's direction
+//   (the last step's motion), λ solved for with it, so the path passes limit
+//   points of any single displacement too (a snap-back).
+//
+// Failures: bad input (a non-positive step or arc length, a control that is
+// held, a mechanism at the start) is an Error before anything moves; a step
+// that still fails to converge after its halvings is an Error naming the step,
+// and the solver is left at the last converged state.
+
+#include <sphshell/core/error.hpp>
+#include <sphshell/statics/conditions.hpp>
+#include <sphshell/statics/stability.hpp>
+#include <sphshell/statics/tangent.hpp>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace sphshell::statics {
+
+struct NewtonOptions {
+  double tolerance = 1e-6;  // ‖residual‖ ≤ tolerance · ‖λ f_ext‖, in (0, 1) (thin shells floor near 1e-7)
+  int max_iterations = 25;  // per load step, before the step is halved
+  int max_halvings = 12;    // per load step
+  TangentSteps steps;       // the tangent's finite-difference steps
+  // Displacement control: at most this many attempted sub-steps (halved
+  // increments and failed tries included) per solve_to_displacement call, so
+  // a path creeping in tiny steps (where the control cannot pass) stops with
+  // an Error.
+  int max_substeps = 64;
+  // Print every displacement-control iteration (load factor, relative
+  // residual, control gap) to standard error.
+  bool trace = false;
+};
+
+namespace detail {
+
+// A relative residual this much above a displacement-control step's smallest
+// so far means the iteration left the path's basin (a wrong branch, a wild
+// load factor): halving the step is cheaper than iterating on.
+inline constexpr double control_divergence = 1e2;
+// A relative residual of load control that no iteration comes back from.
+inline constexpr double load_divergence = 1e8;
+// A target within this fraction of its scale counts as reached.
+inline constexpr double target_reached = 1e-12;
+// The growth of a step after one taken whole.
+inline constexpr double step_growth = 1.5;
+// A rotation angle below this (rad) has no axis to extrapolate along.
+inline constexpr double smallest_extrapolated_rotation = 1e-14;
+
+inline void check(const NewtonOptions& options) {
+  sphshell::detail::require_open_interval("NewtonOptions::tolerance", options.tolerance, 0.0, 1.0);
+  if (options.max_iterations < 1)
+    sphshell::detail::invalid_parameter("NewtonOptions::max_iterations", options.max_iterations, "must be >= 1");
+  if (options.max_halvings < 0)
+    sphshell::detail::invalid_parameter("NewtonOptions::max_halvings", options.max_halvings, "must be >= 0");
+  if (options.max_substeps < 1)
+    sphshell::detail::invalid_parameter("NewtonOptions::max_substeps", options.max_substeps, "must be >= 1");
+}
+
+}  // namespace detail
+
+template <class Solver>
+class PathFollower {
+ public:
+  PathFollower(Solver& solver, Conditions conditions, NewtonOptions options = {})
+      : assembly_(solver, std::move(conditions), (detail::check(options), options.steps)), options_(options) {}
+
+  // Equilibrium at the load factor `lambda`, reached from the current state
+  // in load steps of at most `step` (halved when an iteration diverges).
+  void solve_to(double lambda, double step) {
+    sphshell::detail::require_positive("load step", step);
+    sphshell::detail::require_finite("load factor", lambda);
+    check_start();
+    double increment = std::min(step, lambda - lambda_);
+    while (lambda_ < lambda - detail::target_reached * std::abs(lambda)) {
+      double target = lambda;
+      const double taken = step_with_halving(
+          increment, 0.0,
+          [&](double trial) {
+            target = std::min(lambda, lambda_ + trial);
+            predict(target);
+            if (!converge(target)) return false;
+            lambda_ = target;
+            return true;
+          },
+          [&](double) { return "Newton did not converge at load factor " + std::to_string(target); });
+      increment = std::min(step, detail::step_growth * taken);
+    }
+  }
+
+  // Equilibrium with the control displacement at `target`, reached from the
+  // current state in increments of at most `step` of it (halved when an
+  // iteration diverges); the load factor is solved for with the displacement.
+  void solve_to_displacement(const ControlDisplacement& control, double target, double step) {
+    sphshell::detail::require_positive("displacement step", step);
+    sphshell::detail::require_finite("target displacement", target);
+    check_control(control);
+    check_start();
+    double value = displacement_of(control);
+    double increment = step;
+    int substeps = 0;
+    while (std::abs(target - value) > detail::target_reached * std::max(std::abs(target), step)) {
+      double next = value;
+      const double taken = step_with_halving(
+          increment, value,
+          [&](double trial) {
+            // Every attempt counts, the halved ones too.
+            if (++substeps > options_.max_substeps)
+              throw Error("sphshell: displacement control took more than NewtonOptions::max_substeps = " +
+                          std::to_string(options_.max_substeps) + " sub-steps toward " + std::to_string(target) +
+                          " (at " + std::to_string(value) + ", load factor " + std::to_string(lambda_) +
+                          "); the solver is at the last converged state");
+            next = target > value ? std::min(target, value + trial) : std::max(target, value - trial);
+            predict_displacement(next, value);
+            return converge_displacement(control, next);
+          },
+          [&](double) {
+            return "Newton did not converge at control displacement " + std::to_string(next) + " (load factor " +
+                   std::to_string(lambda_) + ")";
+          });
+      value = next;
+      increment = std::min(step, detail::step_growth * taken);
+    }
+  }
+
+  // One arc-length step: the particles move a root-mean-square `length` (m)
+  // along the path's direction, on the hyperplane normal to it, with the load
+  // factor solved for. The direction is the motion of the last step (before
+  // any step: the response K⁻¹f to the load, the way the load factor grows).
+  // Halved when Newton fails (at most max_halvings times); returns the length taken.
+  double arc_length_step(double length) {
+    sphshell::detail::require_positive("arc length", length);
+    check_start();
+    Solver& solver = assembly_.solver();
+    const std::vector<Vector3> x0 = solver.positions();
+    PathDirection direction;
+    if (previous_.x.empty()) {
+      const DegreesOfFreedom dofs = assembly_.degrees_of_freedom();
+      const Eigen::VectorXd response =
+          assembly_.solve(dofs, assembly_.external_load(dofs), Factorisation::general, "at the path's start").col(0);
+      for (int i = 0; i + 1 < static_cast<int>(dofs.first.size()); ++i) {
+        Vector3 motion = Vector3::Zero();
+        for (int k = dofs.first[i]; k < dofs.first[i + 1]; ++k)
+          if (!dofs.is_rotation[k]) motion += response[k] * dofs.direction[k];
+        direction.motion.push_back({i, motion});
+      }
+    } else {
+      for (int i = 0; i < static_cast<int>(x0.size()); ++i) direction.motion.push_back({i, x0[i] - previous_.x[i]});
+    }
+    double norm = 0.0;
+    for (const auto& [particle, motion] : direction.motion) norm += motion.squaredNorm();
+    norm = std::sqrt(norm);
+    if (!(norm > 0.0))
+      sphshell::detail::invalid_parameter("Conditions force and moment (arc length)", norm,
+                                          "the path has no direction: the load must move the particles");
+    // Lengths are root-mean-square motions of the particles (independent of their number).
+    const double particles = std::sqrt(static_cast<double>(direction.motion.size()));
+    for (auto& [particle, motion] : direction.motion) motion /= norm * particles;
+    const double last_length = previous_.x.empty() ? 0.0 : norm / particles;
+    // The control is 0 where the step begins (direction.start).
+    direction.start = displacement_of(direction);
+    return step_with_halving(
+        length, 0.0,
+        [&](double trial) {
+          if (last_length > 0.0) {
+            previous_.control = -last_length;  // the last step, measured along its own direction
+            predict_displacement(trial, 0.0);
+          }
+          return converge_displacement(direction, trial);
+        },
+        [&](double trial) {
+          return "Newton did not converge on an arc-length step of " + std::to_string(trial) + " (load factor " +
+                 std::to_string(lambda_) + ")";
+        });
+  }
+
+  // One Newton step from the current configuration at load factor lambda on
+  // the symmetrised tangent (LDLᵀ): K u = λ f at the reference state, the
+  // linear theory's answer. (The solver's linear option keeps unit directors,
+  // so its forces are not exactly linear in a finite rotation; the step is
+  // not iterated.)
+  void linear_solve(double lambda) {
+    sphshell::detail::require_finite("load factor", lambda);
+    const DegreesOfFreedom dofs = assembly_.degrees_of_freedom();
+    const Eigen::VectorXd r = assembly_.residual(dofs, lambda);
+    const Eigen::VectorXd update = assembly_.solve(dofs, r, Factorisation::symmetric, "of the linear solve").col(0);
+    lambda_ = lambda;
+    assembly_.apply_update(dofs, update);
+  }
+
+  // The control of an arc-length step in the current configuration.
+  double displacement_of(const PathDirection& control) const {
+    double value = 0.0;
+    for (const auto& [particle, motion] : control.motion) value += displacement(particle).dot(motion);
+    return value - control.start;
+  }
+
+  // The control displacement in the current configuration.
+  double displacement_of(const ControlDisplacement& control) const {
+    double value = 0.0;
+    for (const auto& [particle, weight] : control.weights)
+      value += weight * displacement(particle).dot(control.direction);
+    return value;
+  }
+
+  // The stability of the current state (statics/stability.hpp).
+  Stability stability() { return statics::stability(assembly_); }
+
+  double load_factor() const { return lambda_; }
+  const NewtonReport& report() const { return assembly_.report(); }
+  std::size_t colour_count() const { return assembly_.colour_count(); }
+  Vector3 displacement(int particle) const { return assembly_.displacement(particle); }
+  TangentAssembly<Solver>& assembly() { return assembly_; }
+
+ private:
+  // At the unloaded start a mechanism (a free rigid-body motion) makes every
+  // method fail; it is named before anything moves.
+  void check_start() {
+    if (!previous_.x.empty() || lambda_ != 0.0 || start_checked_) return;
+    const DegreesOfFreedom dofs = assembly_.degrees_of_freedom();
+    Eigen::SimplicialLDLT<SparseMatrix> ldlt;
+    factorise_checked(ldlt, symmetrised(assembly_.tangent(dofs)), "at the start");
+    start_checked_ = true;
+  }
+
+  // A control some particle of which can move along its direction.
+  void check_control(const ControlDisplacement& control) const {
+    const int n = static_cast<int>(assembly_.solver().particle_count());
+    if (control.weights.empty())
+      sphshell::detail::invalid_parameter("ControlDisplacement::weights", "empty", "must name at least one particle");
+    if (!control.direction.allFinite() || !(control.direction.norm() > 0.0))
+      sphshell::detail::invalid_parameter("ControlDisplacement::direction", control.direction.transpose(),
+                                          "must be finite and non-zero");
+    for (const auto& [particle, weight] : control.weights)
+      if (particle < 0 || particle >= n)
+        sphshell::detail::invalid_parameter("ControlDisplacement particle", particle,
+                                            "must lie in [0, " + std::to_string(n) + ")");
+    const DegreesOfFreedom dofs = assembly_.degrees_of_freedom();
+    const Eigen::VectorXd g = control_gradient(dofs, control);
+    double scale = 0.0;
+    for (const auto& [particle, weight] : control.weights) scale += std::abs(weight);
+    if (!(g.norm() > held_remainder() * scale * control.direction.norm()))
+      sphshell::detail::invalid_parameter("ControlDisplacement particle", control.weights.front().first,
+                                          "held along the control direction: a control must be free to move");
+  }
+  static constexpr double held_remainder() { return statics::detail::held_direction_remainder; }
+
+  // An arc-length control's gradient in the degrees of freedom.
+  Eigen::VectorXd control_gradient(const DegreesOfFreedom& dofs, const PathDirection& control) const {
+    Eigen::VectorXd g = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(dofs.direction.size()));
+    for (const auto& [particle, motion] : control.motion)
+      for (int k = dofs.first[particle]; k < dofs.first[particle + 1]; ++k)
+        if (!dofs.is_rotation[k]) g[k] += motion.dot(dofs.direction[k]);
+    return g;
+  }
+
+  // The control displacement's gradient (it is linear in the translations).
+  Eigen::VectorXd control_gradient(const DegreesOfFreedom& dofs, const ControlDisplacement& control) const {
+    Eigen::VectorXd g = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(dofs.direction.size()));
+    for (const auto& [particle, weight] : control.weights)
+      for (int k = dofs.first[particle]; k < dofs.first[particle + 1]; ++k)
+        if (!dofs.is_rotation[k]) g[k] += weight * control.direction.dot(dofs.direction[k]);
+    return g;
+  }
+
+  // Newton's method on equilibrium and the prescribed control, λ an
+  // unknown: with K δu_r = r and K δu_f = f_ext, the update δu_r + δλ δu_f
+  // meets the control to first order (it is linear in the translations, so
+  // exactly).
+  template <class Control>
+  bool converge_displacement(const Control& control, double target) {
+    double smallest = std::numeric_limits<double>::infinity();
+    for (int iteration = 0; iteration < options_.max_iterations; ++iteration) {
+      const DegreesOfFreedom dofs = assembly_.degrees_of_freedom();
+      const Eigen::VectorXd f = assembly_.external_load(dofs);
+      const Eigen::VectorXd r = assembly_.residual(dofs, lambda_);
+      const double reference = std::abs(lambda_) * f.norm();
+      const double gap = target - displacement_of(control);
+      if (options_.trace)
+        std::fprintf(stderr, "  iteration %d: load factor %.8g, residual %.3e (relative %.3e), gap %.3e\n", iteration,
+                     lambda_, r.norm(), reference > 0.0 ? r.norm() / reference : 0.0, gap);
+      if (!std::isfinite(r.norm())) return false;
+      // At λ = 0 (the first iteration from the unloaded state) there is no
+      // load to measure the residual against: iterate.
+      if (reference > 0.0) {
+        const double relative = r.norm() / reference;
+        if (relative > detail::control_divergence * smallest) return false;
+        smallest = std::min(smallest, relative);
+        if (relative <= options_.tolerance && std::abs(gap) <= options_.tolerance * std::abs(target)) return true;
+      }
+      Eigen::MatrixXd rhs(r.size(), 2);
+      rhs.col(0) = r;
+      rhs.col(1) = f;
+      const Eigen::MatrixXd solution = assembly_.solve(dofs, rhs, Factorisation::general, "on the path");
+      const Eigen::VectorXd g = control_gradient(dofs, control);
+      const double along_load = g.dot(solution.col(1));
+      if (!(std::abs(along_load) > 0.0)) return false;
+      const double d_lambda = (gap - g.dot(solution.col(0))) / along_load;
+      lambda_ += d_lambda;
+      assembly_.apply_update(dofs, solution.col(0) + d_lambda * solution.col(1));
+    }
+    return false;
+  }
+
+  // Load control's Newton iteration at λ.
+  bool converge(double lambda) {
+    for (int iteration = 0; iteration < options_.max_iterations; ++iteration) {
+      const DegreesOfFreedom dofs = assembly_.degrees_of_freedom();
+      const Eigen::VectorXd r = assembly_.residual(dofs, lambda);
+      const double reference = assembly_.load_norm(dofs, lambda);
+      const double relative = r.norm() / reference;
+      if (!std::isfinite(relative)) return false;
+      if (relative <= options_.tolerance) return true;
+      if (relative > detail::load_divergence) return false;
+      assembly_.apply_update(dofs, assembly_.solve(dofs, r, Factorisation::general, "on the path").col(0));
+    }
+    return false;
+  }
+
+  // The start of a displacement step: the last two converged states (and
+  // load factors) extrapolated linearly in the control.
+  void predict_displacement(double target, double value) {
+    if (previous_.x.empty()) return;
+    const double span = value - previous_.control;
+    if (!(std::abs(span) > 0.0)) return;
+    const double ratio = (target - value) / span;
+    lambda_ += ratio * (lambda_ - previous_.lambda);
+    extrapolate(ratio);
+  }
+
+  // The start of a load step: the last two converged states extrapolated
+  // linearly in the load factor, else the current state.
+  void predict(double target) {
+    if (previous_.x.empty()) return;
+    const double span = lambda_ - previous_.lambda;
+    if (!(span > 0.0)) return;
+    extrapolate((target - lambda_) / span);
+  }
+
+  // The current state moved on by `ratio` times the last step (translations,
+  // and the director turned on by the last step's rotation, scaled).
+  void extrapolate(double ratio) {
+    const Solver& solver = assembly_.solver();
+    std::vector<Vector3> x = solver.positions(), d = solver.directors();
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      x[i] += ratio * (x[i] - previous_.x[i]);
+      const Vector3 axis = previous_.d[i].cross(d[i]);
+      const double angle = std::atan2(axis.norm(), previous_.d[i].dot(d[i]));
+      if (axis.norm() > detail::smallest_extrapolated_rotation)
+        d[i] = Eigen::AngleAxisd(ratio * angle, axis.normalized()) * d[i];
+    }
+    assembly_.set_configuration(std::move(x), std::move(d));
+  }
+
+  // The step-and-halve loop the controls share: attempt(increment) takes one
+  // step of `increment` from the current state (predictor and Newton) and
+  // returns whether it converged. After a failure the configuration and the
+  // load factor are put back and the increment halved, at most max_halvings
+  // times in a row (then an Error with failure(increment)'s text). A converged
+  // step leaves the state before it (control value `control_before`) as the
+  // last one. Returns the increment that converged.
+  template <class Attempt, class Failure>
+  double step_with_halving(double increment, double control_before, Attempt&& attempt, Failure&& failure) {
+    const Solver& solver = assembly_.solver();
+    for (int halvings = 0;; ++halvings) {
+      const std::vector<Vector3> x0 = solver.positions(), d0 = solver.directors();
+      const double lambda0 = lambda_;
+      bool converged = false;
+      try {
+        converged = attempt(increment);
+      } catch (...) {
+        assembly_.set_configuration(x0, d0);
+        lambda_ = lambda0;
+        throw;
+      }
+      if (converged) {
+        previous_ = {x0, d0, lambda0, control_before};
+        ++assembly_.report().load_steps;
+        return increment;
+      }
+      assembly_.set_configuration(x0, d0);
+      lambda_ = lambda0;
+      if (halvings + 1 > options_.max_halvings)
+        throw Error("sphshell: " + failure(increment) + " after NewtonOptions::max_halvings = " +
+                    std::to_string(options_.max_halvings) + " halvings (relative tolerance " +
+                    std::to_string(options_.tolerance) + "); the solver is at the last converged state, load factor " +
+                    std::to_string(lambda_));
+      increment *= 0.5;
+    }
+  }
+
+  TangentAssembly<Solver> assembly_;
+  NewtonOptions options_;
+  double lambda_ = 0.0;
+  bool start_checked_ = false;
+  struct Converged {
+    std::vector<Vector3> x, d;
+    double lambda = 0.0;
+    double control = 0.0;  // the control displacement (displacement control)
+  } previous_;  // the converged state before the current one
+};
+
+}  // namespace sphshell::statics

@@ -1,0 +1,375 @@
+#pragma once
+// The tangent stiffness of a solver's model in the free degrees of freedom of
+// static Conditions: per particle the free translations and the free
+// rotations of the director (two axes normal to it; drilling is no degree of
+// freedom). The stiffness is the Jacobian of the internal forces, assembled by
+// central differences of the solver's own forces.
+//
+// The assembly perturbs many particles at once: the colours of the coupling
+// graph of the solver's rows (solver::static_detail::coupling and its
+// distance-2 colouring, as Solver::solve_static uses) group particles no
+// particle is coupled to two of, so each response is credited to the one
+// perturbed particle within reach. Central differences cancel the even terms
+// of the forces' expansion: the error is O(h²) plus rounding of O(ε f / h).
+
+#include <sphshell/core/error.hpp>
+#include <sphshell/core/frame.hpp>
+#include <sphshell/core/types.hpp>
+#include <sphshell/solver/integration_points.hpp>
+#include <sphshell/solver/static_solution.hpp>
+#include <sphshell/statics/conditions.hpp>
+#include <sphshell/statics/statics.hpp>
+
+#include <Eigen/Dense>
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace sphshell::statics {
+
+using SparseMatrix = Eigen::SparseMatrix<double>;
+
+// The cost of a static analysis so far.
+struct NewtonReport {
+  int load_steps = 0;          // converged steps, halved ones included
+  int iterations = 0;          // Newton updates in all
+  long force_evaluations = 0;  // internal-force computations in all
+};
+
+// The finite-difference steps of the tangent.
+struct TangentSteps {
+  double translation = 1e-7;  // in units of the model's largest spacing
+  double rotation = 1e-7;     // rad
+  // Perturb one particle at a time (for checking the colouring; slow).
+  bool one_particle_per_colour = false;
+};
+
+// How the tangent is factorised: symmetrised and LDLᵀ (the stiffness of an
+// elastic law at equilibrium is symmetric; the finite differences leave it so
+// to rounding), or as it is by LU (a nonlinear tangent off equilibrium).
+enum class Factorisation { symmetric, general };
+
+// The free degrees of freedom of the current configuration.
+struct DegreesOfFreedom {
+  std::vector<Vector3> direction;  // translation (m) or rotation axis (rad) per degree of freedom
+  std::vector<char> is_rotation;
+  std::vector<int> first;  // first degree of freedom of each particle; first[n] = count
+  int count() const { return first.empty() ? 0 : first.back(); }
+};
+
+namespace detail {
+
+// A direction whose component left after removing held ones is below this
+// (of a unit vector) is held.
+inline constexpr double held_direction_remainder = 1e-8;
+
+// A pivot of the symmetrised tangent below this fraction of the largest one
+// is a rounding residue of zero: with central differences the tangent's
+// entries carry a relative rounding error of about ε = 2.2e-16 times the
+// number of terms, far below the smallest genuine pivot of a thin shell
+// (the bending-to-membrane ratio (t/ℓ)² and the t² of rotations, above 1e-9
+// for every model of the validation suite).
+inline constexpr double mechanism_pivot_ratio = 1e-12;
+
+// Start vectors of inverse and subspace iterations have components
+// sin(1 + g i): a part along every mode (no symmetry of a model is orthogonal
+// to it), g the plastic number's reciprocal.
+inline constexpr double start_vector_increment = 0.7548776662;
+
+// Orthonormal basis of the part of span(ambient) orthogonal to `held`.
+inline std::vector<Vector3> free_basis(const std::vector<Vector3>& ambient, const std::vector<Vector3>& held) {
+  std::vector<Vector3> held_in_span;
+  for (const Vector3& h : held) {
+    Vector3 p = Vector3::Zero();
+    for (const Vector3& a : ambient) p += h.dot(a) * a;
+    for (const Vector3& q : held_in_span) p -= p.dot(q) * q;
+    if (p.norm() > held_direction_remainder) held_in_span.push_back(p.normalized());
+  }
+  std::vector<Vector3> result;
+  for (Vector3 v : ambient) {
+    for (const Vector3& q : held_in_span) v -= v.dot(q) * q;
+    for (const Vector3& q : result) v -= v.dot(q) * q;
+    if (v.norm() > held_direction_remainder) result.push_back(v.normalized());
+  }
+  return result;
+}
+
+}  // namespace detail
+
+// ½ (K + Kᵀ).
+inline SparseMatrix symmetrised(const SparseMatrix& k) {
+  const SparseMatrix transposed = k.transpose();
+  return 0.5 * (k + transposed);
+}
+
+// LDLᵀ of a symmetric stiffness, refused with an Error when a pivot is zero
+// to rounding (a mechanism: a free rigid-body motion or an unsupported part);
+// `where` names the state.
+inline void factorise_checked(Eigen::SimplicialLDLT<SparseMatrix>& ldlt, const SparseMatrix& symmetric,
+                              const std::string& where) {
+  ldlt.compute(symmetric);
+  double largest = 0.0;
+  if (ldlt.info() == Eigen::Success) largest = ldlt.vectorD().cwiseAbs().maxCoeff();
+  Eigen::Index smallest_at = 0;
+  const double smallest = ldlt.info() == Eigen::Success ? ldlt.vectorD().cwiseAbs().minCoeff(&smallest_at) : 0.0;
+  if (ldlt.info() != Eigen::Success || !(smallest > detail::mechanism_pivot_ratio * largest))
+    sphshell::detail::invalid_parameter(
+        "conditions (tangent stiffness " + where + ")", smallest,
+        "a pivot of the tangent is zero to rounding (|pivot| <= " + std::to_string(detail::mechanism_pivot_ratio) +
+            " of the largest, at degree of freedom " + std::to_string(smallest_at) +
+            "): the model has a mechanism; hold its free rigid-body motions");
+}
+
+// The assembly of the residual and the tangent of one solver under Conditions.
+template <class Solver>
+class TangentAssembly {
+  static_assert(is_static_analysable_v<Solver>,
+                "statics: the solver must be a serial sphshell::Solver (set_configuration and the internal forces); "
+                "a distributed run uses Solver::solve_static, the relaxation");
+
+ public:
+  TangentAssembly(Solver& solver, Conditions conditions, TangentSteps steps = {})
+      : solver_(solver), conditions_(std::move(conditions)), steps_(steps) {
+    const std::size_t n = solver_.particle_count();
+    if (conditions_.particle_count() != n || conditions_.held_translations.size() != n ||
+        conditions_.held_rotation_axes.size() != n || conditions_.symmetry_normals.size() != n ||
+        conditions_.rotations_held.size() != n || conditions_.moment.size() != n)
+      sphshell::detail::invalid_parameter("Conditions particle count", conditions_.particle_count(),
+                                          "must equal the solver's particle count " + std::to_string(n));
+    sphshell::detail::require_positive("TangentSteps::translation", steps_.translation);
+    sphshell::detail::require_positive("TangentSteps::rotation", steps_.rotation);
+    translation_step_ = steps_.translation * solver_.model().maximum_spacing();
+    colour_particles();
+  }
+
+  Solver& solver() { return solver_; }
+  const Solver& solver() const { return solver_; }
+  const Conditions& conditions() const { return conditions_; }
+  std::size_t colour_count() const { return colours_.size(); }
+  NewtonReport& report() { return report_; }
+  const NewtonReport& report() const { return report_; }
+
+  Vector3 displacement(int particle) const {
+    return solver_.positions()[particle] - solver_.model().particle_position[particle];
+  }
+
+  DegreesOfFreedom degrees_of_freedom() const {
+    const std::size_t n = solver_.particle_count();
+    DegreesOfFreedom dofs;
+    dofs.first.resize(n + 1);
+    for (std::size_t i = 0; i < n; ++i) {
+      dofs.first[i] = static_cast<int>(dofs.direction.size());
+      for (const Vector3& t : detail::free_basis({Vector3::UnitX(), Vector3::UnitY(), Vector3::UnitZ()},
+                                                 conditions_.held_translations[i])) {
+        dofs.direction.push_back(t);
+        dofs.is_rotation.push_back(0);
+      }
+      if (conditions_.rotations_held[i]) continue;
+      const Vector3 d = solver_.directors()[i];
+      const TangentFrame frame = tangent_frame(d);
+      std::vector<Vector3> held = conditions_.held_rotation_axes[i];
+      for (const Vector3& m : conditions_.symmetry_normals[i]) held.push_back(d.cross(m));
+      for (const Vector3& a : detail::free_basis({frame.e1, frame.e2}, held)) {
+        dofs.direction.push_back(a);
+        dofs.is_rotation.push_back(1);
+      }
+    }
+    dofs.first[n] = static_cast<int>(dofs.direction.size());
+    return dofs;
+  }
+
+  // Residual λ f_ext − f_int in the degrees of freedom (f_int = ∂Π/∂q).
+  Eigen::VectorXd residual(const DegreesOfFreedom& dofs, double lambda) const {
+    const std::size_t n = solver_.particle_count();
+    Eigen::VectorXd r(dofs.direction.size());
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vector3 moment = solver_.directors()[i].cross(solver_.internal_director_forces()[i]);
+      for (int k = dofs.first[i]; k < dofs.first[i + 1]; ++k) {
+        const Vector3& a = dofs.direction[k];
+        r[k] = dofs.is_rotation[k] ? a.dot(lambda * conditions_.moment[i] - moment)
+                                   : a.dot(lambda * conditions_.force[i] - solver_.internal_forces()[i]);
+      }
+    }
+    return r;
+  }
+
+  // The external load at load factor 1 in the degrees of freedom.
+  Eigen::VectorXd external_load(const DegreesOfFreedom& dofs) const {
+    Eigen::VectorXd f(dofs.direction.size());
+    for (std::size_t i = 0; i + 1 < dofs.first.size(); ++i)
+      for (int k = dofs.first[i]; k < dofs.first[i + 1]; ++k)
+        f[k] = dofs.direction[k].dot(dofs.is_rotation[k] ? conditions_.moment[i] : conditions_.force[i]);
+    return f;
+  }
+
+  // ‖λ f_ext‖ in the degrees of freedom.
+  double load_norm(const DegreesOfFreedom& dofs, double lambda) const {
+    double sum = 0.0;
+    for (std::size_t i = 0; i + 1 < dofs.first.size(); ++i)
+      for (int k = dofs.first[i]; k < dofs.first[i + 1]; ++k) {
+        const double f = dofs.direction[k].dot(dofs.is_rotation[k] ? conditions_.moment[i] : conditions_.force[i]);
+        sum += f * f;
+      }
+    return std::abs(lambda) * std::sqrt(sum);
+  }
+
+  // The Jacobian of the residual's negative (the tangent stiffness) at the
+  // current configuration, which it leaves as it found it.
+  SparseMatrix tangent(const DegreesOfFreedom& dofs) {
+    const std::vector<Vector3> x0 = solver_.positions(), d0 = solver_.directors();
+    const int n = static_cast<int>(x0.size());
+    const int count = dofs.first[n];
+    std::vector<Eigen::Triplet<double>> entries;
+    std::vector<int> owner(n, -1);
+    constexpr int most_dofs_per_particle = 5;  // three translations, two director rotations
+    for (const std::vector<int>& members : colours_) {
+      for (int p : members)
+        for (int q : near_[p]) owner[q] = p;
+      for (int local = 0; local < most_dofs_per_particle; ++local) {
+        bool any = false;
+        for (int p : members) any = any || dofs.first[p] + local < dofs.first[p + 1];
+        if (!any) continue;
+        std::vector<Eigen::VectorXd> forces;
+        for (double sign : {1.0, -1.0}) {
+          std::vector<Vector3> x = x0, d = d0;
+          for (int p : members) {
+            const int k = dofs.first[p] + local;
+            if (k >= dofs.first[p + 1]) continue;
+            move(dofs, k, sign * step_of(dofs, k), x[p], d[p]);
+          }
+          solver_.set_configuration(std::move(x), std::move(d));
+          ++report_.force_evaluations;
+          forces.push_back(-residual(dofs, 0.0));
+        }
+        for (int p : members) {
+          const int column = dofs.first[p] + local;
+          if (column >= dofs.first[p + 1]) continue;
+          const double h = step_of(dofs, column);
+          for (int q : near_[p]) {
+            if (owner[q] != p) continue;
+            for (int row = dofs.first[q]; row < dofs.first[q + 1]; ++row) {
+              const double value = (forces[0][row] - forces[1][row]) / (2.0 * h);
+              if (value != 0.0) entries.emplace_back(row, column, value);
+            }
+          }
+        }
+      }
+      for (int p : members)
+        for (int q : near_[p]) owner[q] = -1;
+    }
+    solver_.set_configuration(x0, d0);
+    ++report_.force_evaluations;
+    SparseMatrix k(count, count);
+    k.setFromTriplets(entries.begin(), entries.end());
+    k.makeCompressed();
+    return k;
+  }
+
+  // The tangent's solutions for the columns of `rhs`, from one factorisation;
+  // `where` names the state in an Error.
+  Eigen::MatrixXd solve(const DegreesOfFreedom& dofs, const Eigen::MatrixXd& rhs, Factorisation factorisation,
+                        const std::string& where) {
+    const SparseMatrix k = tangent(dofs);
+    if (factorisation == Factorisation::symmetric) {
+      Eigen::SimplicialLDLT<SparseMatrix> ldlt;
+      factorise_checked(ldlt, symmetrised(k), where);
+      return ldlt.solve(rhs);
+    }
+    Eigen::SparseLU<SparseMatrix> lu;
+    lu.compute(k);
+    if (lu.info() != Eigen::Success)
+      sphshell::detail::invalid_parameter("conditions (tangent stiffness " + where + ")", lu.lastErrorMessage(),
+                                          "the LU factorisation met a zero pivot: a mechanism or a singular point "
+                                          "of the path");
+    return lu.solve(rhs);
+  }
+
+  // Moves the particles by an update in the degrees of freedom (translations
+  // added, directors turned by the rotation vector of their degrees of freedom).
+  void apply_update(const DegreesOfFreedom& dofs, const Eigen::VectorXd& update) {
+    std::vector<Vector3> x = solver_.positions(), d = solver_.directors();
+    const int n = static_cast<int>(x.size());
+    for (int i = 0; i < n; ++i) {
+      Vector3 rotation = Vector3::Zero();
+      for (int k = dofs.first[i]; k < dofs.first[i + 1]; ++k) {
+        if (dofs.is_rotation[k])
+          rotation += update[k] * dofs.direction[k];
+        else
+          x[i] += update[k] * dofs.direction[k];
+      }
+      const double angle = rotation.norm();
+      if (angle > 0.0) d[i] = Eigen::AngleAxisd(angle, rotation / angle) * d[i];
+    }
+    solver_.set_configuration(std::move(x), std::move(d));
+    ++report_.force_evaluations;
+    ++report_.iterations;
+  }
+
+  // Each particle's translation and director rotation in a vector of the
+  // degrees of freedom (a mode).
+  void split(const DegreesOfFreedom& dofs, const Eigen::VectorXd& values, std::vector<Vector3>& translation,
+             std::vector<Vector3>& rotation) const {
+    translation.assign(dofs.first.size() - 1, Vector3::Zero());
+    rotation.assign(dofs.first.size() - 1, Vector3::Zero());
+    for (std::size_t i = 0; i + 1 < dofs.first.size(); ++i)
+      for (int k = dofs.first[i]; k < dofs.first[i + 1]; ++k)
+        (dofs.is_rotation[k] ? rotation[i] : translation[i]) += values[k] * dofs.direction[k];
+  }
+
+  // Sets a configuration, counted as one force evaluation.
+  void set_configuration(std::vector<Vector3> x, std::vector<Vector3> d) {
+    solver_.set_configuration(std::move(x), std::move(d));
+    ++report_.force_evaluations;
+  }
+
+ private:
+  double step_of(const DegreesOfFreedom& dofs, int k) const {
+    return dofs.is_rotation[k] ? steps_.rotation : translation_step_;
+  }
+
+  // Moves particle i by degree of freedom k's amount `amount`.
+  static void move(const DegreesOfFreedom& dofs, int k, double amount, Vector3& x, Vector3& d) {
+    if (dofs.is_rotation[k])
+      d = Eigen::AngleAxisd(amount, dofs.direction[k]) * d;
+    else
+      x += amount * dofs.direction[k];
+  }
+
+  // The colours of the coupling graph of the solver's own rows: each
+  // particle's near_ lists the particles whose forces its motion changes, and
+  // no particle is near two of one colour. Every point's support follows its
+  // own spacing, so a distance bound would have to take the largest radius
+  // everywhere.
+  void colour_particles() {
+    using Approx = typename Solver::approximation_type;
+    const ShellModel& model = solver_.model();
+    const SolverOptions& options = solver_.options();
+    const solver::IntegrationPoints<Approx> points(model, options.physics(), options.particle_integration(),
+                                                   solver_.material().shear_modulus(),
+                                                   solver_.material().poisson_ratio());
+    near_ = solver::static_detail::coupling(points, model.particle_count());
+    if (steps_.one_particle_per_colour) {
+      colours_.clear();
+      for (int i = 0; i < static_cast<int>(near_.size()); ++i) colours_.push_back({i});
+    } else {
+      colours_ = solver::static_detail::colour(near_);
+    }
+  }
+
+  Solver& solver_;
+  Conditions conditions_;
+  TangentSteps steps_;
+  double translation_step_ = 0.0;
+  std::vector<std::vector<int>> colours_;
+  std::vector<std::vector<int>> near_;  // per particle: the particles it is coupled to (itself included)
+  NewtonReport report_;
+};
+
+}  // namespace sphshell::statics

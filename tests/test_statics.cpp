@@ -1,0 +1,164 @@
+// The public static analysis (sphshell/statics): bad input named before
+// anything moves, and the linear buckling analysis against closed forms.
+#include <sphshell/approx/mls.hpp>
+#include <sphshell/kernel/cubic_spline.hpp>
+#include <sphshell/material/elastic.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/statics/all.hpp>
+#include <sphshell/thickness/gauss.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+using namespace sphshell;
+
+namespace {
+
+using NonlinearSolver = Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<3>, material::Elastic>;
+
+constexpr double pi = 3.14159265358979323846;
+
+// Trapezoidal shares of an edge load on n particles along the edge.
+std::vector<double> edge_shares(int n) {
+  std::vector<double> share(n, 1.0 / (n - 1));
+  share.front() = share.back() = 0.5 / (n - 1);
+  return share;
+}
+
+// The cantilever strip of Sze, Liu & Lo (2004): L = 10, b = 1, t = 0.1,
+// E = 1.2e6, ν = 0, clamped at x = 0, nx × ny particles.
+struct Strip {
+  static constexpr double L = 10.0, b = 1.0, t = 0.1, E = 1.2e6;
+  ShellModel model;
+  statics::Conditions conditions;
+  Strip(int nx, int ny) : model(ShellModel::rectangular_plate(L, b, nx, ny, t)), conditions(model.particle_count()) {
+    conditions.clamp(model.set("x_min"));
+  }
+  double EI() const { return E * b * t * t * t / 12.0; }
+  // An axial dead load −P along x shared by the tip particles.
+  void compress_tip(double P) {
+    const ParticleSet tip = model.set("x_max");
+    const std::vector<double> share = edge_shares(static_cast<int>(tip.size()));
+    for (std::size_t k = 0; k < tip.size(); ++k) conditions.add_force({tip[k]}, Vector3(-P * share[k], 0.0, 0.0));
+  }
+};
+
+bool same_configuration(const NonlinearSolver& solver, const std::vector<Vector3>& x, const std::vector<Vector3>& d) {
+  return solver.positions() == x && solver.directors() == d;
+}
+
+}  // namespace
+
+TEST_CASE("Statics: bad input is an Error naming it, and the solver is left as it was", "[statics]") {
+  Strip strip(11, 3);
+  strip.compress_tip(1.0);
+  strip.conditions.add_force(strip.model.set("x_max"), Vector3(0.0, 0.0, 0.1));
+  NonlinearSolver solver(strip.model, {Strip::E, 0.0});
+  const std::vector<Vector3> x0 = solver.positions(), d0 = solver.directors();
+  statics::PathFollower<NonlinearSolver> path(solver, strip.conditions);
+
+  SECTION("a control particle that is held") {
+    const int root = strip.model.set("x_min").front();
+    CHECK_THROWS_WITH(path.solve_to_displacement({{{root, 1.0}}, Vector3::UnitZ()}, 0.1, 0.05),
+                      Catch::Contains("ControlDisplacement particle = " + std::to_string(root)) &&
+                          Catch::Contains("held along the control direction"));
+    CHECK_THROWS_WITH(path.solve_to_displacement({{{-1, 1.0}}, Vector3::UnitZ()}, 0.1, 0.05),
+                      Catch::Contains("ControlDisplacement particle = -1"));
+    CHECK_THROWS_WITH(path.solve_to_displacement({{{root + 1, 1.0}}, Vector3::UnitZ()}, 0.1, 0.0),
+                      Catch::Contains("displacement step = 0"));
+  }
+  SECTION("an arc length <= 0") {
+    CHECK_THROWS_WITH(path.arc_length_step(0.0), Catch::Contains("arc length = 0") && Catch::Contains("> 0"));
+    CHECK_THROWS_WITH(path.arc_length_step(-0.5), Catch::Contains("arc length = -0.5"));
+    CHECK_THROWS_WITH(path.solve_to(1.0, 0.0), Catch::Contains("load step = 0"));
+  }
+  SECTION("a buckling reference load of zero") {
+    Strip unloaded(11, 3);
+    CHECK_THROWS_WITH(statics::linear_buckling(solver, unloaded.conditions),
+                      Catch::Contains("buckling reference load") && Catch::Contains("non-zero"));
+  }
+  SECTION("a mechanism: the tangent singular at the start") {
+    statics::Conditions free(strip.model.particle_count());  // no support: six rigid motions
+    free.add_force(strip.model.set("x_max"), Vector3(0.0, 0.0, 0.1));
+    statics::PathFollower<NonlinearSolver> loose(solver, free);
+    CHECK_THROWS_WITH(loose.solve_to(1.0, 0.5), Catch::Contains("mechanism"));
+    CHECK_THROWS_WITH(loose.arc_length_step(0.1), Catch::Contains("mechanism"));
+    CHECK_THROWS_WITH(loose.linear_solve(1.0), Catch::Contains("mechanism"));
+    CHECK_THROWS_WITH(statics::linear_buckling(solver, free), Catch::Contains("mechanism"));
+    // Too few holds: only the root's x held, the strip free to move across and turn.
+    statics::Conditions pinned(strip.model.particle_count());
+    pinned.hold_translation(strip.model.set("x_min"), Vector3::UnitX());
+    pinned.add_force(strip.model.set("x_max"), Vector3(0.0, 0.0, 0.1));
+    statics::PathFollower<NonlinearSolver> rolling(solver, pinned);
+    CHECK_THROWS_WITH(rolling.solve_to(1.0, 0.5), Catch::Contains("mechanism"));
+  }
+  CHECK(same_configuration(solver, x0, d0));
+  CHECK(path.load_factor() == 0.0);
+  // Unharmed: the same follower still solves.
+  path.solve_to(0.5, 0.5);
+  CHECK(path.load_factor() == 0.5);
+}
+
+TEST_CASE("Statics: linear buckling of an Euler strip", "[validation][statics]") {
+  // The cantilever strip under an axial tip load: P_cr = π² EI / (4 L²)
+  // (Mindlin's shear lowers it by P_cr / (κ G A), 5·10⁻⁵ here). The
+  // reference load is P_cr itself, so the lowest factor is 1.
+  Strip strip(21, 3);
+  const double euler = pi * pi * strip.EI() / (4.0 * Strip::L * Strip::L);
+  strip.compress_tip(euler);
+  NonlinearSolver solver(strip.model, {Strip::E, 0.0});
+  const std::vector<Vector3> x0 = solver.positions(), d0 = solver.directors();
+  statics::BucklingOptions options;
+  options.modes = 2;
+  const statics::BucklingResult result = statics::linear_buckling(solver, strip.conditions, options);
+  REQUIRE(result.modes.size() == 2);
+  const double first = result.modes[0].load_factor, second = result.modes[1].load_factor;
+  std::printf("Euler strip (21 x 3), linear buckling: P1 = %.6f P_cr (%+.3f %%), P2 = %.5f P_cr (Euler: 9); %d "
+              "subspace iterations, %ld force evaluations\n",
+              first, 100.0 * (first - 1.0), second, result.iterations, result.force_evaluations);
+  CHECK(first == Approx(1.0).epsilon(5e-3));
+  CHECK(second == Approx(9.0).epsilon(3e-2));
+  // The first mode bends the strip out of its plane, the tip moving most.
+  const int tip = 20 + 21;  // the tip particle on the centre line
+  const Vector3 motion = result.modes[0].translation[static_cast<std::size_t>(tip)];
+  CHECK(std::abs(motion.z()) == Approx(1.0));
+  CHECK(std::abs(motion.x()) < 1e-6);
+  CHECK(same_configuration(solver, x0, d0));
+}
+
+TEST_CASE("Statics: linear buckling of a simply supported square plate under uniaxial compression",
+          "[validation][statics]") {
+  // a = b = 1, t = 0.01, E = 1e9, ν = 0.3, simply supported on all edges
+  // (w = 0; the twist along each edge held, the Kirchhoff plate's hard
+  // support), compressed along x by a uniform edge stress σ. Kirchhoff plate
+  // theory: σ_cr = k π² D / (b² t), k = 4 for a square (one half-wave each
+  // way; Timoshenko & Gere, Theory of Elastic Stability, §9.2). The
+  // reference stress is σ_cr, so the lowest factor is 1.
+  const double a = 1.0, t = 0.01, E = 1e9, nu = 0.3;
+  const double D = E * t * t * t / (12.0 * (1.0 - nu * nu));
+  const double critical = 4.0 * pi * pi * D / (a * a * t);
+  double error = 0.0;
+  for (int n : {11, 15, 19}) {
+    const ShellModel model = ShellModel::rectangular_plate(a, a, n, n, t);
+    statics::Conditions conditions(model.particle_count());
+    conditions.hold_translation(model.set("boundary"), Vector3::UnitZ());
+    for (const char* edge : {"x_min", "x_max"}) conditions.hold_rotation(model.set(edge), Vector3::UnitX());
+    for (const char* edge : {"y_min", "y_max"}) conditions.hold_rotation(model.set(edge), Vector3::UnitY());
+    const ParticleSet loaded_edge = model.set("x_max"), held_edge = model.set("x_min");
+    conditions.hold_translation(held_edge, Vector3::UnitX());
+    conditions.hold_translation({held_edge[held_edge.size() / 2]}, Vector3::UnitY());
+    const std::vector<double> share = edge_shares(n);
+    for (int k = 0; k < n; ++k) conditions.add_force({loaded_edge[k]}, Vector3(-critical * t * a * share[k], 0.0, 0.0));
+    NonlinearSolver solver(model, {E, nu});
+    const statics::BucklingResult result = statics::linear_buckling(solver, conditions);
+    REQUIRE(result.modes.size() == 1);
+    error = result.modes[0].load_factor - 1.0;
+    std::printf("Square plate %d x %d, linear buckling: sigma1 = %.6f sigma_cr (%+.3f %%); %d subspace iterations, "
+                "%ld force evaluations\n",
+                n, n, result.modes[0].load_factor, 100.0 * error, result.iterations, result.force_evaluations);
+  }
+  CHECK(std::abs(error) < 1e-2);
+}
