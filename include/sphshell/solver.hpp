@@ -199,8 +199,6 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
         detail::invalid_parameter("checkpoint_path", options_.checkpoint_path,
                                   "a run with rigid bodies cannot be checkpointed yet: set checkpoint_every_steps "
                                   "and checkpoint_every_seconds to 0");
-      if (body_thickness_.empty())
-        for (std::size_t i = 0; i < particles_.size(); ++i) body_thickness_.push_back(model_.particle_thickness(i));
       return bodies_.add(std::move(body), contact_options, contact_particles(), time_step_);
     }
   }
@@ -411,7 +409,7 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
   StepTime now() const { return {steps_, time_}; }
   contact::ContactParticles contact_particles() {
     return {particles_.position, particles_.director, particles_.velocity, particles_.angular_velocity,
-            inertia_.mass,       body_thickness_};
+            inertia_.mass,       model_.particle_thicknesses()};
   }
 
   void set_up(const typename Domain::Weights& weights) try {
@@ -576,7 +574,6 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
   long steps_ = 0;
   bool forces_current_ = false;
   contact::RigidBodySet bodies_;
-  std::vector<double> body_thickness_;  // each particle's thickness, for the contact offsets
   solver::StepLatch latch_;  // the error that stopped step(); later steps refuse with it
 };
 

@@ -225,6 +225,8 @@ class ShellModel {
     detail::model_checks::check_index("particle", i, particle_count());
     return particle_thickness_[i];
   }
+  // Every particle's wall thickness, indexed as the particles (m).
+  const std::vector<double>& particle_thicknesses() const { return particle_thickness_; }
   double stress_point_thickness(std::size_t p) const {
     detail::model_checks::check_index("stress point", p, stress_point_count());
     return stress_point_thickness_[p];
