@@ -329,8 +329,10 @@ TEST_CASE("Johnson-Cook: the damage increment uses the step's rate and temperatu
 
 TEST_CASE("Cowper-Symonds: uniaxial flow stress at constant strain rates is the CS formula", "[material][rate]") {
   // Mild steel, D = 40.4 /s, q = 5 (Jones, Structural Impact, 2012, Table 8.2);
-  // the paper's σs0 = 235 MPa and a plastic modulus of 1 GPa.
-  const CowperSymonds::Parameters p{210e9, 0.3, 235e6, 1e9, 40.4, 5.0};
+  // the paper's σs0 = 235 MPa and a plastic modulus of 1 GPa. q = 4.3 takes
+  // the law's std::pow path, q = 5 its integer power.
+  for (const double q : {5.0, 4.3}) {
+  const CowperSymonds::Parameters p{210e9, 0.3, 235e6, 1e9, 40.4, q};
   const CowperSymonds law(p);
   for (const double rate : {1e-3, 1.0, 100.0, 1e4}) {
     const double time_step = 1e-4 / rate;  // axial increments of 1e-4
@@ -343,13 +345,14 @@ TEST_CASE("Cowper-Symonds: uniaxial flow stress at constant strain rates is the 
       if (increment <= 0.0) continue;
       ++plastic_steps;
       const double expected = cs_flow_stress(p, state.eps_p, increment / time_step);
-      INFO("rate " << rate << " /s, step " << step);
+      INFO("q " << q << ", rate " << rate << " /s, step " << step);
       REQUIRE(state.stress.x() == Approx(expected).epsilon(1e-6));
       REQUIRE(state.flow_stress == Approx(expected).epsilon(1e-6));
       REQUIRE(state.sigma_y == Approx(p.sigma_y0 + p.Ep * state.eps_p).epsilon(1e-12));
     }
     CHECK(plastic_steps > 250);
     CHECK(state.strain_rate == Approx(rate).epsilon(0.05));
+  }
   }
 }
 

@@ -12,6 +12,12 @@
 //   (Δε̄p/(DΔt))^(1/q) at that bound does not change 1 + x in double
 //   precision, the rate factor is 1 at every admissible Δε̄p and J2's own
 //   return (return_map::solve) is the answer: D → ∞ is J2Plasticity bit for bit.
+// - Both tests above are made on r = Δε̄p,bound/(DΔt) against constants of the
+//   law (r ≤ (2⁻⁵³)^q ⇔ x ≤ 2⁻⁵³, the largest x with 1 + x == 1), so a step
+//   pays no root r^(1/q) unless that bound is the tighter bracket end.
+// - An integer q (mild steel's 5, aluminium's 4) raises x to it by repeated
+//   squaring instead of std::pow: the Newton iterations then cost J2's plus a
+//   few multiplications.
 // - Otherwise Newton runs on x = (Δε̄p/(DΔt))^(1/q), Δε̄p = DΔt xᵠ
 //   (flow_stress_return.hpp): in Δε̄p the rate factor rises with an infinite
 //   slope at 0 (q > 1), in x it is linear, and a typical explicit step's root
@@ -66,7 +72,11 @@ struct CowperSymonds {
       : parameters_((validate(parameters), parameters)),
         elasticity_(parameters.E, parameters.nu),
         constants_(elasticity_, parameters.Ep),
-        inverse_exponent_(1.0 / parameters.q) {}
+        inverse_exponent_(1.0 / parameters.q),
+        integer_exponent_(parameters.q == std::floor(parameters.q) && parameters.q <= max_integer_exponent
+                              ? static_cast<int>(parameters.q)
+                              : 0),
+        quasi_static_ratio_(std::pow(largest_negligible_factor, parameters.q)) {}
 
   State initial_state() const {
     return State{StressVoigt::Zero(), 0.0, parameters_.sigma_y0, parameters_.sigma_y0, 0.0};
@@ -91,10 +101,10 @@ struct CowperSymonds {
     const double sigma_y_n = state.sigma_y, plastic_modulus = parameters_.Ep, q = parameters_.q;
     const double rate_time = parameters_.D * context.time_step;  // DΔt: Δε̄p/(DΔt) = ε̄̇p/D
     // J2's Δε̄p is at most excess/min(κᵢ + Ep) (return_map.hpp), and the
-    // rate-scaled one lies below J2's; x of that bound bounds x.
-    const double bound_x =
-        std::pow((trial_equivalent - sigma_y_n) * constants_.inverse_min_slope / rate_time, inverse_exponent_);
-    if (1.0 + bound_x == 1.0) {
+    // rate-scaled one lies below J2's; x of that bound, r^(1/q), bounds x.
+    const double excess = trial_equivalent - sigma_y_n;
+    const double bound_ratio = excess * constants_.inverse_min_slope / rate_time;
+    if (bound_ratio <= quasi_static_ratio_) {
       // The rate factor is 1 in double at every admissible Δε̄p (always in the
       // quasi-static limit, Δt = +inf): J2's return, bit for bit.
       const return_map::Solution quasi_static =
@@ -107,7 +117,7 @@ struct CowperSymonds {
       return {true, quasi_static.iterations};
     }
     const auto flow = [&](double x) {
-      const double increment = rate_time * std::pow(x, q);
+      const double increment = rate_time * power(x);
       // dΔε̄p/dx = q Δε̄p/x; at x = 0: +inf (q < 1), DΔt (q = 1) or 0.
       const double increment_slope = x > 0.0 ? q * increment / x : q * rate_time * std::pow(x, q - 1.0);
       const double quasi_static_flow = sigma_y_n + plastic_modulus * increment;
@@ -119,7 +129,8 @@ struct CowperSymonds {
     // and uᵢ > σy, so g ≤ 0. Newton starts from the last step's x, σy/σs − 1
     // (in steady flow the root hardly moves), or from the upper end; the
     // safeguard keeps it inside the bracket.
-    const double upper = std::min(bound_x, (trial_equivalent - sigma_y_n) / sigma_y_n);
+    const double relative_excess = excess / sigma_y_n;
+    const double upper = bound_ratio < power(relative_excess) ? std::pow(bound_ratio, inverse_exponent_) : relative_excess;
     const double last_x = state.flow_stress / state.sigma_y - 1.0;
     const double start = last_x > 0.0 && last_x < upper ? last_x : upper;
     const return_map::FlowStressSolution solution =
@@ -162,10 +173,28 @@ struct CowperSymonds {
     sphshell::detail::require_positive("q", parameters.q);
   }
 
+  // xᵠ: by repeated squaring for an integer q, else std::pow.
+  double power(double x) const {
+    if (integer_exponent_ == 0) return std::pow(x, parameters_.q);
+    double result = 1.0, square = x;
+    for (int e = integer_exponent_; e > 0; e >>= 1) {
+      if (e & 1) result *= square;
+      square *= square;
+    }
+    return result;
+  }
+
+  // The largest x with 1 + x == 1 in double (ties round to even): 2⁻⁵³.
+  static constexpr double largest_negligible_factor = 0.5 * std::numeric_limits<double>::epsilon();
+  // Integer exponents up to this are raised by squaring (at most 2·6 products).
+  static constexpr double max_integer_exponent = 64.0;
+
   Parameters parameters_;
   PlaneStressElasticity elasticity_;
   return_map::ClosedFormConstants constants_;
-  double inverse_exponent_;  // 1/q
+  double inverse_exponent_;     // 1/q
+  int integer_exponent_;        // q when it is an integer ≤ max_integer_exponent, else 0
+  double quasi_static_ratio_;   // (2⁻⁵³)^q: r at or below it gives x ≤ 2⁻⁵³
 };
 
 }  // namespace sphshell::material

@@ -145,16 +145,21 @@ struct JohnsonCook {
     // which is the one it returns: the hardening of the next elastic limit and
     // the damage's rate term reuse them instead of a second pow() and log().
     double hardening_at_return = parameters_.A, log_rate_at_return = 0.0;
+    // The Newton iterates after the first move by a small fraction of ε̄p and
+    // of Δε̄p: ε̄pⁿ and ln ε̇* follow by short series from their values at the
+    // last iterate evaluated exactly (nearby_power, nearby_log) instead of
+    // another pow() and log(); each value is within round-off of theirs.
+    NearbyPoint power_anchor, log_anchor;
     const auto flow = [&](double increment) {
       const double eps_p = eps_p_n + increment;
-      const double power = std::pow(eps_p, parameters_.n);
+      const double power = nearby_power(power_anchor, eps_p);
       const double hardening = parameters_.A + parameters_.B * power;
       // d(Bε̄pⁿ)/dε̄p; at ε̄p = 0 it is +inf (n < 1), B (n = 1) or 0.
       const double hardening_slope = eps_p > 0.0 ? parameters_.n * parameters_.B * power / eps_p
                                                  : parameters_.n * parameters_.B * std::pow(eps_p, parameters_.n - 1.0);
       const double rate = increment * rate_per_increment;
       const bool rate_active = rate > 1.0;  // ln ε̇* taken as 0 below ε̇* = 1
-      const double log_rate = rate_active ? std::log(rate) : 0.0;
+      const double log_rate = rate_active ? nearby_log(log_anchor, rate) : 0.0;
       const double rate_factor = rate_active ? 1.0 + parameters_.C * log_rate : 1.0;
       const double rate_slope = rate_active ? parameters_.C / increment : 0.0;
       hardening_at_return = hardening;
@@ -246,6 +251,45 @@ struct JohnsonCook {
   }
 
  private:
+  // A point where a function was evaluated exactly (argument 0: none yet).
+  struct NearbyPoint {
+    double argument = 0.0;
+    double value = 0.0;
+  };
+  // Relative distance from the anchor below which the series replace pow()
+  // and log(): their first omitted terms, |C(n,5)|δ⁵ and δ⁶/6, are then below
+  // 1e-16 of the value for 0 < n ≤ max_series_exponent.
+  static constexpr double series_reach = 1e-3;
+  static constexpr double max_series_exponent = 6.0;
+
+  // xⁿ, from the anchor's value by the binomial series of (1 + δ)ⁿ to δ⁴ when
+  // x is within series_reach of it, else by std::pow (and x becomes the anchor).
+  double nearby_power(NearbyPoint& anchor, double x) const {
+    const double n = parameters_.n;
+    if (anchor.argument > 0.0 && n <= max_series_exponent) {
+      const double delta = (x - anchor.argument) / anchor.argument;
+      if (std::abs(delta) <= series_reach) {
+        const double series =
+            1.0 + n * delta * (1.0 + (n - 1.0) * delta / 2.0 * (1.0 + (n - 2.0) * delta / 3.0 * (1.0 + (n - 3.0) * delta / 4.0)));
+        return anchor.value * series;
+      }
+    }
+    anchor = {x, std::pow(x, n)};
+    return anchor.value;
+  }
+  // ln x, from the anchor's by the series of ln(1 + δ) to δ⁵ when x is within
+  // series_reach of it, else by std::log (and x becomes the anchor).
+  static double nearby_log(NearbyPoint& anchor, double x) {
+    if (anchor.argument > 0.0) {
+      const double delta = (x - anchor.argument) / anchor.argument;
+      if (std::abs(delta) <= series_reach)
+        return anchor.value +
+               delta * (1.0 - delta * (0.5 - delta * (1.0 / 3.0 - delta * (0.25 - delta * 0.2))));
+    }
+    anchor = {x, std::log(x)};
+    return anchor.value;
+  }
+
   static void validate(const Parameters& p) {
     using sphshell::detail::invalid_parameter;
     detail::validate_elastic_constants(p.E, p.nu);
