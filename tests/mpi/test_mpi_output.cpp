@@ -246,7 +246,7 @@ TEST_CASE("Distributed probes continue their files after load_checkpoint: the se
     particle = comm.all_gather(layout.owned.front()).back();
     stress_point = comm.all_gather(first_owned).back();
   }
-  REQUIRE(stress_point >= 0);
+  CHECK(stress_point >= 0);
   // The reference: the serial run, uninterrupted (each rank its own files).
   const std::string serial_particle = directory + "/serial/particle_" + std::to_string(comm.rank()) + ".csv";
   const std::string serial_stress = directory + "/serial/stress_" + std::to_string(comm.rank()) + ".csv";
