@@ -1,10 +1,11 @@
 #pragma once
 // The integration points of the shell and what is fixed about them: the two
 // groups (stress points and particles), their shape functions and tangent
-// frames, integration weights, reference surface gradients and the slot
-// transpose (which shape-function slots refer to each particle). Built once in
-// the reference configuration (total Lagrangian); only a crack changes rows,
-// through rebuild_row.
+// frames, integration weights, reference surface gradients, the stress
+// points' edge-tied shear (solver/tied_shear.hpp) and the slot transpose
+// (which shape-function slots refer to each particle, solver/slot_transpose.hpp).
+// Built once in the reference configuration (total Lagrangian); only a crack
+// changes rows, through rebuild_row.
 //
 // Points are numbered across both groups: the stress points first, then the
 // particle points, so per-point arrays elsewhere (section states, work) use one
