@@ -2,7 +2,8 @@
 // per rank, a .pvtu per frame and one .pvd series, read back with VTK's own
 // parallel reader (tests/mpi/check_pvtu.py, when a Python with VTK was found
 // at configure time); probe CSVs written by the rank owning the particle or
-// stress point, byte for byte the serial Solver's probe of the same one.
+// stress point, byte for byte the serial Solver's probe of the same one, also
+// across a checkpoint and load_checkpoint.
 #include <sphshell/approx/mls.hpp>
 #include <sphshell/kernel/cubic_spline.hpp>
 #include <sphshell/material/elastic.hpp>
@@ -217,4 +218,83 @@ TEST_CASE("More ranks than particles is an Error on every rank", "[mpi][errors]"
   }
   CHECK(message == "sphshell: invalid parameter rank count = " + std::to_string(comm.size()) +
                        " (exceeds the particle count 3: every rank must own at least one particle)");
+}
+
+TEST_CASE("Distributed probes continue their files after load_checkpoint: the serial run's files byte for byte",
+          "[mpi][output][checkpoint]") {
+  const mpi::Communicator comm;
+  namespace fs = std::filesystem;
+  const std::string directory = "mpi_probe_restart_np" + std::to_string(comm.size());
+  if (comm.is_root()) {
+    fs::remove_all(directory);
+    fs::create_directories(directory + "/serial");
+  }
+  comm.barrier();
+  const ShellModel model = ShellModel::rectangular_plate(0.5, 0.5, 21, 21, 0.01);
+  SolverOptions options;
+  options.density = 7850.0;
+  constexpr long checkpoint_step = 30, killed_at = 50, total_steps = 80;
+  // The last rank's first particle and stress point: on 2 and 3 ranks
+  // another rank's than the first's, whose file the checkpoint does not hold.
+  int particle = -1, stress_point = -1;
+  {
+    Distributed layout_only(comm, model, {210e9, 0.3}, options);
+    const mpi::RankLayout& layout = layout_only.layout();
+    int first_owned = -1;
+    for (std::size_t k = 0; k < layout.computed[0].size() && first_owned < 0; ++k)
+      if (layout.computed_is_owned[0][k]) first_owned = static_cast<int>(layout.computed[0][k]);
+    particle = comm.all_gather(layout.owned.front()).back();
+    stress_point = comm.all_gather(first_owned).back();
+  }
+  CHECK(stress_point >= 0);
+  // The reference: the serial run, uninterrupted (each rank its own files).
+  const std::string serial_particle = directory + "/serial/particle_" + std::to_string(comm.rank()) + ".csv";
+  const std::string serial_stress = directory + "/serial/stress_" + std::to_string(comm.rank()) + ".csv";
+  {
+    Serial serial(model, {210e9, 0.3}, options);
+    serial.clamp(model.set("boundary"));
+    serial.add_uniform_pressure(model.all_particles(), 5e5);
+    serial.add_particle_probe(serial_particle, particle);
+    serial.add_stress_point_probe(serial_stress, stress_point);
+    for (long n = 0; n < total_steps; ++n) serial.step();
+  }
+  const std::string particle_csv = directory + "/particle.csv", stress_csv = directory + "/stress.csv";
+  const std::string checkpoint = directory + "/run.ckpt";
+  auto same_as_serial = [&](const char* run) {
+    comm.barrier();  // the owners' rows are written before any rank reads them
+    const std::string particle_rows = file_text(particle_csv), stress_rows = file_text(stress_csv);
+    INFO(run << ": probes of particle " << particle << " and stress point " << stress_point);
+    // A header, the row at t = 0 and one row a step: the rows before the checkpoint once.
+    CHECK(std::count(particle_rows.begin(), particle_rows.end(), '\n') == 1 + 1 + total_steps);
+    CHECK(particle_rows == file_text(serial_particle));
+    CHECK(stress_rows == file_text(serial_stress));
+  };
+  {
+    // Probes added before the checkpoint; the run goes on past it, then
+    // reloads it: the files are cut back to the checkpoint's rows and go on.
+    Distributed run(comm, model, {210e9, 0.3}, options);
+    run.clamp("boundary");
+    run.add_uniform_pressure(model.all_particles(), 5e5);
+    run.add_particle_probe(particle_csv, particle);
+    run.add_stress_point_probe(stress_csv, stress_point);
+    for (long n = 0; n < checkpoint_step; ++n) run.step();
+    run.save_checkpoint(checkpoint);
+    for (long n = checkpoint_step; n < killed_at; ++n) run.step();
+    run.load_checkpoint(checkpoint);
+    CHECK(run.steps() == checkpoint_step);
+    for (long n = checkpoint_step; n < total_steps; ++n) run.step();
+  }
+  same_as_serial("reloaded into the run that added the probes");
+  {
+    // A new solver that loads the checkpoint and then adds the same probes
+    // continues the files from the checkpoint's rows too.
+    Distributed restarted(comm, model, {210e9, 0.3}, options);
+    restarted.clamp("boundary");
+    restarted.add_uniform_pressure(model.all_particles(), 5e5);
+    restarted.load_checkpoint(checkpoint);
+    restarted.add_particle_probe(particle_csv, particle);
+    restarted.add_stress_point_probe(stress_csv, stress_point);
+    for (long n = checkpoint_step; n < total_steps; ++n) restarted.step();
+  }
+  same_as_serial("restarted by a new solver");
 }

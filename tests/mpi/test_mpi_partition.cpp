@@ -42,6 +42,8 @@ void check_decomposition(const mpi::Communicator& comm, const mpi_test::Case& c)
   CHECK(owned == expected);
   CHECK(layout.owned_count() > 0);
 
+  // The rank's rows as the solver builds them (IntegrationPoints::subset).
+  const mpi_test::Points local_points = c.points->subset(layout.computed, layout.local_of, layout.local_count());
   for (std::size_t g = 0; g < mpi::group_count; ++g) {
     const approx::ShapeFunctions& shape = *input.groups[g].shape;
     // Every point owned once, by a rank that computes it.
@@ -70,7 +72,7 @@ void check_decomposition(const mpi::Communicator& comm, const mpi_test::Case& c)
     CHECK(missing_neighbours == 0);
 
     // The local rows: the same slots, in the same places, with local indices.
-    const approx::ShapeFunctions local = mpi::local_rows(shape, layout, g);
+    const approx::ShapeFunctions& local = local_points.shape(solver::point_groups[g]);
     std::size_t mismatched = 0;
     for (std::size_t k = 0; k < layout.computed[g].size(); ++k) {
       const std::size_t row = layout.computed[g][k];

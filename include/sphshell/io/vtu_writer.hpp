@@ -1,7 +1,8 @@
 #pragma once
 // VTK XML UnstructuredGrid (.vtu) output for ParaView: surfaces of triangles
 // and quadrilaterals, point clouds (VTK_VERTEX cells) and line sets (crack
-// segments), with point data, cell data and the frame's time.
+// segments), with point data, cell data and the frame's time, and the
+// parallel file (.pvtu) of a grid written in pieces.
 //
 // Format: file version 1.0 with 64-bit block headers. The encoding and the
 // precision are chosen per file (io/vtu_format.hpp, VtuFormat):
@@ -433,6 +434,38 @@ inline void write_vtu_lines(const std::string& path, const std::vector<Vector3>&
   grid.point_fields = point_fields;
   grid.cell_fields = cell_fields;
   detail::write_grid(path, grid, format);
+}
+
+// The parallel file (.pvtu) of a grid written in pieces, one .vtu each
+// (`pieces`, relative to the .pvtu): the arrays every piece holds, named,
+// typed and with components as `layout` (one of the pieces) has them.
+inline void write_pvtu(const std::string& path, const VtuGrid& layout, const std::vector<std::string>& pieces,
+                       VtuPrecision precision) {
+  const std::string real = detail::real_type(precision);
+  auto array = [&](std::ostream& out, const Field& field) {
+    out << "      <PDataArray type=\"" << (field.kind == FieldValues::integer ? "Int32" : real) << "\" Name=\""
+        << field.name << "\"";
+    if (field.components > 1) out << " NumberOfComponents=\"" << field.components << "\"";
+    out << "/>\n";
+  };
+  detail::ReplacingOutputFile file(path);
+  std::ostream& out = file.stream();
+  out << "<?xml version=\"1.0\"?>\n"
+      << "<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
+      << "  <PUnstructuredGrid GhostLevel=\"0\">\n"
+      << "    <PPointData>\n";
+  for (const PointField& field : layout.point_fields) array(out, field);
+  out << "    </PPointData>\n"
+      << "    <PCellData>\n";
+  for (const CellField& field : layout.cell_fields) array(out, field);
+  out << "    </PCellData>\n"
+      << "    <PPoints>\n"
+      << "      <PDataArray type=\"" << real << "\" Name=\"Points\" NumberOfComponents=\"3\"/>\n"
+      << "    </PPoints>\n";
+  for (const std::string& piece : pieces) out << "    <Piece Source=\"" << piece << "\"/>\n";
+  out << "  </PUnstructuredGrid>\n"
+      << "</VTKFile>\n";
+  file.commit();
 }
 
 }  // namespace sphshell::io

@@ -14,6 +14,7 @@
 #include <sphshell/mpi/halo.hpp>
 #include <sphshell/mpi/layout.hpp>
 #include <sphshell/mpi/partition.hpp>
+#include <sphshell/mpi/reductions.hpp>
 #include <sphshell/solver/integration_points.hpp>
 
 #include <algorithm>
@@ -164,24 +165,10 @@ class Domain {
     counts.push_back({"rank", static_cast<std::uint64_t>(rank())});
   }
   // The correctly rounded totals of several exact accumulators over all
-  // ranks, in one all-reduce of their limbs side by side (collective).
+  // ranks, in one all-reduce (mpi::sums; collective).
   template <std::size_t N>
   std::array<double, N> totals(const std::array<const ExactSum*, N>& local) const {
-    std::vector<std::int64_t> raw;
-    raw.reserve(N * ExactSum::raw_size);
-    for (const ExactSum* accumulator : local) {
-      ExactSum normalised = *accumulator;
-      normalised.normalize();
-      raw.insert(raw.end(), normalised.raw().begin(), normalised.raw().end());
-    }
-    comm_->sum_in_place(raw);
-    std::array<double, N> result{};
-    for (std::size_t k = 0; k < N; ++k) {
-      ExactSum::Raw part{};
-      std::copy_n(raw.begin() + static_cast<std::ptrdiff_t>(k * ExactSum::raw_size), ExactSum::raw_size, part.begin());
-      result[k] = ExactSum::from_raw(part).value();
-    }
-    return result;
+    return sums(*comm_, local);
   }
   // The largest (global id, value) of the ranks' (id < 0: none), ties to the
   // lowest id, as a serial max_element finds it (collective).

@@ -95,31 +95,6 @@ inline RankLayout rank_layout(const DecompositionInput& input, const Partition& 
   return layout;
 }
 
-// The computed rows of one group with neighbours in local indices: every
-// slot of the row's capacity kept in its place (so gathers add in the global
-// row's order, and a crack's hidden slots stay where they are). A neighbour
-// that is not local is an Error (the layout does not fit the rows).
-inline approx::ShapeFunctions local_rows(const approx::ShapeFunctions& global, const RankLayout& layout,
-                                         std::size_t group) {
-  approx::ShapeFunctions local;
-  local.row_begin.push_back(0);
-  for (std::size_t row : layout.computed[group]) {
-    for (std::size_t s = global.row_begin[row]; s < global.row_begin[row + 1]; ++s) {
-      const int j = layout.local_of[global.neighbour[s]];
-      if (j < 0)
-        sphshell::detail::invalid_parameter("neighbour of row " + std::to_string(row) + " on rank " +
-                                                std::to_string(layout.rank),
-                                            global.neighbour[s], "is neither owned nor a ghost");
-      local.neighbour.push_back(j);
-      local.value.push_back(global.value[s]);
-    }
-    local.row_begin.push_back(local.neighbour.size());
-    local.row_size.push_back(global.row_size[row]);
-    local.shepard.push_back(global.shepard.empty() ? 0 : global.shepard[row]);
-  }
-  return local;
-}
-
 // How good a partition is (docs/scaling.md reports these for the paper's
 // cases): the neighbour graph's edge cut, the weight imbalance, and what the
 // ghost layer costs.

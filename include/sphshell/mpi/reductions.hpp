@@ -17,6 +17,8 @@
 #include <sphshell/mpi/communicator.hpp>
 #include <sphshell/mpi/exact_sum.hpp>
 
+#include <algorithm>
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -24,15 +26,31 @@
 
 namespace sphshell::mpi {
 
+// The exact sums of several accumulators over all ranks (sum k of every
+// rank's local[k]), each rounded once, in one all-reduce of their limbs side
+// by side; the same on every rank.
+template <std::size_t N>
+std::array<double, N> sums(const Communicator& comm, const std::array<const ExactSum*, N>& local) {
+  std::vector<std::int64_t> raw;
+  raw.reserve(N * ExactSum::raw_size);
+  for (const ExactSum* accumulator : local) {
+    ExactSum normalised = *accumulator;
+    normalised.normalize();
+    raw.insert(raw.end(), normalised.raw().begin(), normalised.raw().end());
+  }
+  comm.sum_in_place(raw);
+  std::array<double, N> result{};
+  for (std::size_t k = 0; k < N; ++k) {
+    ExactSum::Raw part{};
+    std::copy_n(raw.begin() + static_cast<std::ptrdiff_t>(k * ExactSum::raw_size), ExactSum::raw_size, part.begin());
+    result[k] = ExactSum::from_raw(part).value();
+  }
+  return result;
+}
+
 // The exact sum of every rank's accumulator, rounded once; the same on every rank.
 inline double sum(const Communicator& comm, const ExactSum& local) {
-  ExactSum normalised = local;
-  normalised.normalize();
-  std::vector<std::int64_t> raw(normalised.raw().begin(), normalised.raw().end());
-  comm.sum_in_place(raw);
-  ExactSum::Raw total{};
-  for (std::size_t k = 0; k < total.size(); ++k) total[k] = raw[k];
-  return ExactSum::from_raw(total).value();
+  return sums(comm, std::array<const ExactSum*, 1>{&local})[0];
 }
 
 // Σ terms over all ranks, order-independent.

@@ -1,10 +1,11 @@
 #pragma once
 // The integration points of the shell and what is fixed about them: the two
 // groups (stress points and particles), their shape functions and tangent
-// frames, integration weights, reference surface gradients and the slot
-// transpose (which shape-function slots refer to each particle). Built once in
-// the reference configuration (total Lagrangian); only a crack changes rows,
-// through rebuild_row.
+// frames, integration weights, reference surface gradients, the stress
+// points' edge-tied shear (solver/tied_shear.hpp) and the slot transpose
+// (which shape-function slots refer to each particle, solver/slot_transpose.hpp).
+// Built once in the reference configuration (total Lagrangian); only a crack
+// changes rows, through rebuild_row.
 //
 // Points are numbered across both groups: the stress points first, then the
 // particle points, so per-point arrays elsewhere (section states, work) use one
@@ -14,18 +15,18 @@
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
-#include <sphshell/shell/cell_hourglass.hpp>
-#include <sphshell/shell/cell_shear.hpp>
 #include <sphshell/shell/cuts.hpp>
 #include <sphshell/shell/kinematics.hpp>
 #include <sphshell/shell/model.hpp>
 #include <sphshell/solver/local_spacing.hpp>
 #include <sphshell/solver/options.hpp>
 #include <sphshell/solver/particles.hpp>
+#include <sphshell/solver/point_group.hpp>
+#include <sphshell/solver/slot_transpose.hpp>
+#include <sphshell/solver/tied_shear.hpp>
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -34,15 +35,6 @@
 #include <vector>
 
 namespace sphshell::solver {
-
-// The two kinds of integration point (docs/method.md, "Particles, stress
-// points and integral points").
-enum class PointGroup { stress_points, particles };
-inline constexpr std::array<PointGroup, 2> point_groups{PointGroup::stress_points, PointGroup::particles};
-inline constexpr std::size_t index_of(PointGroup group) { return group == PointGroup::stress_points ? 0 : 1; }
-inline const char* name_of(PointGroup group) {
-  return group == PointGroup::stress_points ? "stress point" : "particle";
-}
 
 template <class Approx>
 class IntegrationPoints {
@@ -96,7 +88,10 @@ class IntegrationPoints {
     const std::size_t particle_points = particles_integrate ? model.particle_count() : 0;
     offset_ = {0, stress_points};
     keep_reference_ = !physics.nonlinear;
-    tie_shear(model, physics, shear_modulus, poisson_ratio);
+    tied_ = TiedShear(
+        model, physics, shape_[0], frames_[0],
+        [&](std::size_t row) { return support_radius(PointGroup::stress_points, row); }, shear_modulus,
+        poisson_ratio, keep_reference_);
     compute_weights(model, physics, particle_integration, shear_modulus, stress_points, particle_points);
     if (keep_reference_) reference_.resize(size());
     reference_products_.resize(size());
@@ -153,16 +148,8 @@ class IntegrationPoints {
         if (keep_reference_) part.reference_.push_back(reference_[p]);
         part.reference_products_.push_back(reference_products_[p]);
       }
-    if (!shear_tying_.empty())
-      for (std::size_t row : rows[0]) {
-        part.tied_corners_visible_.push_back(tied_corners_visible_[row]);
-        part.shear_tying_.push_back(shear_tying_[row]);
-        if (keep_reference_) part.shear_edges_.push_back(shear_edges_[row]);
-        if (!hourglass_.empty()) part.hourglass_.push_back(hourglass_[row]);
-        shell::CellShearTie& tying = part.shear_tying_.back();
-        for (int k = 0; k < tying.corners; ++k)
-          tying.particle[k] = local(tying.particle[k], PointGroup::stress_points, row);
-      }
+    part.tied_ =
+        tied_.subset(rows[0], [&](int global, std::size_t row) { return local(global, PointGroup::stress_points, row); });
     part.build_slot_transpose(local_count);
     return part;
   }
@@ -236,26 +223,14 @@ class IntegrationPoints {
   // at particles) for transverse shear.
   double membrane_bending_weight(std::size_t p) const { return membrane_bending_weight_[p]; }
   double shear_weight(std::size_t p) const { return shear_weight_[p]; }
-  // The edge-tied shear of a stress point's cell (TransverseShear::cell_edges);
-  // its `corners` is 0 for a point whose shear comes from the shape functions.
+  // The edge-tied shear of a stress point's cell (solver/tied_shear.hpp).
   bool shear_tied(PointGroup group, std::size_t row) const {
-    return group == PointGroup::stress_points && !shear_tying_.empty() && shear_tying_[row].corners > 0;
+    return group == PointGroup::stress_points && tied_.tied(row);
   }
-  const shell::CellShearTie& shear_tying(std::size_t row) const { return shear_tying_[row]; }
-  // A tied stress point's director hourglass term (null: none, the option is off).
-  const shell::CellHourglass* hourglass(std::size_t row) const {
-    return hourglass_.empty() ? nullptr : &hourglass_[row];
-  }
-  // Its reference edges, which the linear analysis reads (null in a nonlinear
-  // one, which keeps none: 192 bytes a stress point).
-  const shell::CellShearEdges* shear_edges(std::size_t row) const {
-    return shear_edges_.empty() ? nullptr : &shear_edges_[row];
-  }
-  // Whether every corner of a tied stress point's cell is among its row's
-  // used slots (a crack can hide one: the cell's shear is then left out).
-  // Kept per row, refreshed wherever a row changes, so the step does not
-  // search the row for its corners.
-  bool tied_corners_visible(std::size_t row) const { return tied_corners_visible_[row] != 0; }
+  const shell::CellShearTie& shear_tying(std::size_t row) const { return tied_.tying(row); }
+  const shell::CellHourglass* hourglass(std::size_t row) const { return tied_.hourglass(row); }
+  const shell::CellShearEdges* shear_edges(std::size_t row) const { return tied_.edges(row); }
+  bool tied_corners_visible(std::size_t row) const { return tied_.corners_visible(row); }
   // Kept for the linear analysis only (the nonlinear one needs only its
   // products below): 120 bytes a point.
   const shell::SurfaceGradients& reference(std::size_t p) const { return reference_[p]; }
@@ -323,7 +298,7 @@ class IntegrationPoints {
     // Flagged first: a rebuild that throws (nothing visible) leaves its row
     // changed too, and no corner of its tied cell counted as visible.
     mark_rebuilt(group, row);
-    if (shear_tied(group, row)) tied_corners_visible_[row] = 0;
+    if (group == PointGroup::stress_points) tied_.hide_corners(row);
     const auto cut_visible = cut_visibility(model, group);
     const auto both = [&](std::size_t r, std::size_t j) { return cut_visible(r, j) && visible(r, j); };
     Approx::rebuild_row(shape_[index_of(group)], row, model.particle_position, model.particle_area,
@@ -416,95 +391,22 @@ class IntegrationPoints {
     build_slot_transpose(particle_count);
   }
 
-  // Slots: every (row, neighbour) entry of both groups.
+  // Slots: every (row, neighbour) entry of both groups, and their transpose
+  // by particle (solver/slot_transpose.hpp), which a crack's rebuilt rows
+  // need built again.
   std::size_t slot_count() const { return shape_[0].neighbour.size() + shape_[1].neighbour.size(); }
-  // The used slots referring to particle i are force_entries()[k] for k in
-  // [particle_slot_begin()[i], particle_slot_begin()[i + 1]): the stress
-  // points' rows first, then the particles', rows and slots ascending.
-  const std::vector<std::size_t>& particle_slot_begin() const { return particle_slot_begin_; }
-
-  // Each such slot with what a particle needs to add its force from the
-  // point's conjugate forces (InternalForceAssembler): the point, the slot in
-  // its group's shape functions (whose Φ, ∇Φ it reads there: a copy of them
-  // here would cost 24 bytes a slot), and which corner of the point's
-  // edge-tied cell the particle is, as the index row × max_cell_corners +
-  // corner of the tied corner forces the assembler keeps per stress point
-  // (untied_corner() when it is none: an index past them). Contiguous
-  // per particle, so the per-particle sum streams through them; the slots of
-  // one particle lie in rows near each other.
-  struct ForceEntry {
-    std::uint32_t point;
-    std::uint32_t tied_corner;
-    std::uint32_t slot;
-  };
-  const std::vector<ForceEntry>& force_entries() const { return force_entries_; }
-  // Changes whenever the entries are rebuilt (a stamp unique in the process,
-  // so that one kept for another IntegrationPoints never matches), for what
-  // is derived from them (the assembler's schedule).
-  std::uint64_t force_entries_stamp() const { return force_entries_stamp_; }
-  std::size_t untied_corner() const { return count(PointGroup::stress_points) * shell::max_cell_corners; }
-
-  // Maps every particle to the shape-function slots that reference it, so the
-  // force gather is a deterministic per-particle sum (no atomic additions, identical
-  // results for any thread count). Rows keep their capacity when cracks shrink
-  // them, so the slot numbering stays; only the map is rebuilt.
-  void build_slot_transpose(std::size_t particle_count) {
-    // The entries' 32-bit indices: points (× max_cell_corners for the tied
-    // corners) and each group's slots.
-    constexpr std::size_t index_limit = std::size_t(UINT32_MAX);
-    if (size() >= index_limit / shell::max_cell_corners)
-      detail::invalid_parameter("integration point count", size(), "must stay below 2³⁰ (32-bit force entries)");
-    for (PointGroup group : point_groups)
-      if (shape(group).slots() >= index_limit)
-        detail::invalid_parameter(std::string(name_of(group)) + " shape-function slot count", shape(group).slots(),
-                                  "must stay below 2³² (32-bit force entries)");
-    std::vector<std::size_t> count_of(particle_count + 1, 0);
-    for (PointGroup group : point_groups) {
-      const approx::ShapeFunctions& sf = shape(group);
-      for (std::size_t row = 0; row < count(group); ++row)
-        for (std::size_t s = sf.row_begin[row]; s < sf.row_begin[row] + sf.row_size[row]; ++s)
-          ++count_of[std::size_t(sf.neighbour[s]) + 1];
-    }
-    for (std::size_t i = 1; i < count_of.size(); ++i) count_of[i] += count_of[i - 1];
-    particle_slot_begin_ = count_of;
-    // Exactly sized: a rebuilt transpose (a checkpoint load) must not keep a
-    // larger one's capacity.
-    std::vector<ForceEntry>(count_of.back()).swap(force_entries_);
-    static std::atomic<std::uint64_t> next_stamp{1};
-    force_entries_stamp_ = next_stamp.fetch_add(1, std::memory_order_relaxed);
-    for (PointGroup group : point_groups) {
-      const approx::ShapeFunctions& sf = shape(group);
-      for (std::size_t row = 0; row < count(group); ++row) {
-        const bool tied = shear_tied(group, row);
-        for (std::size_t s = sf.row_begin[row]; s < sf.row_begin[row] + sf.row_size[row]; ++s) {
-          const int particle = sf.neighbour[s];
-          std::size_t tied_corner = untied_corner();
-          for (int k = 0; tied && k < shear_tying_[row].corners; ++k)
-            if (shear_tying_[row].particle[std::size_t(k)] == particle)
-              tied_corner = row * shell::max_cell_corners + std::size_t(k);
-          const std::size_t k = count_of[particle]++;
-          force_entries_[k] = ForceEntry{static_cast<std::uint32_t>(point(group, row)),
-                                         static_cast<std::uint32_t>(tied_corner), static_cast<std::uint32_t>(s)};
-        }
-      }
-    }
-  }
+  using ForceEntry = solver::ForceEntry;
+  const std::vector<std::size_t>& particle_slot_begin() const { return slots_.particle_slot_begin(); }
+  const std::vector<ForceEntry>& force_entries() const { return slots_.entries(); }
+  std::uint64_t force_entries_stamp() const { return slots_.stamp(); }
+  std::size_t untied_corner() const { return SlotTranspose::untied_corner(shape_); }
+  void build_slot_transpose(std::size_t particle_count) { slots_.build(shape_, offset_, tied_, particle_count); }
 
  private:
   IntegrationPoints() = default;  // subset() fills it
 
-  // Refreshes tied_corners_visible of a changed row (rows are rebuilt in
-  // parallel: each sets its own flag, in an array sized by tie_shear).
   void check_tied_corners(PointGroup group, std::size_t row) {
-    if (!shear_tied(group, row)) return;
-    const approx::ShapeFunctions& sf = shape(group);
-    const shell::CellShearTie& tying = shear_tying_[row];
-    const auto used_begin = sf.neighbour.begin() + std::ptrdiff_t(sf.row_begin[row]);
-    const auto used_end = used_begin + sf.row_size[row];
-    bool visible = true;
-    for (int k = 0; k < tying.corners; ++k)
-      visible = visible && std::find(used_begin, used_end, tying.particle[std::size_t(k)]) != used_end;
-    tied_corners_visible_[row] = visible ? 1 : 0;
+    if (group == PointGroup::stress_points) tied_.check_corners(shape_[0], row);
   }
 
   void set_reference(std::size_t p, const shell::SurfaceGradients& g) {
@@ -554,66 +456,9 @@ class IntegrationPoints {
     }
   }
 
-  // Ties every stress point's shear to its cell's edges (TransverseShear::cell_edges,
-  // a model with cells). A corner outside the point's row would leave its forces
-  // nowhere to go: the support is too small for the cell.
-  void tie_shear(const ShellModel& model, const PhysicsOptions& physics, double shear_modulus, double poisson_ratio) {
-    shear_tying_.clear();
-    shear_edges_.clear();
-    tied_corners_visible_.clear();
-    hourglass_.clear();
-    if (physics.director_hourglass) {
-      if (physics.transverse_shear != TransverseShear::cell_edges)
-        detail::invalid_parameter("director_hourglass", "true", "needs transverse_shear = TransverseShear::cell_edges");
-      if (model.cells().empty())
-        detail::invalid_parameter("director_hourglass", "true", "needs a model with cells (this one has none)");
-      if (!(poisson_ratio > -1.0 && poisson_ratio < 0.5))
-        detail::invalid_parameter("poisson_ratio (for director_hourglass)", poisson_ratio, "must lie in (-1, 0.5)");
-    }
-    if (physics.transverse_shear != TransverseShear::cell_edges || model.cells().empty()) return;
-    if (physics.director_hourglass) hourglass_.resize(model.stress_point_count());
-    const approx::ShapeFunctions& sf = shape(PointGroup::stress_points);
-    shear_tying_.resize(model.stress_point_count());
-    if (keep_reference_) shear_edges_.resize(shear_tying_.size());
-    // Every corner is in its row (checked below) until a crack hides one.
-    tied_corners_visible_.assign(shear_tying_.size(), 1);
-    for (std::size_t row = 0; row < shear_tying_.size(); ++row) {
-      const Cell& cell = model.cells()[row];
-      for (int corner : cell) {
-        bool found = false;
-        for (std::size_t s = sf.row_begin[row]; s < sf.row_begin[row] + sf.row_size[row]; ++s)
-          found = found || sf.neighbour[s] == corner;
-        if (!found)
-          detail::invalid_parameter("support_radius_factor", physics.support_radius_factor,
-                                    "too small: corner particle " + std::to_string(corner) + " of cell " +
-                                        std::to_string(row) + " lies outside its stress point's support radius " +
-                                        std::to_string(support_radius(PointGroup::stress_points, row)) + " m");
-      }
-      const double stiffness = physics.shear_correction * shear_modulus * model.stress_point_thickness(row);
-      const shell::CellShearTying tying =
-          shell::tie_cell_shear(cell.begin(), static_cast<int>(cell.size()), model.particle_position,
-                                model.particle_normal, frame(PointGroup::stress_points, row), stiffness,
-                                model.stress_point_area[row]);
-      shear_tying_[row] = tying;
-      if (keep_reference_) shear_edges_[row] = tying;
-      // A triangle's directors have no ξη part: its hourglass term stays zero.
-      if (!hourglass_.empty() && cell.size() == std::size_t(shell::hourglass_corners)) {
-        const double thickness = model.stress_point_thickness(row);
-        // E d³ / (12 (1 − ν²)) with E = 2 G (1 + ν).
-        const double bending = shear_modulus * thickness * thickness * thickness / (6.0 * (1.0 - poisson_ratio));
-        hourglass_[row] = shell::tie_cell_hourglass(cell.begin(), model.particle_position, model.particle_normal,
-                                                    frame(PointGroup::stress_points, row), bending, poisson_ratio,
-                                                    model.stress_point_area[row]);
-      }
-    }
-  }
-
   std::array<std::vector<double>, 2> smoothing_length_;  // h_i per row of each group
   shell::CutVisibility cuts_;  // the model's cuts
-  std::vector<shell::CellShearTie> shear_tying_;  // per stress point, or empty
-  std::vector<shell::CellShearEdges> shear_edges_;  // per stress point with shear_tying_ when keep_reference_
-  std::vector<unsigned char> tied_corners_visible_;  // per stress point with shear_tying_
-  std::vector<shell::CellHourglass> hourglass_;  // per stress point with shear_tying_ when director_hourglass, or empty
+  TiedShear tied_;  // the stress points' edge-tied shear
   std::array<approx::ShapeFunctions, 2> shape_;
   std::array<std::vector<TangentFrame>, 2> frames_;  // evaluation frames, kept for rebuilds
   std::array<std::size_t, 2> offset_{};
@@ -621,9 +466,7 @@ class IntegrationPoints {
   bool keep_reference_ = true;  // a linear analysis: its reference gradients and tied edges are kept
   std::vector<shell::SurfaceGradients> reference_;  // per point when keep_reference_, else empty
   std::vector<shell::ReferenceProducts> reference_products_;
-  std::vector<std::size_t> particle_slot_begin_;
-  std::vector<ForceEntry> force_entries_;  // per particle, from particle_slot_begin_
-  std::uint64_t force_entries_stamp_ = 0;
+  SlotTranspose slots_;
   std::array<std::vector<unsigned char>, 2> rebuilt_;  // per row: changed by a crack since construction
   std::array<std::vector<std::size_t>, 2> global_row_;  // a subset's global rows (empty: the whole model)
 };
