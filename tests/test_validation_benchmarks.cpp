@@ -138,7 +138,7 @@ TEST_CASE("Static shell: displacement control follows the load-controlled path",
   NonlinearSolver solver(cantilever.strip.model, {1.2e6, 0.0});
   statics::PathFollower<NonlinearSolver> statics(solver, cantilever.strip.conditions);
   CHECK_THROWS_WITH(statics.solve_to_displacement(cantilever.tip_w, 1.0, 0.0),
-                    Catch::Contains("displacement step must be positive"));
+                    Catch::Contains("displacement step = 0") && Catch::Contains("> 0"));
 }
 
 TEST_CASE("Static shell: the arc length follows the load-controlled path", "[static][benchmarks]") {
@@ -156,7 +156,7 @@ TEST_CASE("Static shell: the arc length follows the load-controlled path", "[sta
   cantilever.check("arc length", path);
   NonlinearSolver solver(cantilever.strip.model, {1.2e6, 0.0});
   statics::PathFollower<NonlinearSolver> statics(solver, cantilever.strip.conditions);
-  CHECK_THROWS_WITH(statics.arc_length_step(0.0), Catch::Contains("arc length must be positive"));
+  CHECK_THROWS_WITH(statics.arc_length_step(0.0), Catch::Contains("arc length = 0") && Catch::Contains("> 0"));
 }
 
 TEST_CASE("Static shell: the tangent's inertia finds the Euler load of a compressed strip", "[static][benchmarks]") {

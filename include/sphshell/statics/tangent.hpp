@@ -28,6 +28,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -70,12 +72,19 @@ namespace detail {
 // (of a unit vector) is held.
 inline constexpr double held_direction_remainder = 1e-8;
 
-// A pivot of the symmetrised tangent below this fraction of the largest one
-// is a rounding residue of zero: with central differences the tangent's
-// entries carry a relative rounding error of about ε = 2.2e-16 times the
-// number of terms, far below the smallest genuine pivot of a thin shell
-// (the bending-to-membrane ratio (t/ℓ)² and the t² of rotations, above 1e-9
-// for every model of the validation suite).
+// A pivot of the symmetrised tangent at the unloaded start below this
+// fraction of its own diagonal entry is a rounding residue of zero. The
+// comparison is per degree of freedom, not with the largest pivot: the rows
+// mix N/m and N·m/rad, so a ratio to the largest pivot depends on the model's
+// size and thickness. A pivot D_i of LDLᵀ is the diagonal entry K_ii less the
+// part other degrees of freedom carry; D_i / K_ii ≥ λ_min of the diagonally
+// scaled tangent, which for a supported thin plate is about (t/L)² (ℓ/L)²
+// (1.6e-9 at L/t = 500 and 51 particles a side). Unloaded, the forces are
+// zero, so the central differences' rounding is ε |K| per entry: a free
+// motion leaves D_i / K_ii at rounding level, near ε times the number of
+// entries of a row (1e-16 to 1e-13 on the free strips and the Scordelis–Lo
+// roof left free to slide along its axis, against 4e-6 and more on the
+// supported models of the tests).
 inline constexpr double mechanism_pivot_ratio = 1e-12;
 
 // Start vectors of inverse and subspace iterations have components
@@ -109,22 +118,37 @@ inline SparseMatrix symmetrised(const SparseMatrix& k) {
   return 0.5 * (k + transposed);
 }
 
-// LDLᵀ of a symmetric stiffness, refused with an Error when a pivot is zero
-// to rounding (a mechanism: a free rigid-body motion or an unsupported part);
-// `where` names the state.
+// LDLᵀ of a symmetric stiffness. With `check` set (the unloaded start of a
+// solve, where a zero pivot can only be a mechanism) it is refused with an
+// Error when a pivot is zero to rounding against its own diagonal entry (a
+// free rigid-body motion or an unsupported part); otherwise only a failed
+// factorisation is. `where` names the state.
+enum class MechanismCheck { at_start, none };
 inline void factorise_checked(Eigen::SimplicialLDLT<SparseMatrix>& ldlt, const SparseMatrix& symmetric,
-                              const std::string& where) {
+                              const std::string& where, MechanismCheck check = MechanismCheck::at_start) {
   ldlt.compute(symmetric);
-  double largest = 0.0;
-  if (ldlt.info() == Eigen::Success) largest = ldlt.vectorD().cwiseAbs().maxCoeff();
-  Eigen::Index smallest_at = 0;
-  const double smallest = ldlt.info() == Eigen::Success ? ldlt.vectorD().cwiseAbs().minCoeff(&smallest_at) : 0.0;
-  if (ldlt.info() != Eigen::Success || !(smallest > detail::mechanism_pivot_ratio * largest))
-    sphshell::detail::invalid_parameter(
-        "conditions (tangent stiffness " + where + ")", smallest,
-        "a pivot of the tangent is zero to rounding (|pivot| <= " + std::to_string(detail::mechanism_pivot_ratio) +
-            " of the largest, at degree of freedom " + std::to_string(smallest_at) +
-            "): the model has a mechanism; hold its free rigid-body motions");
+  if (ldlt.info() != Eigen::Success)
+    sphshell::detail::invalid_parameter("conditions (tangent stiffness " + where + ")", "a failed LDLT",
+                                        "the tangent has a zero pivot: the model has a mechanism; hold its free "
+                                        "rigid-body motions");
+  if (check == MechanismCheck::none) return;
+  // D is in the fill-reducing order P K Pᵀ: the diagonal taken to the same order.
+  const Eigen::VectorXd diagonal = ldlt.permutationP() * Eigen::VectorXd(symmetric.diagonal());
+  const Eigen::VectorXd& pivots = ldlt.vectorD();
+  Eigen::Index worst = -1;
+  double worst_ratio = std::numeric_limits<double>::infinity();
+  for (Eigen::Index i = 0; i < pivots.size(); ++i) {
+    const double ratio = std::abs(diagonal[i]) > 0.0 ? std::abs(pivots[i]) / std::abs(diagonal[i]) : 0.0;
+    if (!(ratio > detail::mechanism_pivot_ratio) && !(ratio >= worst_ratio)) worst = i, worst_ratio = ratio;
+  }
+  if (worst < 0) return;
+  // The degree of freedom in the caller's numbering.
+  const Eigen::Index dof = ldlt.permutationPinv().indices()[worst];
+  std::ostringstream text;
+  text << "a pivot of the tangent is zero to rounding (|pivot| / |diagonal| = " << worst_ratio
+       << " <= " << detail::mechanism_pivot_ratio << " at degree of freedom " << dof
+       << "): the model has a mechanism; hold its free rigid-body motions";
+  sphshell::detail::invalid_parameter("conditions (tangent stiffness " + where + ")", pivots[worst], text.str());
 }
 
 // The assembly of the residual and the tangent of one solver under Conditions.
@@ -274,12 +298,14 @@ class TangentAssembly {
 
   // The tangent's solutions for the columns of `rhs`, from one factorisation;
   // `where` names the state in an Error.
+  // `check`: whether a pivot zero to rounding is refused as a mechanism (at
+  // the unloaded start of a solve only, see factorise_checked).
   Eigen::MatrixXd solve(const DegreesOfFreedom& dofs, const Eigen::MatrixXd& rhs, Factorisation factorisation,
-                        const std::string& where) {
+                        const std::string& where, MechanismCheck check = MechanismCheck::none) {
     const SparseMatrix k = tangent(dofs);
     if (factorisation == Factorisation::symmetric) {
       Eigen::SimplicialLDLT<SparseMatrix> ldlt;
-      factorise_checked(ldlt, symmetrised(k), where);
+      factorise_checked(ldlt, symmetrised(k), where, check);
       return ldlt.solve(rhs);
     }
     Eigen::SparseLU<SparseMatrix> lu;
