@@ -5,19 +5,16 @@
 // freedom). The stiffness is the Jacobian of the internal forces, assembled by
 // central differences of the solver's own forces.
 //
-// The assembly perturbs many particles at once: the colours of the coupling
-// graph of the solver's rows (solver::static_detail::coupling and its
-// distance-2 colouring, as Solver::solve_static uses) group particles no
-// particle is coupled to two of, so each response is credited to the one
-// perturbed particle within reach. Central differences cancel the even terms
-// of the forces' expansion: the error is O(h²) plus rounding of O(ε f / h).
+// The assembly perturbs many particles at once, colour by colour of the
+// coupling graph of the solver's rows (statics/coupling.hpp, the one
+// difference Jacobian Solver::solve_static uses too).
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/solver/integration_points.hpp>
-#include <sphshell/solver/static_solution.hpp>
 #include <sphshell/statics/conditions.hpp>
+#include <sphshell/statics/coupling.hpp>
 #include <sphshell/statics/statics.hpp>
 
 #include <Eigen/Dense>
@@ -35,8 +32,6 @@
 #include <vector>
 
 namespace sphshell::statics {
-
-using SparseMatrix = Eigen::SparseMatrix<double>;
 
 // The cost of a static analysis so far.
 struct NewtonReport {
@@ -156,7 +151,7 @@ template <class Solver>
 class TangentAssembly {
   static_assert(is_static_analysable_v<Solver>,
                 "statics: the solver must be a serial sphshell::Solver (set_configuration and the internal forces); "
-                "a distributed run uses Solver::solve_static, the relaxation");
+                "solve a distributed model on one process and load its state");
 
  public:
   TangentAssembly(Solver& solver, Conditions conditions, TangentSteps steps = {})
@@ -176,7 +171,7 @@ class TangentAssembly {
   Solver& solver() { return solver_; }
   const Solver& solver() const { return solver_; }
   const Conditions& conditions() const { return conditions_; }
-  std::size_t colour_count() const { return colours_.size(); }
+  std::size_t colour_count() const { return coupling_.colours.size(); }
   NewtonReport& report() { return report_; }
   const NewtonReport& report() const { return report_; }
 
@@ -248,51 +243,18 @@ class TangentAssembly {
   // current configuration, which it leaves as it found it.
   SparseMatrix tangent(const DegreesOfFreedom& dofs) {
     const std::vector<Vector3> x0 = solver_.positions(), d0 = solver_.directors();
-    const int n = static_cast<int>(x0.size());
-    const int count = dofs.first[n];
-    std::vector<Eigen::Triplet<double>> entries;
-    std::vector<int> owner(n, -1);
-    constexpr int most_dofs_per_particle = 5;  // three translations, two director rotations
-    for (const std::vector<int>& members : colours_) {
-      for (int p : members)
-        for (int q : near_[p]) owner[q] = p;
-      for (int local = 0; local < most_dofs_per_particle; ++local) {
-        bool any = false;
-        for (int p : members) any = any || dofs.first[p] + local < dofs.first[p + 1];
-        if (!any) continue;
-        std::vector<Eigen::VectorXd> forces;
-        for (double sign : {1.0, -1.0}) {
+    const SparseMatrix k = difference_tangent(
+        coupling_, dofs.first, [&](int p, int local) { return step_of(dofs, dofs.first[p] + local); },
+        [&](const std::vector<Perturbation>& perturbations) {
           std::vector<Vector3> x = x0, d = d0;
-          for (int p : members) {
-            const int k = dofs.first[p] + local;
-            if (k >= dofs.first[p + 1]) continue;
-            move(dofs, k, sign * step_of(dofs, k), x[p], d[p]);
-          }
+          for (const Perturbation& m : perturbations)
+            move(dofs, dofs.first[m.particle] + m.local, m.amount, x[m.particle], d[m.particle]);
           solver_.set_configuration(std::move(x), std::move(d));
           ++report_.force_evaluations;
-          forces.push_back(-residual(dofs, 0.0));
-        }
-        for (int p : members) {
-          const int column = dofs.first[p] + local;
-          if (column >= dofs.first[p + 1]) continue;
-          const double h = step_of(dofs, column);
-          for (int q : near_[p]) {
-            if (owner[q] != p) continue;
-            for (int row = dofs.first[q]; row < dofs.first[q + 1]; ++row) {
-              const double value = (forces[0][row] - forces[1][row]) / (2.0 * h);
-              if (value != 0.0) entries.emplace_back(row, column, value);
-            }
-          }
-        }
-      }
-      for (int p : members)
-        for (int q : near_[p]) owner[q] = -1;
-    }
+          return Eigen::VectorXd(-residual(dofs, 0.0));
+        });
     solver_.set_configuration(x0, d0);
     ++report_.force_evaluations;
-    SparseMatrix k(count, count);
-    k.setFromTriplets(entries.begin(), entries.end());
-    k.makeCompressed();
     return k;
   }
 
@@ -368,11 +330,9 @@ class TangentAssembly {
       x += amount * dofs.direction[k];
   }
 
-  // The colours of the coupling graph of the solver's own rows: each
-  // particle's near_ lists the particles whose forces its motion changes, and
-  // no particle is near two of one colour. Every point's support follows its
-  // own spacing, so a distance bound would have to take the largest radius
-  // everywhere.
+  // The coupling graph of the solver's own rows and its colours (every
+  // point's support follows its own spacing, so a distance bound would have
+  // to take the largest radius everywhere).
   void colour_particles() {
     using Approx = typename Solver::approximation_type;
     const ShellModel& model = solver_.model();
@@ -380,21 +340,14 @@ class TangentAssembly {
     const solver::IntegrationPoints<Approx> points(model, options.physics(), options.particle_integration(),
                                                    solver_.material().shear_modulus(),
                                                    solver_.material().poisson_ratio());
-    near_ = solver::static_detail::coupling(points, model.particle_count());
-    if (steps_.one_particle_per_colour) {
-      colours_.clear();
-      for (int i = 0; i < static_cast<int>(near_.size()); ++i) colours_.push_back({i});
-    } else {
-      colours_ = solver::static_detail::colour(near_);
-    }
+    coupling_ = coloured_coupling(points, model.particle_count(), steps_.one_particle_per_colour);
   }
 
   Solver& solver_;
   Conditions conditions_;
   TangentSteps steps_;
   double translation_step_ = 0.0;
-  std::vector<std::vector<int>> colours_;
-  std::vector<std::vector<int>> near_;  // per particle: the particles it is coupled to (itself included)
+  Coupling coupling_;
   NewtonReport report_;
 };
 
