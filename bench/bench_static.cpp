@@ -234,7 +234,7 @@ void cantilever_damped(benchmark::State& state) {
 // damping) in one load step, ||r|| <= 1e-6 ||f|| (the default tolerance).
 // test_static_solution takes two load steps {0.5, 1}: 2.2-2.8 times the
 // evaluations of one, with the same answer. Newton (StaticMass::tangent)
-// stalls on this strip (static_solution.hpp, "Known limit"): its line search
+// stalls on this strip (statics/static_solve.hpp, "Known limit"): its line search
 // on ||r|| rejects the full steps.
 void cantilever_static(benchmark::State& state) {
   const long alpha = state.range(0);

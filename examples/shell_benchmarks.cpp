@@ -8,7 +8,7 @@
 // printed (Markdown) gives the finest one's value, reference and error with
 // the two coarser ones' errors beside it, as in docs/validation.md. The cases and the
 // static Newton solution on the solver's own forces are the validation tests'
-// (tests/support/shell_benchmarks.hpp, tests/support/static_shell.hpp).
+// (tests/support/shell_benchmarks.hpp, sphshell/statics/path_following.hpp).
 // `shell_benchmarks --help` lists the options and the files written.
 
 #include <sphshell/sphshell.hpp>
@@ -129,7 +129,7 @@ std::vector<Row> run_linear(const std::string& name, const std::function<StaticB
     SolverOptions options;
     options.nonlinear = false;
     LinearSolver solver(benchmark.model, {benchmark.E, benchmark.nu}, options);
-    StaticShell<LinearSolver> statics(solver, benchmark.conditions);
+    statics::PathFollower<LinearSolver> statics(solver, benchmark.conditions);
     statics.linear_solve(1.0);
     const double value = reported_displacement(benchmark, solver);
     rows.push_back({name, std::to_string(n) + "²", value, benchmark.reference, seconds_since(start)});
@@ -334,7 +334,7 @@ int run(const Arguments& arguments) {
       for (const TabulatedTriple& point : pullout_reference)
         if (point.load_factor <= pullout_last + 1e-12) pullout_factors.push_back(point.load_factor);
       const TabulatedTriple& pullout_at_last = pullout_reference[pullout_factors.size() - 1];
-      NewtonOptions newton;
+      statics::NewtonOptions newton;
       newton.tolerance = 1e-5;
       std::vector<Row> w_a, u_b, u_c;
       CylinderRun pullout;
@@ -406,17 +406,17 @@ int run(const Arguments& arguments) {
     // do not stop it); the paper's points are read where the path first
     // reaches their load factor (load control's response). Each case's files
     // are written when its path ends.
-    NewtonOptions newton;
+    statics::NewtonOptions newton;
     newton.tolerance = 1e-5;
     newton.max_iterations = 12;
     const auto start = std::chrono::steady_clock::now();
-    const auto progress = [&](const PathPoint& point, const NewtonReport& report) {
+    const auto progress = [&](const PathPoint& point, const statics::NewtonReport& report) {
       std::cerr << "  control " << point.control << ": P/Pmax " << point.load_factor << " (" << report.iterations
                 << " Newton iterations, " << seconds_since(start) << " s)\n";
     };
     const auto follow = [&](const char* name, const std::string& grid, const ShellModel& model, double E, double nu,
-                            const SolverOptions& options, const StaticConditions& conditions,
-                            const ControlDisplacement& control, const std::vector<PathReading>& readings, double step,
+                            const SolverOptions& options, const statics::Conditions& conditions,
+                            const statics::ControlDisplacement& control, const std::vector<PathReading>& readings, double step,
                             int max_steps) {
       std::cerr << name << ", " << grid << ": following the path\n";
       const PathRun run = follow_path<NonlinearSolver>(model, E, nu, options, conditions, control, readings, step,
@@ -485,8 +485,8 @@ int run(const Arguments& arguments) {
     hemisphere_options.director_hourglass = hemisphere_only;
     for (int n : hemisphere_only ? std::vector<int>{33, 41, 45} : std::vector<int>{25, 29, 33}) {
       const SzeHemisphere hemisphere = sze_hemisphere(n);
-      const ControlDisplacement pushed{hemisphere.pushed, -Vector3::UnitY()};
-      const ControlDisplacement pulled{hemisphere.pulled, Vector3::UnitX()};
+      const statics::ControlDisplacement pushed{hemisphere.pushed, -Vector3::UnitY()};
+      const statics::ControlDisplacement pulled{hemisphere.pulled, Vector3::UnitX()};
       const std::string grid = std::to_string(n) + "²";
       hemisphere_runs.push_back({grid, follow("Hemisphere (Sze)", grid, hemisphere.model, 6.825e7, 0.3,
                                               hemisphere_options, hemisphere.conditions, pushed, {pulled, pushed},
@@ -553,7 +553,7 @@ int run(const Arguments& arguments) {
     // it does not with it (docs/validation.md, "What limits them"): the tangent's
     // stability after every step of the −U_B control, and without the
     // hourglass the same path by arc length.
-    NewtonOptions newton;
+    statics::NewtonOptions newton;
     newton.tolerance = 1e-5;
     newton.max_iterations = 12;
     struct StabilityRun {
@@ -569,16 +569,16 @@ int run(const Arguments& arguments) {
                               (case_run.director_hourglass ? "_hourglass" : "");
       const std::string name = "Pull-out (Sze), " + grid.text() +
                                (case_run.director_hourglass ? " with the director hourglass" : " without the director hourglass");
-      const ControlDisplacement w_a{cylinder.a, Vector3::UnitX()}, u_b{cylinder.b, -Vector3::UnitY()},
+      const statics::ControlDisplacement w_a{cylinder.a, Vector3::UnitX()}, u_b{cylinder.b, -Vector3::UnitY()},
           u_c{cylinder.c, -Vector3::UnitY()};
       {
         NonlinearSolver solver(cylinder.model, {cylinder.E, cylinder.nu}, cylinder.options);
-        StaticShell<NonlinearSolver> statics(solver, cylinder.conditions, newton);
+        statics::PathFollower<NonlinearSolver> statics(solver, cylinder.conditions, newton);
         io::CsvProbe stability_csv(arguments.output + "/pullout_stability_" + tag + ".csv",
                                    {"P/Pmax", "W_A", "-U_B", "-U_C", "negative eigenvalues", "eigenvalue nearest zero",
                                     "over the unloaded one", "mode's share of the load"});
         const auto unloaded = statics.stability();
-        const auto write = [&](const StaticShell<NonlinearSolver>::Stability& stability) {
+        const auto write = [&](const statics::Stability& stability) {
           const std::vector<double> row{statics.load_factor(),
                                         statics.displacement_of(w_a),
                                         statics.displacement_of(u_b),
@@ -597,7 +597,7 @@ int run(const Arguments& arguments) {
         for (int k = 1; k <= 60 && statics.load_factor() < 1.0; ++k) {
           try {
             statics.solve_to_displacement(u_b, 0.15 * k, 0.15);
-          } catch (const std::runtime_error& error) {
+          } catch (const Error& error) {
             std::cerr << "  stalled: " << error.what() << "\n";
             const auto stalled = statics.stability();
             write(stalled);

@@ -1,4 +1,4 @@
-// Static solutions (Solver::solve_static, solver/static_solution.hpp): the
+// Static solutions (Solver::solve_static, statics/static_solve.hpp): the
 // clamped plate against Mindlin's values and an independent linear solve of
 // the same discrete system, the elastica under an end moment (closed form) and
 // an end shear (an elastica computed here by shooting), and the Errors.
@@ -376,7 +376,7 @@ TEST_CASE("A static solve that cannot reach its tolerance keeps its best state a
 
 TEST_CASE("The automatic relaxation budget grows with the particles per side and the slenderness",
           "[static][budget]") {
-  // √κ ln(1/tol) with √κ = L²/(s min(s, d)) (solver/static_solution.hpp), at least 200 000; here
+  // √κ ln(1/tol) with √κ = L²/(s min(s, d)) (statics/static_solve.hpp), at least 200 000; here
   // for square plates of side 1 m (L = √2 m, s = 1/(n − 1) m).
   auto expected = [](int n, double d, double tolerance) {
     const double s = 1.0 / (n - 1);

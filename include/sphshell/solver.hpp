@@ -279,7 +279,7 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
   void run_until(double t_end) { run_until(t_end, [](const Solver&) {}); }
 
   // Static equilibrium under the loads evaluated at parameters.load_time and
-  // scaled by each load factor in turn (solver/static_solution.hpp; docs/method.md,
+  // scaled by each load factor in turn (statics/static_solve.hpp; docs/method.md,
   // "Static solutions"). After it the solver holds the equilibrium at rest
   // (velocities zero, energy books restarted at it) and can step on from there.
   // observer(const solver::StaticIteration&) is called after every iteration.

@@ -4,6 +4,8 @@
 
 #include <sphshell/statics/buckling.hpp>
 #include <sphshell/statics/conditions.hpp>
+#include <sphshell/statics/coupling.hpp>
 #include <sphshell/statics/path_following.hpp>
 #include <sphshell/statics/stability.hpp>
+#include <sphshell/statics/static_solve.hpp>
 #include <sphshell/statics/tangent.hpp>

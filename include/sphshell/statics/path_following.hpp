@@ -205,7 +205,10 @@ class PathFollower {
     sphshell::detail::require_finite("load factor", lambda);
     const DegreesOfFreedom dofs = assembly_.degrees_of_freedom();
     const Eigen::VectorXd r = assembly_.residual(dofs, lambda);
-    const Eigen::VectorXd update = assembly_.solve(dofs, r, Factorisation::symmetric, "of the linear solve").col(0);
+    // From the unloaded start a zero pivot is a mechanism; elsewhere it may be a point of the path.
+    const MechanismCheck check = at_start() ? MechanismCheck::at_start : MechanismCheck::none;
+    const Eigen::VectorXd update =
+        assembly_.solve(dofs, r, Factorisation::symmetric, "of the linear solve", check).col(0);
     lambda_ = lambda;
     assembly_.apply_update(dofs, update);
   }
@@ -237,8 +240,9 @@ class PathFollower {
  private:
   // At the unloaded start a mechanism (a free rigid-body motion) makes every
   // method fail; it is named before anything moves.
+  bool at_start() const { return previous_.x.empty() && lambda_ == 0.0; }
   void check_start() {
-    if (!previous_.x.empty() || lambda_ != 0.0 || start_checked_) return;
+    if (!at_start() || start_checked_) return;
     const DegreesOfFreedom dofs = assembly_.degrees_of_freedom();
     Eigen::SimplicialLDLT<SparseMatrix> ldlt;
     factorise_checked(ldlt, symmetrised(assembly_.tangent(dofs)), "at the start");

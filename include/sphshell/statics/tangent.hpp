@@ -5,19 +5,16 @@
 // freedom). The stiffness is the Jacobian of the internal forces, assembled by
 // central differences of the solver's own forces.
 //
-// The assembly perturbs many particles at once: the colours of the coupling
-// graph of the solver's rows (solver::static_detail::coupling and its
-// distance-2 colouring, as Solver::solve_static uses) group particles no
-// particle is coupled to two of, so each response is credited to the one
-// perturbed particle within reach. Central differences cancel the even terms
-// of the forces' expansion: the error is O(h²) plus rounding of O(ε f / h).
+// The assembly perturbs many particles at once, colour by colour of the
+// coupling graph of the solver's rows (statics/coupling.hpp, the one
+// difference Jacobian Solver::solve_static uses too).
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/solver/integration_points.hpp>
-#include <sphshell/solver/static_solution.hpp>
 #include <sphshell/statics/conditions.hpp>
+#include <sphshell/statics/coupling.hpp>
 #include <sphshell/statics/statics.hpp>
 
 #include <Eigen/Dense>
@@ -28,13 +25,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace sphshell::statics {
-
-using SparseMatrix = Eigen::SparseMatrix<double>;
 
 // The cost of a static analysis so far.
 struct NewtonReport {
@@ -70,12 +67,19 @@ namespace detail {
 // (of a unit vector) is held.
 inline constexpr double held_direction_remainder = 1e-8;
 
-// A pivot of the symmetrised tangent below this fraction of the largest one
-// is a rounding residue of zero: with central differences the tangent's
-// entries carry a relative rounding error of about ε = 2.2e-16 times the
-// number of terms, far below the smallest genuine pivot of a thin shell
-// (the bending-to-membrane ratio (t/ℓ)² and the t² of rotations, above 1e-9
-// for every model of the validation suite).
+// A pivot of the symmetrised tangent at the unloaded start below this
+// fraction of its own diagonal entry is a rounding residue of zero. The
+// comparison is per degree of freedom, not with the largest pivot: the rows
+// mix N/m and N·m/rad, so a ratio to the largest pivot depends on the model's
+// size and thickness. A pivot D_i of LDLᵀ is the diagonal entry K_ii less the
+// part other degrees of freedom carry; D_i / K_ii ≥ λ_min of the diagonally
+// scaled tangent, which for a supported thin plate is about (t/L)² (ℓ/L)²
+// (1.6e-9 at L/t = 500 and 51 particles a side). Unloaded, the forces are
+// zero, so the central differences' rounding is ε |K| per entry: a free
+// motion leaves D_i / K_ii at rounding level, near ε times the number of
+// entries of a row (1e-16 to 1e-13 on the free strips and the Scordelis–Lo
+// roof left free to slide along its axis, against 4e-6 and more on the
+// supported models of the tests).
 inline constexpr double mechanism_pivot_ratio = 1e-12;
 
 // Start vectors of inverse and subspace iterations have components
@@ -109,22 +113,37 @@ inline SparseMatrix symmetrised(const SparseMatrix& k) {
   return 0.5 * (k + transposed);
 }
 
-// LDLᵀ of a symmetric stiffness, refused with an Error when a pivot is zero
-// to rounding (a mechanism: a free rigid-body motion or an unsupported part);
-// `where` names the state.
+// LDLᵀ of a symmetric stiffness. With `check` set (the unloaded start of a
+// solve, where a zero pivot can only be a mechanism) it is refused with an
+// Error when a pivot is zero to rounding against its own diagonal entry (a
+// free rigid-body motion or an unsupported part); otherwise only a failed
+// factorisation is. `where` names the state.
+enum class MechanismCheck { at_start, none };
 inline void factorise_checked(Eigen::SimplicialLDLT<SparseMatrix>& ldlt, const SparseMatrix& symmetric,
-                              const std::string& where) {
+                              const std::string& where, MechanismCheck check = MechanismCheck::at_start) {
   ldlt.compute(symmetric);
-  double largest = 0.0;
-  if (ldlt.info() == Eigen::Success) largest = ldlt.vectorD().cwiseAbs().maxCoeff();
-  Eigen::Index smallest_at = 0;
-  const double smallest = ldlt.info() == Eigen::Success ? ldlt.vectorD().cwiseAbs().minCoeff(&smallest_at) : 0.0;
-  if (ldlt.info() != Eigen::Success || !(smallest > detail::mechanism_pivot_ratio * largest))
-    sphshell::detail::invalid_parameter(
-        "conditions (tangent stiffness " + where + ")", smallest,
-        "a pivot of the tangent is zero to rounding (|pivot| <= " + std::to_string(detail::mechanism_pivot_ratio) +
-            " of the largest, at degree of freedom " + std::to_string(smallest_at) +
-            "): the model has a mechanism; hold its free rigid-body motions");
+  if (ldlt.info() != Eigen::Success)
+    sphshell::detail::invalid_parameter("conditions (tangent stiffness " + where + ")", "a failed LDLT",
+                                        "the tangent has a zero pivot: the model has a mechanism; hold its free "
+                                        "rigid-body motions");
+  if (check == MechanismCheck::none) return;
+  // D is in the fill-reducing order P K Pᵀ: the diagonal taken to the same order.
+  const Eigen::VectorXd diagonal = ldlt.permutationP() * Eigen::VectorXd(symmetric.diagonal());
+  const Eigen::VectorXd& pivots = ldlt.vectorD();
+  Eigen::Index worst = -1;
+  double worst_ratio = std::numeric_limits<double>::infinity();
+  for (Eigen::Index i = 0; i < pivots.size(); ++i) {
+    const double ratio = std::abs(diagonal[i]) > 0.0 ? std::abs(pivots[i]) / std::abs(diagonal[i]) : 0.0;
+    if (!(ratio > detail::mechanism_pivot_ratio) && !(ratio >= worst_ratio)) worst = i, worst_ratio = ratio;
+  }
+  if (worst < 0) return;
+  // The degree of freedom in the caller's numbering.
+  const Eigen::Index dof = ldlt.permutationPinv().indices()[worst];
+  std::ostringstream text;
+  text << "a pivot of the tangent is zero to rounding (|pivot| / |diagonal| = " << worst_ratio
+       << " <= " << detail::mechanism_pivot_ratio << " at degree of freedom " << dof
+       << "): the model has a mechanism; hold its free rigid-body motions";
+  sphshell::detail::invalid_parameter("conditions (tangent stiffness " + where + ")", pivots[worst], text.str());
 }
 
 // The assembly of the residual and the tangent of one solver under Conditions.
@@ -132,7 +151,7 @@ template <class Solver>
 class TangentAssembly {
   static_assert(is_static_analysable_v<Solver>,
                 "statics: the solver must be a serial sphshell::Solver (set_configuration and the internal forces); "
-                "a distributed run uses Solver::solve_static, the relaxation");
+                "solve a distributed model on one process and load its state");
 
  public:
   TangentAssembly(Solver& solver, Conditions conditions, TangentSteps steps = {})
@@ -152,7 +171,7 @@ class TangentAssembly {
   Solver& solver() { return solver_; }
   const Solver& solver() const { return solver_; }
   const Conditions& conditions() const { return conditions_; }
-  std::size_t colour_count() const { return colours_.size(); }
+  std::size_t colour_count() const { return coupling_.colours.size(); }
   NewtonReport& report() { return report_; }
   const NewtonReport& report() const { return report_; }
 
@@ -224,62 +243,31 @@ class TangentAssembly {
   // current configuration, which it leaves as it found it.
   SparseMatrix tangent(const DegreesOfFreedom& dofs) {
     const std::vector<Vector3> x0 = solver_.positions(), d0 = solver_.directors();
-    const int n = static_cast<int>(x0.size());
-    const int count = dofs.first[n];
-    std::vector<Eigen::Triplet<double>> entries;
-    std::vector<int> owner(n, -1);
-    constexpr int most_dofs_per_particle = 5;  // three translations, two director rotations
-    for (const std::vector<int>& members : colours_) {
-      for (int p : members)
-        for (int q : near_[p]) owner[q] = p;
-      for (int local = 0; local < most_dofs_per_particle; ++local) {
-        bool any = false;
-        for (int p : members) any = any || dofs.first[p] + local < dofs.first[p + 1];
-        if (!any) continue;
-        std::vector<Eigen::VectorXd> forces;
-        for (double sign : {1.0, -1.0}) {
+    const SparseMatrix k = difference_tangent(
+        coupling_, dofs.first, [&](int p, int local) { return step_of(dofs, dofs.first[p] + local); },
+        [&](const std::vector<Perturbation>& perturbations) {
           std::vector<Vector3> x = x0, d = d0;
-          for (int p : members) {
-            const int k = dofs.first[p] + local;
-            if (k >= dofs.first[p + 1]) continue;
-            move(dofs, k, sign * step_of(dofs, k), x[p], d[p]);
-          }
+          for (const Perturbation& m : perturbations)
+            move(dofs, dofs.first[m.particle] + m.local, m.amount, x[m.particle], d[m.particle]);
           solver_.set_configuration(std::move(x), std::move(d));
           ++report_.force_evaluations;
-          forces.push_back(-residual(dofs, 0.0));
-        }
-        for (int p : members) {
-          const int column = dofs.first[p] + local;
-          if (column >= dofs.first[p + 1]) continue;
-          const double h = step_of(dofs, column);
-          for (int q : near_[p]) {
-            if (owner[q] != p) continue;
-            for (int row = dofs.first[q]; row < dofs.first[q + 1]; ++row) {
-              const double value = (forces[0][row] - forces[1][row]) / (2.0 * h);
-              if (value != 0.0) entries.emplace_back(row, column, value);
-            }
-          }
-        }
-      }
-      for (int p : members)
-        for (int q : near_[p]) owner[q] = -1;
-    }
+          return Eigen::VectorXd(-residual(dofs, 0.0));
+        });
     solver_.set_configuration(x0, d0);
     ++report_.force_evaluations;
-    SparseMatrix k(count, count);
-    k.setFromTriplets(entries.begin(), entries.end());
-    k.makeCompressed();
     return k;
   }
 
   // The tangent's solutions for the columns of `rhs`, from one factorisation;
   // `where` names the state in an Error.
+  // `check`: whether a pivot zero to rounding is refused as a mechanism (at
+  // the unloaded start of a solve only, see factorise_checked).
   Eigen::MatrixXd solve(const DegreesOfFreedom& dofs, const Eigen::MatrixXd& rhs, Factorisation factorisation,
-                        const std::string& where) {
+                        const std::string& where, MechanismCheck check = MechanismCheck::none) {
     const SparseMatrix k = tangent(dofs);
     if (factorisation == Factorisation::symmetric) {
       Eigen::SimplicialLDLT<SparseMatrix> ldlt;
-      factorise_checked(ldlt, symmetrised(k), where);
+      factorise_checked(ldlt, symmetrised(k), where, check);
       return ldlt.solve(rhs);
     }
     Eigen::SparseLU<SparseMatrix> lu;
@@ -342,11 +330,9 @@ class TangentAssembly {
       x += amount * dofs.direction[k];
   }
 
-  // The colours of the coupling graph of the solver's own rows: each
-  // particle's near_ lists the particles whose forces its motion changes, and
-  // no particle is near two of one colour. Every point's support follows its
-  // own spacing, so a distance bound would have to take the largest radius
-  // everywhere.
+  // The coupling graph of the solver's own rows and its colours (every
+  // point's support follows its own spacing, so a distance bound would have
+  // to take the largest radius everywhere).
   void colour_particles() {
     using Approx = typename Solver::approximation_type;
     const ShellModel& model = solver_.model();
@@ -354,21 +340,14 @@ class TangentAssembly {
     const solver::IntegrationPoints<Approx> points(model, options.physics(), options.particle_integration(),
                                                    solver_.material().shear_modulus(),
                                                    solver_.material().poisson_ratio());
-    near_ = solver::static_detail::coupling(points, model.particle_count());
-    if (steps_.one_particle_per_colour) {
-      colours_.clear();
-      for (int i = 0; i < static_cast<int>(near_.size()); ++i) colours_.push_back({i});
-    } else {
-      colours_ = solver::static_detail::colour(near_);
-    }
+    coupling_ = coloured_coupling(points, model.particle_count(), steps_.one_particle_per_colour);
   }
 
   Solver& solver_;
   Conditions conditions_;
   TangentSteps steps_;
   double translation_step_ = 0.0;
-  std::vector<std::vector<int>> colours_;
-  std::vector<std::vector<int>> near_;  // per particle: the particles it is coupled to (itself included)
+  Coupling coupling_;
   NewtonReport report_;
 };
 
