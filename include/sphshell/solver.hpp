@@ -292,56 +292,7 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
   template <class Observer>
   solver::StaticResult solve_static(const solver::StaticParameters& parameters, Observer&& observer) {
     latch_.check();
-    if constexpr (distributed) {
-      domain_.collectively([&] {
-        throw Error("sphshell: solve_static: a distributed run has no static solver yet: neither the tangent "
-                    "(StaticMass::tangent, Newton steps) nor the dynamic relaxation (StaticMass::particle_bound) "
-                    "runs over a domain's processes; solve on one process and load its state, or run the "
-                    "dynamics to rest with damping");
-      });
-      return {};
-    } else {
-      solver::validate(parameters);
-      const double load_time = std::isnan(parameters.load_time) ? time_ : parameters.load_time;
-      const solver::ParticleState start = particles_;
-      const States start_states = *states_;
-      States converged = *states_;
-      auto evaluate = [&](double load_factor) {
-        apply_loads_now({steps_, load_time});
-        for (std::size_t i = 0; i < particles_.size(); ++i) {
-          forces_.external[i] *= load_factor;
-          forces_.external_moment[i] *= load_factor;
-        }
-        // Equilibrium is quasi-static: no strain rate (rate-dependent laws at their static limit).
-        assembler_->set_time_step(std::numeric_limits<double>::infinity());
-        assembler_->compute(now(), particles_, *points_, *states_, forces_);
-      };
-      auto save = [&] {
-        if constexpr (!solver::is_path_independent_v<Material>) converged = *states_;
-      };
-      auto restore = [&] {
-        if constexpr (!solver::is_path_independent_v<Material>) *states_ = converged;
-      };
-      solver::StaticSystem<Approx, decltype(evaluate), decltype(save), decltype(restore)> system{
-          model_, particles_, forces_, constraints_, *points_, evaluate, save, restore, options_.progress_stream};
-      try {
-        const solver::StaticResult result = solver::solve_static(system, parameters, observer);
-        forces_current_ = true;
-        ledger_->restart_at_rest(energy().elastic);
-        return result;
-      } catch (const solver::StaticNotConverged&) {
-        // The solve left the failed load step's best state with its material
-        // state and internal forces; the books restart at rest there.
-        forces_current_ = true;
-        ledger_->restart_at_rest(energy().elastic);
-        throw;
-      } catch (...) {
-        particles_ = start;
-        *states_ = start_states;
-        compute_internal_forces();
-        throw;
-      }
-    }
+    return solver::StaticSolution<Solver>::solve(*this, parameters, observer);
   }
   solver::StaticResult solve_static(const solver::StaticParameters& parameters = {}) {
     return solve_static(parameters, [](const solver::StaticIteration&) {});
@@ -406,6 +357,7 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
   friend Output;
   friend class solver::CheckpointIO<Solver>;
   friend class solver::FramePiece<Solver>;
+  friend class solver::StaticSolution<Solver>;
   StepTime now() const { return {steps_, time_}; }
   contact::ContactParticles contact_particles() {
     return {particles_.position, particles_.director, particles_.velocity, particles_.angular_velocity,
