@@ -45,6 +45,7 @@
 
 #include <sphshell/contact/penalty.hpp>
 #include <sphshell/contact/rigid_body.hpp>
+#include <sphshell/contact/surface_mesh.hpp>
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/types.hpp>
 
@@ -100,6 +101,8 @@ class BodyContact {
   virtual ContactStepResult finish_step(const StepTime& at, double time_step, double velocity_step,
                                         double& body_work, double& contact_second_half) = 0;
   virtual RigidBodyState state() const = 0;
+  // The body's surface where it is now, for the frames (surface_mesh.hpp).
+  virtual SurfaceMesh surface(const ModelExtent& model, const SurfaceMeshResolution& resolution) const = 0;
   const ParticleContactLoads& loads() const { return loads_; }
 
  protected:
@@ -157,6 +160,10 @@ class BodyContactOf final : public BodyContact {
     state.contacts = contacts_;
     state.kinetic_energy = kinetic_energy();
     return state;
+  }
+
+  SurfaceMesh surface(const ModelExtent& model, const SurfaceMeshResolution& resolution) const override {
+    return place_surface_mesh(body_, model, resolution);
   }
 
   // ½ m |v|² + ½ Σ I_k ω_k² (body frame); a body that is not free has no mass here.
@@ -287,6 +294,20 @@ class RigidBodySet {
   RigidBodyState state(RigidBodyId id) const {
     check(id);
     return bodies_[id]->state();
+  }
+
+  // Body `id`'s surface where it is now (world frame): a plane's patch sized
+  // to the model, whose extent is that of `positions` (the shell's particles).
+  SurfaceMesh surface(RigidBodyId id, const std::vector<Vector3>& positions,
+                      const SurfaceMeshResolution& resolution = {}) const {
+    check(id);
+    ModelExtent model;
+    if (!positions.empty()) model.lower = model.upper = positions.front();
+    for (const Vector3& x : positions) {
+      model.lower = model.lower.cwiseMin(x);
+      model.upper = model.upper.cwiseMax(x);
+    }
+    return bodies_[id]->surface(model, resolution);
   }
 
   // CSV time history of one body: written now and after every step.

@@ -56,6 +56,7 @@
 #include <sphshell/io/output_directory.hpp>
 #include <sphshell/io/output_file.hpp>
 #include <sphshell/io/pvd_collection.hpp>
+#include <sphshell/io/rigid_body_surfaces.hpp>
 #include <sphshell/io/vtu_writer.hpp>
 #include <sphshell/solver/integration_points.hpp>
 #include <sphshell/solver/options.hpp>
@@ -388,6 +389,11 @@ class SolverOutput {
       if (with_cracks) io::write_vtu(listed[2], cracks, format);
       // Every file of the frame is complete before any collection lists it.
       particle_collection_->stage(solver.time(), listed[0]);
+      if (!solver.bodies_.empty()) {  // the rigid bodies' surfaces: part 1 of the particle series
+        const std::string bodies = series_path("bodies_" + number + ".vtu");
+        io::write_vtu(bodies, io::rigid_body_grid(solver.bodies_, solver.particles_.position, solver.time()), format);
+        particle_collection_->stage(solver.time(), bodies, 1);
+      }
       stress_point_collection_->stage(solver.time(), listed[1]);
       std::vector<const io::PvdCollection*> collections{particle_collection_.get(), stress_point_collection_.get()};
       if (with_cracks) {
