@@ -5,11 +5,15 @@
 // computed here from what the solver reports.
 #include <sphshell/sphshell.hpp>
 
+#include "support/mesh_files.hpp"
+#include "support/vtu_reader.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -228,4 +232,146 @@ TEST_CASE("rigid bodies: refused input and the probe", "[contact]") {
   while (std::getline(in, line)) ++lines;
   CHECK(lines == 2 + 1 + 3);  // comment, header, the start and three steps
   CHECK_THROWS_WITH(solver.save_checkpoint("test_contact_solver.ckpt"), Catch::Contains("rigid bodies"));
+}
+
+namespace {
+
+// A free 0.1 m square plate, 2 mm thick, lying on a fixed wall (its lower
+// face touching it) under gravity: first a normal component g_n, ramped in
+// over many contact periods so the plate settles on its contact springs
+// without ringing, then a tangential component g_t along x, ramped in after
+// it. Coulomb's law for the whole plate: it sticks while g_t < μ g_n (the
+// wall then holds it with the tangential force M g_t) and slides otherwise,
+// the wall's tangential force being μ times its normal force and the plate
+// accelerating at g_t − μ g_n.
+constexpr double friction_coefficient = 0.3;
+constexpr double normal_gravity = 50.0;  // m/s²
+constexpr double normal_ramp = 4e-4, tangential_start = 5e-4, tangential_ramp = 2e-4;
+constexpr double measure_from = 1e-3, slide_end = 1.6e-3;
+
+struct SlideRun {
+  double mean_ratio = 0.0;          // |F_t| / |F_n| of the wall's reaction, averaged over the window
+  double largest_ratio_error = 0.0;  // largest | |F_t|/|F_n| − mean | over the window's steps
+  double mean_tangential = 0.0;     // wall's tangential reaction, averaged over the window (N)
+  double acceleration = 0.0;        // plate's mean x acceleration over the window (m/s²)
+  double largest_speed = 0.0;       // plate's largest mean x speed over the window (m/s)
+  double plate_mass = 0.0;
+};
+
+SlideRun slide_on_wall(double tangential_gravity) {
+  const double thickness = 2e-3;
+  const ShellModel plate = ShellModel::rectangular_plate(0.1, 0.1, 9, 9, thickness);
+  PlateSolver solver(plate, steel, plate_options());
+  contact::PenaltyOptions contact;
+  contact.friction_coefficient = friction_coefficient;
+  const contact::RigidBodyId wall =
+      solver.add_rigid_body(contact::fixed_wall(Vector3(0.0, 0.0, -0.5 * thickness), Vector3::UnitZ()), contact);
+  solver.add_gravity(plate.all_particles(), Vector3(0.0, 0.0, -normal_gravity), time_function::Ramp{normal_ramp, 0.0});
+  solver.add_gravity(plate.all_particles(), Vector3(tangential_gravity, 0.0, 0.0),
+                     time_function::Ramp{tangential_ramp, tangential_start});
+  SlideRun run;
+  for (const double m : solver.masses()) run.plate_mass += m;
+  auto mean_speed = [&](const PlateSolver& s) {
+    double momentum = 0.0;
+    const std::vector<Vector3> velocity = s.velocities();
+    for (std::size_t i = 0; i < velocity.size(); ++i) momentum += s.masses()[i] * velocity[i].x();
+    return momentum / run.plate_mass;
+  };
+  std::vector<double> ratios;
+  double tangential_time = 0.0, window = 0.0, speed_at_start = 0.0, time_at_start = 0.0;
+  solver.run_until(slide_end, [&](const PlateSolver& s) {
+    if (s.time() < measure_from) return;
+    const Vector3 force = s.rigid_body(wall).contact_force;
+    const double speed = mean_speed(s);
+    if (window == 0.0) {
+      speed_at_start = speed;
+      time_at_start = s.time();
+    }
+    ratios.push_back(std::hypot(force.x(), force.y()) / std::abs(force.z()));
+    tangential_time += s.time_step() * force.x();
+    window += s.time_step();
+    run.largest_speed = std::max(run.largest_speed, std::abs(speed));
+    run.acceleration = (speed - speed_at_start) / std::max(s.time() - time_at_start, s.time_step());
+  });
+  REQUIRE(!ratios.empty());
+  for (const double r : ratios) run.mean_ratio += r / ratios.size();
+  for (const double r : ratios) run.largest_ratio_error = std::max(run.largest_ratio_error, std::abs(r - run.mean_ratio));
+  run.mean_tangential = tangential_time / window;
+  return run;
+}
+
+}  // namespace
+
+TEST_CASE("a plate sliding on a wall: the wall's tangential force is mu times its normal force", "[contact]") {
+  // Pulled along at twice the sticking limit.
+  const double pull = 2.0 * friction_coefficient * normal_gravity;
+  const SlideRun slide = slide_on_wall(pull);
+  INFO("mean |F_t|/|F_n| " << slide.mean_ratio << " (largest step deviation " << slide.largest_ratio_error
+                           << "), plate acceleration " << slide.acceleration << " m/s²");
+  CHECK(slide.mean_ratio == Approx(friction_coefficient).epsilon(0.01));
+  CHECK(slide.largest_ratio_error < 0.02 * friction_coefficient);
+  // Newton for the plate: g_t − μ g_n.
+  CHECK(slide.acceleration == Approx(pull - friction_coefficient * normal_gravity).epsilon(0.03));
+}
+
+TEST_CASE("a plate pulled below mu g on a wall sticks: the wall holds it with M g_t", "[contact]") {
+  const double pull = 0.5 * friction_coefficient * normal_gravity;
+  const SlideRun stick = slide_on_wall(pull);
+  INFO("mean tangential reaction " << stick.mean_tangential << " N, M g_t " << stick.plate_mass * pull
+                                   << " N, largest speed " << stick.largest_speed << " m/s");
+  CHECK(stick.mean_tangential == Approx(stick.plate_mass * pull).epsilon(0.01));
+  // Were it sliding at μ g_n below the pull it would reach (g_t) × the window's
+  // time; stuck, the plate only shakes on its tangential springs.
+  CHECK(stick.largest_speed < 0.01 * pull * (slide_end - measure_from));
+  CHECK(stick.mean_ratio < friction_coefficient);
+}
+
+TEST_CASE("frames draw the rigid bodies: bodies_N.vtu, part 1 of particles.pvd, the body where it is",
+          "[contact]") {
+  const test_support::ScratchDirectory directory("contact_frames");
+  const ShellModel plate = ShellModel::rectangular_plate(plate_side, plate_side, plate_particles, plate_particles,
+                                                         plate_thickness);
+  SolverOptions options = plate_options();
+  options.output_directory = directory.path().string();
+  options.output_interval = 2e-4;
+  options.frame_encoding = io::VtuEncoding::binary;
+  options.frame_precision = io::VtuPrecision::float64;
+  PlateSolver solver(plate, steel, options);
+  solver.clamp(plate.set("boundary"));
+  const contact::RigidBodyId sphere = solver.add_rigid_body(sphere_above_plate(impact_gap, {0.0, 0.0, -20.0}));
+  const contact::RigidBodyId wall =
+      solver.add_rigid_body(contact::fixed_wall(Vector3(0.0, 0.0, -0.05), Vector3::UnitZ()));
+  solver.run_until(6e-4);
+  const std::vector<test_support::PvdEntry> entries =
+      test_support::read_pvd((directory.path() / "particles.pvd").string());
+  std::vector<test_support::PvdEntry> shells, bodies;
+  for (const auto& entry : entries) (entry.part == "1" ? bodies : shells).push_back(entry);
+  REQUIRE(shells.size() == 4);  // t = 0, 2e-4, 4e-4, 6e-4
+  REQUIRE(bodies.size() == shells.size());
+  for (std::size_t k = 0; k < bodies.size(); ++k) {
+    CHECK(bodies[k].time == shells[k].time);
+    CHECK(bodies[k].file == "bodies_" + std::string(5, '0') + std::to_string(k) + ".vtu");
+  }
+  const test_support::Vtu last = test_support::read_vtu((directory.path() / bodies.back().file).string());
+  const contact::SurfaceMesh sphere_mesh = contact::surface_mesh(contact::Sphere(sphere_radius));
+  REQUIRE(last.cells() == sphere_mesh.triangles.size() + 2);
+  REQUIRE(last.points() == sphere_mesh.vertices.size() + 4);
+  const std::vector<double>& body = last.array("CellData", "body").values;
+  CHECK(std::count(body.begin(), body.end(), 0.0) == static_cast<long>(sphere_mesh.triangles.size()));
+  CHECK(std::count(body.begin(), body.end(), 1.0) == 2);
+  // The sphere's vertices lie on the sphere where the run has it now, the wall's on the wall.
+  const Vector3 centre = solver.rigid_body(sphere).kinematics.position;
+  // It moved (struck the plate and rebounded) since the first frame.
+  REQUIRE((centre - sphere_above_plate(impact_gap, Vector3::Zero()).position()).norm() > 5e-4);
+  std::vector<double> points;
+  for (const auto& array : last.arrays)
+    if (array.section == "Points") points = array.values;
+  REQUIRE(points.size() == 3 * last.points());
+  for (std::size_t p = 0; p < last.points(); ++p) {
+    const Vector3 x(points[3 * p], points[3 * p + 1], points[3 * p + 2]);
+    if (p < sphere_mesh.vertices.size())
+      REQUIRE((x - centre).norm() == Approx(sphere_radius).epsilon(1e-12));
+    else
+      REQUIRE(x.z() == Approx(solver.rigid_body(wall).kinematics.position.z()).epsilon(1e-12));
+  }
 }
