@@ -29,7 +29,7 @@ struct Arguments {
   double mass = 2.0;
   double speed = 5.0;
   double striker_radius = 0.0125;
-  double end_time = 4e-3;
+  double end_time = 6e-3;
   std::string output = "mass_impact";
   bool frames = false;
 };
@@ -116,6 +116,11 @@ int run(const Arguments& a) {
             << " s" << std::endl;
 
   double peak_force = 0.0, peak_force_time = 0.0, peak_deflection = 0.0, peak_deflection_time = 0.0;
+  // The central deflection integrated over time since the striker last touched
+  // the plate: its mean is the permanent deflection with the elastic
+  // vibration averaged out.
+  double free_deflection_time = 0.0, free_time = 0.0;
+  bool touched = false;
   io::PlotSeries force{"contact force on the striker", {}, {}};
   io::PlotSeries deflection{"central deflection", {}, {}};
   const auto wall_start = std::chrono::steady_clock::now();
@@ -126,6 +131,13 @@ int run(const Arguments& a) {
     if (f > peak_force) {
       peak_force = f;
       peak_force_time = s.time();
+    }
+    if (body.contacts > 0) {
+      touched = true;
+      free_deflection_time = free_time = 0.0;
+    } else if (touched) {
+      free_deflection_time += s.time_step() * w;
+      free_time += s.time_step();
     }
     if (w > peak_deflection) {
       peak_deflection = w;
@@ -145,8 +157,14 @@ int run(const Arguments& a) {
             << "peak contact force " << peak_force << " N at t = " << peak_force_time * 1e3 << " ms\n"
             << "largest central deflection " << peak_deflection * 1e3 << " mm at t = " << peak_deflection_time * 1e3
             << " ms\n"
-            << "central deflection at the end " << -solver.displacement(centre).z() * 1e3 << " mm\n"
-            << "striker velocity at the end " << body.kinematics.velocity.z() << " m/s (contact impulse "
+            << "central deflection at the end " << -solver.displacement(centre).z() * 1e3 << " mm\n";
+  if (free_time > 0.0)
+    std::cout << "mean central deflection over the " << free_time * 1e3
+              << " ms since the striker left (permanent deflection, vibration averaged out) "
+              << free_deflection_time / free_time * 1e3 << " mm\n";
+  else
+    std::cout << "the striker is still on the plate at the end: no permanent deflection yet\n";
+  std::cout << "striker velocity at the end " << body.kinematics.velocity.z() << " m/s (contact impulse "
             << body.contact_impulse.z() << " N s)\n"
             << "energy at the end: plate kinetic " << energy.kinetic << " J, internal " << energy.internal
             << " J (plastic dissipation " << energy.plastic_dissipation << " J), striker kinetic "
