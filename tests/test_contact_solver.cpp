@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -231,7 +232,136 @@ TEST_CASE("rigid bodies: refused input and the probe", "[contact]") {
   int lines = 0;
   while (std::getline(in, line)) ++lines;
   CHECK(lines == 2 + 1 + 3);  // comment, header, the start and three steps
-  CHECK_THROWS_WITH(solver.save_checkpoint("test_contact_solver.ckpt"), Catch::Contains("rigid bodies"));
+}
+
+namespace {
+
+// The struck clamped plate with friction (so the contact has a tangential history).
+contact::PenaltyOptions rough_contact() {
+  contact::PenaltyOptions options;
+  options.friction_coefficient = 0.3;
+  return options;
+}
+
+struct ImpactEnd {
+  std::vector<Vector3> positions, velocities;
+  contact::RigidBodyState sphere;
+  EnergyReport energy;
+};
+
+ImpactEnd impact_end(const PlateSolver& solver) {
+  return {solver.positions(), solver.velocities(), solver.rigid_body(0), solver.energy()};
+}
+
+// Bitwise equality of doubles (memcmp: −0 and +0 differ, as a restart must not change either).
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+bool same_bits(const Vector3& a, const Vector3& b) {
+  return same_bits(a.x(), b.x()) && same_bits(a.y(), b.y()) && same_bits(a.z(), b.z());
+}
+
+}  // namespace
+
+TEST_CASE("a plate struck by a free sphere, checkpointed mid-impact and restarted, ends bit for bit as the whole run",
+          "[contact][checkpoint]") {
+  const test_support::ScratchDirectory directory("contact_checkpoint");
+  const std::string path = (directory.path() / "impact.ckpt").string();
+  const ShellModel plate = ShellModel::rectangular_plate(plate_side, plate_side, plate_particles, plate_particles,
+                                                         plate_thickness);
+  // The sphere strikes after 50 µs; the checkpoint is taken at the first step
+  // after 150 µs that ends with the sphere touching the plate.
+  constexpr double checkpoint_after = 1.5e-4, end_time = 6e-4;
+  const Vector3 strike(0.3 * impact_speed, 0.0, -impact_speed);  // oblique, so friction acts
+  PlateSolver whole(plate, steel, plate_options());
+  whole.clamp(plate.set("boundary"));
+  whole.add_rigid_body(sphere_above_plate(impact_gap, strike), rough_contact());
+  whole.run_until(checkpoint_after);
+  while (whole.rigid_body(0).contacts == 0 && whole.time() < end_time) whole.step();
+  REQUIRE(whole.rigid_body(0).contacts > 0);
+  REQUIRE(whole.time() < 0.5 * end_time);
+  REQUIRE(whole.energy().friction_dissipation > 0.0);
+  const double saved_time = whole.time();
+  whole.save_checkpoint(path);
+  whole.run_until(end_time);
+  const ImpactEnd expected = impact_end(whole);
+
+  PlateSolver restarted(plate, steel, plate_options());
+  restarted.clamp(plate.set("boundary"));
+  restarted.add_rigid_body(sphere_above_plate(impact_gap, strike), rough_contact());
+  restarted.load_checkpoint(path);
+  REQUIRE(restarted.time() == saved_time);
+  restarted.run_until(end_time);
+  const ImpactEnd got = impact_end(restarted);
+
+  REQUIRE(got.positions.size() == expected.positions.size());
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < got.positions.size(); ++i)
+    differing += same_bits(got.positions[i], expected.positions[i]) && same_bits(got.velocities[i], expected.velocities[i])
+                     ? 0
+                     : 1;
+  CHECK(differing == 0);
+  const contact::RigidKinematics& a = got.sphere.kinematics;
+  const contact::RigidKinematics& b = expected.sphere.kinematics;
+  CHECK(same_bits(a.position, b.position));
+  CHECK(same_bits(a.velocity, b.velocity));
+  CHECK(same_bits(a.angular_velocity, b.angular_velocity));
+  CHECK(a.orientation.coeffs() == b.orientation.coeffs());
+  CHECK(same_bits(got.sphere.contact_impulse, expected.sphere.contact_impulse));
+  CHECK(same_bits(got.sphere.contact_force, expected.sphere.contact_force));
+  CHECK(got.sphere.contacts == expected.sphere.contacts);
+  // The sphere turned (friction's moment), so the orientation was a real test.
+  CHECK(b.angular_velocity.norm() > 0.0);
+  const EnergyReport& e = got.energy;
+  const EnergyReport& f = expected.energy;
+  CHECK(same_bits(e.kinetic, f.kinetic));
+  CHECK(same_bits(e.elastic, f.elastic));
+  CHECK(same_bits(e.external_work, f.external_work));
+  CHECK(same_bits(e.rigid_body_kinetic, f.rigid_body_kinetic));
+  CHECK(same_bits(e.contact_energy, f.contact_energy));
+  CHECK(same_bits(e.friction_dissipation, f.friction_dissipation));
+  CHECK(same_bits(e.contact_work_on_shell, f.contact_work_on_shell));
+  CHECK(same_bits(e.rigid_body_work, f.rigid_body_work));
+  CHECK(same_bits(e.balance(), f.balance()));
+}
+
+TEST_CASE("a checkpoint whose rigid bodies are not the solver's is refused, naming what differs",
+          "[contact][checkpoint]") {
+  const test_support::ScratchDirectory directory("contact_checkpoint_refused");
+  const std::string path = (directory.path() / "impact.ckpt").string();
+  const ShellModel plate = ShellModel::rectangular_plate(plate_side, plate_side, plate_particles, plate_particles,
+                                                         plate_thickness);
+  {
+    PlateSolver saving(plate, steel, plate_options());
+    saving.add_rigid_body(sphere_above_plate(impact_gap, {0.0, 0.0, -impact_speed}));
+    saving.run_until(1e-4);
+    saving.save_checkpoint(path);
+  }
+  auto refusal = [&](auto&& add_bodies) {
+    PlateSolver loading(plate, steel, plate_options());
+    add_bodies(loading);
+    try {
+      loading.load_checkpoint(path);
+    } catch (const Error& error) {
+      // Refused before anything was loaded: the solver still steps.
+      loading.step();
+      return std::string(error.what());
+    }
+    return std::string();
+  };
+  const std::string none = refusal([](PlateSolver&) {});
+  CHECK_THAT(none, Catch::Contains(path) && Catch::Contains("1 rigid bodies and this solver 0"));
+  const std::string wall = refusal([](PlateSolver& s) {
+    s.add_rigid_body(contact::fixed_wall(Vector3(0.0, 0.0, -0.05), Vector3::UnitZ()));
+  });
+  CHECK_THAT(wall, Catch::Contains("free sphere") && Catch::Contains("fixed plane"));
+  const std::string heavier = refusal([](PlateSolver& s) {
+    contact::RigidKinematics start;
+    start.position = sphere_above_plate(impact_gap, Vector3::Zero()).position();
+    const double inertia = 0.4 * sphere_mass * sphere_radius * sphere_radius;
+    s.add_rigid_body(FreeSphere(contact::Sphere(sphere_radius),
+                                contact::Free({1.1 * sphere_mass, Vector3::Constant(inertia), Vector3::Zero()}), start));
+  });
+  CHECK_THAT(heavier, Catch::Contains("rigid body 0") && Catch::Contains("mass"));
+  CHECK(refusal([](PlateSolver& s) { s.add_rigid_body(sphere_above_plate(impact_gap, Vector3::Zero())); }).empty());
 }
 
 namespace {
