@@ -588,3 +588,103 @@ TEST_CASE("contact: particles in chunks give the bits of one pass", "[contact]")
     for (std::size_t i = 0; i < sheet.position.size(); ++i) sheet.position[i] += dt * sheet.velocity[i];
   }
 }
+
+namespace {
+
+// Enclosed volume of a triangulation, Σ a · (b × c) / 6 (divergence theorem),
+// computed here rather than taken from TriangleSurface::volume().
+double enclosed_volume(const SurfaceMesh& mesh) {
+  double volume = 0.0;
+  for (const auto& t : mesh.triangles)
+    volume += mesh.vertices[t[0]].dot(mesh.vertices[t[1]].cross(mesh.vertices[t[2]])) / 6.0;
+  return volume;
+}
+
+// Every vertex of a placed mesh lies on the body's surface.
+template <class Shape, class Motion>
+double largest_vertex_gap(const RigidBody<Shape, Motion>& body, const SurfaceMesh& mesh) {
+  double largest = 0.0;
+  for (const Vector3& vertex : mesh.vertices) largest = std::max(largest, std::abs(body.proximity(vertex).gap));
+  return largest;
+}
+
+RigidKinematics turned_and_moved() {
+  RigidKinematics at;
+  at.position = Vector3(0.3, -0.1, 0.7);
+  at.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Vector3(1.0, 2.0, -0.5).normalized()));
+  return at;
+}
+
+}  // namespace
+
+TEST_CASE("contact: drawn surfaces are closed, outward, on the shape and converge to its volume", "[contact]") {
+  const double radius = 0.02, length = 0.05;
+  SECTION("sphere") {
+    const RigidBody<Sphere, Fixed> body(Sphere(radius), Fixed{}, turned_and_moved());
+    const SurfaceMesh coarse = place_surface_mesh(body, {});
+    // TriangleSurface refuses an open, inconsistently turned or inward surface.
+    const TriangleSurface closed(TriangleSurfaceParameters{coarse.vertices, coarse.triangles});
+    CHECK(largest_vertex_gap(body, coarse) < 1e-12 * radius);
+    const double exact = 4.0 / 3.0 * pi * radius * radius * radius;
+    const SurfaceMesh local = surface_mesh(Sphere(radius), {32});
+    const SurfaceMesh fine = surface_mesh(Sphere(radius), {64});
+    const double coarse_error = exact - enclosed_volume(local);
+    const double fine_error = exact - enclosed_volume(fine);
+    // Inscribed: below the sphere's volume, by a chord error of second order.
+    CHECK(closed.volume() == Approx(enclosed_volume(local)).epsilon(1e-12));
+    CHECK(coarse_error > 0.0);
+    CHECK(coarse_error < 0.02 * exact);
+    CHECK(coarse_error / fine_error == Approx(4.0).epsilon(0.05));
+  }
+  SECTION("flat-ended cylinder: a prism of exactly n/2 R² sin(2π/n) L") {
+    const Cylinder shape({Vector3(0.0, 1.0, 1.0), radius, length, CylinderEnds::flat});
+    const RigidBody<Cylinder, Fixed> body(shape, Fixed{}, turned_and_moved());
+    const SurfaceMesh placed = place_surface_mesh(body, {}, {24});
+    const TriangleSurface closed(TriangleSurfaceParameters{placed.vertices, placed.triangles});
+    CHECK(largest_vertex_gap(body, placed) < 1e-12 * radius);
+    CHECK(closed.volume() == Approx(12.0 * radius * radius * std::sin(2.0 * pi / 24.0) * length).epsilon(1e-12));
+  }
+  SECTION("capsule") {
+    const Cylinder shape({Vector3(1.0, 0.0, 0.0), radius, length, CylinderEnds::hemispherical});
+    const RigidBody<Cylinder, Fixed> body(shape, Fixed{}, turned_and_moved());
+    const SurfaceMesh placed = place_surface_mesh(body, {}, {48});
+    const TriangleSurface closed(TriangleSurfaceParameters{placed.vertices, placed.triangles});
+    CHECK(largest_vertex_gap(body, placed) < 1e-12 * radius);
+    const double exact = pi * radius * radius * (length + 4.0 / 3.0 * radius);
+    CHECK(closed.volume() < exact);
+    CHECK(closed.volume() > 0.99 * exact);
+  }
+  SECTION("triangle surface: its own triangles, placed") {
+    const RigidBody<TriangleSurface, Fixed> body(TriangleSurface(cube_surface(0.1)), Fixed{}, turned_and_moved());
+    const SurfaceMesh placed = place_surface_mesh(body, {});
+    CHECK(placed.triangles == body.shape().triangles());
+    CHECK(largest_vertex_gap(body, placed) < 1e-12);
+  }
+  SECTION("plane: a patch in the wall, facing out, reaching past the model") {
+    RigidKinematics at;
+    at.position = Vector3(0.0, 0.0, -0.01);
+    const RigidBody<Plane, Fixed> wall(Plane(Vector3(0.0, 0.0, 1.0)), Fixed{}, at);
+    const ModelExtent model{Vector3(0.0, 0.0, 0.0), Vector3(0.4, 0.2, 0.0)};
+    const SurfaceMesh patch = place_surface_mesh(wall, model);
+    REQUIRE(patch.triangles.size() == 2);
+    CHECK(largest_vertex_gap(wall, patch) < 1e-15);
+    for (const auto& t : patch.triangles) {
+      const Vector3 normal = (patch.vertices[t[1]] - patch.vertices[t[0]]).cross(patch.vertices[t[2]] - patch.vertices[t[0]]);
+      CHECK(normal.normalized().dot(Vector3::UnitZ()) == Approx(1.0));
+    }
+    // Centred under the model, each corner beyond the model's corners.
+    Vector3 lower = patch.vertices[0], upper = patch.vertices[0];
+    for (const Vector3& v : patch.vertices) {
+      lower = lower.cwiseMin(v);
+      upper = upper.cwiseMax(v);
+    }
+    CHECK((0.5 * (lower + upper) - Vector3(0.2, 0.1, -0.01)).norm() < 1e-15);
+    CHECK(lower.x() < 0.0);
+    CHECK(lower.y() < 0.0);
+    CHECK(upper.x() > 0.4);
+    CHECK(upper.y() > 0.2);
+  }
+  SECTION("too few segments are refused by name") {
+    CHECK_THROWS_WITH(surface_mesh(Sphere(radius), {2}), Catch::Contains("surface mesh segments"));
+  }
+}

@@ -5,11 +5,16 @@
 // computed here from what the solver reports.
 #include <sphshell/sphshell.hpp>
 
+#include "support/mesh_files.hpp"
+#include "support/vtu_reader.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -227,5 +232,276 @@ TEST_CASE("rigid bodies: refused input and the probe", "[contact]") {
   int lines = 0;
   while (std::getline(in, line)) ++lines;
   CHECK(lines == 2 + 1 + 3);  // comment, header, the start and three steps
-  CHECK_THROWS_WITH(solver.save_checkpoint("test_contact_solver.ckpt"), Catch::Contains("rigid bodies"));
+}
+
+namespace {
+
+// The struck clamped plate with friction (so the contact has a tangential history).
+contact::PenaltyOptions rough_contact() {
+  contact::PenaltyOptions options;
+  options.friction_coefficient = 0.3;
+  return options;
+}
+
+struct ImpactEnd {
+  std::vector<Vector3> positions, velocities;
+  contact::RigidBodyState sphere;
+  EnergyReport energy;
+};
+
+ImpactEnd impact_end(const PlateSolver& solver) {
+  return {solver.positions(), solver.velocities(), solver.rigid_body(0), solver.energy()};
+}
+
+// Bitwise equality of doubles (memcmp: −0 and +0 differ, as a restart must not change either).
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+bool same_bits(const Vector3& a, const Vector3& b) {
+  return same_bits(a.x(), b.x()) && same_bits(a.y(), b.y()) && same_bits(a.z(), b.z());
+}
+
+}  // namespace
+
+TEST_CASE("a plate struck by a free sphere, checkpointed mid-impact and restarted, ends bit for bit as the whole run",
+          "[contact][checkpoint]") {
+  const test_support::ScratchDirectory directory("contact_checkpoint");
+  const std::string path = (directory.path() / "impact.ckpt").string();
+  const ShellModel plate = ShellModel::rectangular_plate(plate_side, plate_side, plate_particles, plate_particles,
+                                                         plate_thickness);
+  // The sphere strikes after 50 µs; the checkpoint is taken at the first step
+  // after 150 µs that ends with the sphere touching the plate.
+  constexpr double checkpoint_after = 1.5e-4, end_time = 6e-4;
+  const Vector3 strike(0.3 * impact_speed, 0.0, -impact_speed);  // oblique, so friction acts
+  PlateSolver whole(plate, steel, plate_options());
+  whole.clamp(plate.set("boundary"));
+  whole.add_rigid_body(sphere_above_plate(impact_gap, strike), rough_contact());
+  whole.run_until(checkpoint_after);
+  while (whole.rigid_body(0).contacts == 0 && whole.time() < end_time) whole.step();
+  REQUIRE(whole.rigid_body(0).contacts > 0);
+  REQUIRE(whole.time() < 0.5 * end_time);
+  REQUIRE(whole.energy().friction_dissipation > 0.0);
+  const double saved_time = whole.time();
+  whole.save_checkpoint(path);
+  whole.run_until(end_time);
+  const ImpactEnd expected = impact_end(whole);
+
+  PlateSolver restarted(plate, steel, plate_options());
+  restarted.clamp(plate.set("boundary"));
+  restarted.add_rigid_body(sphere_above_plate(impact_gap, strike), rough_contact());
+  restarted.load_checkpoint(path);
+  REQUIRE(restarted.time() == saved_time);
+  restarted.run_until(end_time);
+  const ImpactEnd got = impact_end(restarted);
+
+  REQUIRE(got.positions.size() == expected.positions.size());
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < got.positions.size(); ++i)
+    differing += same_bits(got.positions[i], expected.positions[i]) && same_bits(got.velocities[i], expected.velocities[i])
+                     ? 0
+                     : 1;
+  CHECK(differing == 0);
+  const contact::RigidKinematics& a = got.sphere.kinematics;
+  const contact::RigidKinematics& b = expected.sphere.kinematics;
+  CHECK(same_bits(a.position, b.position));
+  CHECK(same_bits(a.velocity, b.velocity));
+  CHECK(same_bits(a.angular_velocity, b.angular_velocity));
+  CHECK(a.orientation.coeffs() == b.orientation.coeffs());
+  CHECK(same_bits(got.sphere.contact_impulse, expected.sphere.contact_impulse));
+  CHECK(same_bits(got.sphere.contact_force, expected.sphere.contact_force));
+  CHECK(got.sphere.contacts == expected.sphere.contacts);
+  // The sphere turned (friction's moment), so the orientation was a real test.
+  CHECK(b.angular_velocity.norm() > 0.0);
+  const EnergyReport& e = got.energy;
+  const EnergyReport& f = expected.energy;
+  CHECK(same_bits(e.kinetic, f.kinetic));
+  CHECK(same_bits(e.elastic, f.elastic));
+  CHECK(same_bits(e.external_work, f.external_work));
+  CHECK(same_bits(e.rigid_body_kinetic, f.rigid_body_kinetic));
+  CHECK(same_bits(e.contact_energy, f.contact_energy));
+  CHECK(same_bits(e.friction_dissipation, f.friction_dissipation));
+  CHECK(same_bits(e.contact_work_on_shell, f.contact_work_on_shell));
+  CHECK(same_bits(e.rigid_body_work, f.rigid_body_work));
+  CHECK(same_bits(e.balance(), f.balance()));
+}
+
+TEST_CASE("a checkpoint whose rigid bodies are not the solver's is refused, naming what differs",
+          "[contact][checkpoint]") {
+  const test_support::ScratchDirectory directory("contact_checkpoint_refused");
+  const std::string path = (directory.path() / "impact.ckpt").string();
+  const ShellModel plate = ShellModel::rectangular_plate(plate_side, plate_side, plate_particles, plate_particles,
+                                                         plate_thickness);
+  {
+    PlateSolver saving(plate, steel, plate_options());
+    saving.add_rigid_body(sphere_above_plate(impact_gap, {0.0, 0.0, -impact_speed}));
+    saving.run_until(1e-4);
+    saving.save_checkpoint(path);
+  }
+  auto refusal = [&](auto&& add_bodies) {
+    PlateSolver loading(plate, steel, plate_options());
+    add_bodies(loading);
+    try {
+      loading.load_checkpoint(path);
+    } catch (const Error& error) {
+      // Refused before anything was loaded: the solver still steps.
+      loading.step();
+      return std::string(error.what());
+    }
+    return std::string();
+  };
+  const std::string none = refusal([](PlateSolver&) {});
+  CHECK_THAT(none, Catch::Contains(path) && Catch::Contains("1 rigid bodies and this solver 0"));
+  const std::string wall = refusal([](PlateSolver& s) {
+    s.add_rigid_body(contact::fixed_wall(Vector3(0.0, 0.0, -0.05), Vector3::UnitZ()));
+  });
+  CHECK_THAT(wall, Catch::Contains("free sphere") && Catch::Contains("fixed plane"));
+  const std::string heavier = refusal([](PlateSolver& s) {
+    contact::RigidKinematics start;
+    start.position = sphere_above_plate(impact_gap, Vector3::Zero()).position();
+    const double inertia = 0.4 * sphere_mass * sphere_radius * sphere_radius;
+    s.add_rigid_body(FreeSphere(contact::Sphere(sphere_radius),
+                                contact::Free({1.1 * sphere_mass, Vector3::Constant(inertia), Vector3::Zero()}), start));
+  });
+  CHECK_THAT(heavier, Catch::Contains("rigid body 0") && Catch::Contains("mass"));
+  CHECK(refusal([](PlateSolver& s) { s.add_rigid_body(sphere_above_plate(impact_gap, Vector3::Zero())); }).empty());
+}
+
+namespace {
+
+// A free 0.1 m square plate, 2 mm thick, lying on a fixed wall (its lower
+// face touching it) under gravity: first a normal component g_n, ramped in
+// over many contact periods so the plate settles on its contact springs
+// without ringing, then a tangential component g_t along x, ramped in after
+// it. Coulomb's law for the whole plate: it sticks while g_t < μ g_n (the
+// wall then holds it with the tangential force M g_t) and slides otherwise,
+// the wall's tangential force being μ times its normal force and the plate
+// accelerating at g_t − μ g_n.
+constexpr double friction_coefficient = 0.3;
+constexpr double normal_gravity = 50.0;  // m/s²
+constexpr double normal_ramp = 4e-4, tangential_start = 5e-4, tangential_ramp = 2e-4;
+constexpr double measure_from = 1e-3, slide_end = 1.6e-3;
+
+struct SlideRun {
+  double mean_ratio = 0.0;          // |F_t| / |F_n| of the wall's reaction, averaged over the window
+  double largest_ratio_error = 0.0;  // largest | |F_t|/|F_n| − mean | over the window's steps
+  double mean_tangential = 0.0;     // wall's tangential reaction, averaged over the window (N)
+  double acceleration = 0.0;        // plate's mean x acceleration over the window (m/s²)
+  double largest_speed = 0.0;       // plate's largest mean x speed over the window (m/s)
+  double plate_mass = 0.0;
+};
+
+SlideRun slide_on_wall(double tangential_gravity) {
+  const double thickness = 2e-3;
+  const ShellModel plate = ShellModel::rectangular_plate(0.1, 0.1, 9, 9, thickness);
+  PlateSolver solver(plate, steel, plate_options());
+  contact::PenaltyOptions contact;
+  contact.friction_coefficient = friction_coefficient;
+  const contact::RigidBodyId wall =
+      solver.add_rigid_body(contact::fixed_wall(Vector3(0.0, 0.0, -0.5 * thickness), Vector3::UnitZ()), contact);
+  solver.add_gravity(plate.all_particles(), Vector3(0.0, 0.0, -normal_gravity), time_function::Ramp{normal_ramp, 0.0});
+  solver.add_gravity(plate.all_particles(), Vector3(tangential_gravity, 0.0, 0.0),
+                     time_function::Ramp{tangential_ramp, tangential_start});
+  SlideRun run;
+  for (const double m : solver.masses()) run.plate_mass += m;
+  auto mean_speed = [&](const PlateSolver& s) {
+    double momentum = 0.0;
+    const std::vector<Vector3> velocity = s.velocities();
+    for (std::size_t i = 0; i < velocity.size(); ++i) momentum += s.masses()[i] * velocity[i].x();
+    return momentum / run.plate_mass;
+  };
+  std::vector<double> ratios;
+  double tangential_time = 0.0, window = 0.0, speed_at_start = 0.0, time_at_start = 0.0;
+  solver.run_until(slide_end, [&](const PlateSolver& s) {
+    if (s.time() < measure_from) return;
+    const Vector3 force = s.rigid_body(wall).contact_force;
+    const double speed = mean_speed(s);
+    if (window == 0.0) {
+      speed_at_start = speed;
+      time_at_start = s.time();
+    }
+    ratios.push_back(std::hypot(force.x(), force.y()) / std::abs(force.z()));
+    tangential_time += s.time_step() * force.x();
+    window += s.time_step();
+    run.largest_speed = std::max(run.largest_speed, std::abs(speed));
+    run.acceleration = (speed - speed_at_start) / std::max(s.time() - time_at_start, s.time_step());
+  });
+  REQUIRE(!ratios.empty());
+  for (const double r : ratios) run.mean_ratio += r / ratios.size();
+  for (const double r : ratios) run.largest_ratio_error = std::max(run.largest_ratio_error, std::abs(r - run.mean_ratio));
+  run.mean_tangential = tangential_time / window;
+  return run;
+}
+
+}  // namespace
+
+TEST_CASE("a plate sliding on a wall: the wall's tangential force is mu times its normal force", "[contact]") {
+  // Pulled along at twice the sticking limit.
+  const double pull = 2.0 * friction_coefficient * normal_gravity;
+  const SlideRun slide = slide_on_wall(pull);
+  INFO("mean |F_t|/|F_n| " << slide.mean_ratio << " (largest step deviation " << slide.largest_ratio_error
+                           << "), plate acceleration " << slide.acceleration << " m/s²");
+  CHECK(slide.mean_ratio == Approx(friction_coefficient).epsilon(0.01));
+  CHECK(slide.largest_ratio_error < 0.02 * friction_coefficient);
+  // Newton for the plate: g_t − μ g_n.
+  CHECK(slide.acceleration == Approx(pull - friction_coefficient * normal_gravity).epsilon(0.03));
+}
+
+TEST_CASE("a plate pulled below mu g on a wall sticks: the wall holds it with M g_t", "[contact]") {
+  const double pull = 0.5 * friction_coefficient * normal_gravity;
+  const SlideRun stick = slide_on_wall(pull);
+  INFO("mean tangential reaction " << stick.mean_tangential << " N, M g_t " << stick.plate_mass * pull
+                                   << " N, largest speed " << stick.largest_speed << " m/s");
+  CHECK(stick.mean_tangential == Approx(stick.plate_mass * pull).epsilon(0.01));
+  // Were it sliding at μ g_n below the pull it would reach (g_t) × the window's
+  // time; stuck, the plate only shakes on its tangential springs.
+  CHECK(stick.largest_speed < 0.01 * pull * (slide_end - measure_from));
+  CHECK(stick.mean_ratio < friction_coefficient);
+}
+
+TEST_CASE("frames draw the rigid bodies: bodies_N.vtu, part 1 of particles.pvd, the body where it is",
+          "[contact]") {
+  const test_support::ScratchDirectory directory("contact_frames");
+  const ShellModel plate = ShellModel::rectangular_plate(plate_side, plate_side, plate_particles, plate_particles,
+                                                         plate_thickness);
+  SolverOptions options = plate_options();
+  options.output_directory = directory.path().string();
+  options.output_interval = 2e-4;
+  options.frame_encoding = io::VtuEncoding::binary;
+  options.frame_precision = io::VtuPrecision::float64;
+  PlateSolver solver(plate, steel, options);
+  solver.clamp(plate.set("boundary"));
+  const contact::RigidBodyId sphere = solver.add_rigid_body(sphere_above_plate(impact_gap, {0.0, 0.0, -20.0}));
+  const contact::RigidBodyId wall =
+      solver.add_rigid_body(contact::fixed_wall(Vector3(0.0, 0.0, -0.05), Vector3::UnitZ()));
+  solver.run_until(6e-4);
+  const std::vector<test_support::PvdEntry> entries =
+      test_support::read_pvd((directory.path() / "particles.pvd").string());
+  std::vector<test_support::PvdEntry> shells, bodies;
+  for (const auto& entry : entries) (entry.part == "1" ? bodies : shells).push_back(entry);
+  REQUIRE(shells.size() == 4);  // t = 0, 2e-4, 4e-4, 6e-4
+  REQUIRE(bodies.size() == shells.size());
+  for (std::size_t k = 0; k < bodies.size(); ++k) {
+    CHECK(bodies[k].time == shells[k].time);
+    CHECK(bodies[k].file == "bodies_" + std::string(5, '0') + std::to_string(k) + ".vtu");
+  }
+  const test_support::Vtu last = test_support::read_vtu((directory.path() / bodies.back().file).string());
+  const contact::SurfaceMesh sphere_mesh = contact::surface_mesh(contact::Sphere(sphere_radius));
+  REQUIRE(last.cells() == sphere_mesh.triangles.size() + 2);
+  REQUIRE(last.points() == sphere_mesh.vertices.size() + 4);
+  const std::vector<double>& body = last.array("CellData", "body").values;
+  CHECK(std::count(body.begin(), body.end(), 0.0) == static_cast<long>(sphere_mesh.triangles.size()));
+  CHECK(std::count(body.begin(), body.end(), 1.0) == 2);
+  // The sphere's vertices lie on the sphere where the run has it now, the wall's on the wall.
+  const Vector3 centre = solver.rigid_body(sphere).kinematics.position;
+  // It moved (struck the plate and rebounded) since the first frame.
+  REQUIRE((centre - sphere_above_plate(impact_gap, Vector3::Zero()).position()).norm() > 5e-4);
+  std::vector<double> points;
+  for (const auto& array : last.arrays)
+    if (array.section == "Points") points = array.values;
+  REQUIRE(points.size() == 3 * last.points());
+  for (std::size_t p = 0; p < last.points(); ++p) {
+    const Vector3 x(points[3 * p], points[3 * p + 1], points[3 * p + 2]);
+    if (p < sphere_mesh.vertices.size())
+      REQUIRE((x - centre).norm() == Approx(sphere_radius).epsilon(1e-12));
+    else
+      REQUIRE(x.z() == Approx(solver.rigid_body(wall).kinematics.position.z()).epsilon(1e-12));
+  }
 }

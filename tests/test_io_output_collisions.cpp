@@ -112,7 +112,8 @@ TEST_CASE("A probe on a frame's or a collection's path is refused before the fir
   ScratchDirectory scratch("collisions_probe_frame");
   const fs::path frames = scratch / "frames";
   PlateSolver solver(small_plate(), steel, with_frames(frames));
-  for (const char* name : {"particles_000000.vtu", "stress_points_000003.vtu", "particles.pvd"}) {
+  for (const char* name :
+       {"particles_000000.vtu", "stress_points_000003.vtu", "particles.pvd", "bodies_000002.vtu"}) {
     const std::string message = error_of([&] { solver.add_particle_probe((frames / name).string(), 0); });
     CHECK_THAT(message, Catch::Contains(name));
     CHECK_THAT(message, Catch::Contains("frame"));
@@ -170,4 +171,22 @@ TEST_CASE("A restart keeps and names stray files named like frames in the output
   CHECK(fs::exists(frames / "particles_junk.vtu"));
   CHECK_THAT(notes.str(), Catch::Contains(huge));
   CHECK_THAT(notes.str(), Catch::Contains("stress_points_000099.vtu"));
+}
+
+TEST_CASE("An earlier run's body frames are removed when a new run starts in the folder", "[io][output]") {
+  ScratchDirectory scratch("collisions_stale_bodies");
+  const fs::path frames = scratch / "frames";
+  fs::create_directories(frames);
+  // What a run with rigid bodies left: body surfaces of frames this run may never write.
+  for (const char* name : {"bodies_000000.vtu", "bodies_000041.vtu", "bodies_000003.vtu.tmp"})
+    std::ofstream(frames / name) << "an earlier run's bodies\n";
+  std::ofstream(frames / "bodies_notes.txt") << "not a frame\n";
+  PlateSolver solver(small_plate(), steel, with_frames(frames));
+  solver.clamp(solver.model().set("boundary"));
+  solver.run_until(5e-6);
+  CHECK_FALSE(fs::exists(frames / "bodies_000041.vtu"));
+  CHECK_FALSE(fs::exists(frames / "bodies_000003.vtu.tmp"));
+  // This run has no bodies, so it wrote none in frame 0's place either.
+  CHECK_FALSE(fs::exists(frames / "bodies_000000.vtu"));
+  CHECK(fs::exists(frames / "bodies_notes.txt"));
 }

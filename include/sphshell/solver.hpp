@@ -195,10 +195,6 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
       return 0;
     } else {
       latch_.check();
-      if (this->periodic_checkpoints())
-        detail::invalid_parameter("checkpoint_path", options_.checkpoint_path,
-                                  "a run with rigid bodies cannot be checkpointed yet: set checkpoint_every_steps "
-                                  "and checkpoint_every_seconds to 0");
       return bodies_.add(std::move(body), contact_options, contact_particles(), time_step_);
     }
   }

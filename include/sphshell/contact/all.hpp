@@ -8,4 +8,5 @@
 #include <sphshell/contact/plane.hpp>
 #include <sphshell/contact/rigid_body.hpp>
 #include <sphshell/contact/sphere.hpp>
+#include <sphshell/contact/surface_mesh.hpp>
 #include <sphshell/contact/triangle_surface.hpp>

@@ -43,17 +43,27 @@
 // sums and the spring's trapezoidal sums differ only by their end term, the
 // second half above.
 
+#include <sphshell/contact/cylinder.hpp>
 #include <sphshell/contact/penalty.hpp>
+#include <sphshell/contact/plane.hpp>
 #include <sphshell/contact/rigid_body.hpp>
+#include <sphshell/contact/sphere.hpp>
+#include <sphshell/contact/surface_mesh.hpp>
+#include <sphshell/contact/triangle_surface.hpp>
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/types.hpp>
+#include <sphshell/io/binary_stream.hpp>
 
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <iomanip>
 #include <memory>
 #include <string>
+#include <type_traits>
+#include <typeinfo>
 #include <utility>
 #include <vector>
 
@@ -84,7 +94,40 @@ struct ContactEnergy {
   double body_work = 0.0;              // W_b, summed over the steps
 };
 
+// What a checkpoint checks a body against (the body added before loading
+// must be the one saved): its shape's kind, its motion's kind and, for a free
+// body, its mass (0 for the others).
+struct RigidBodyDescription {
+  std::string shape;
+  std::string motion;
+  double mass = 0.0;
+};
+
 namespace detail {
+
+template <class Shape>
+std::string shape_kind() {
+  if constexpr (std::is_same_v<Shape, Sphere>)
+    return "sphere";
+  else if constexpr (std::is_same_v<Shape, Cylinder>)
+    return "cylinder";
+  else if constexpr (std::is_same_v<Shape, Plane>)
+    return "plane";
+  else if constexpr (std::is_same_v<Shape, TriangleSurface>)
+    return "triangle surface";
+  else
+    return std::string("shape ") + typeid(Shape).name();
+}
+
+template <class Motion>
+std::string motion_kind() {
+  if constexpr (Motion::free)
+    return "free";
+  else if constexpr (std::is_same_v<Motion, Fixed>)
+    return "fixed";
+  else
+    return "prescribed";
+}
 
 // One body with its contact; the solver's interface to it.
 class BodyContact {
@@ -100,6 +143,12 @@ class BodyContact {
   virtual ContactStepResult finish_step(const StepTime& at, double time_step, double velocity_step,
                                         double& body_work, double& contact_second_half) = 0;
   virtual RigidBodyState state() const = 0;
+  // The body's surface where it is now, for the frames (surface_mesh.hpp).
+  virtual SurfaceMesh surface(const ModelExtent& model, const SurfaceMeshResolution& resolution) const = 0;
+  // Checkpoints (RigidBodySet::save): what the body is, and its state.
+  virtual RigidBodyDescription description() const = 0;
+  virtual void save(io::BinaryWriter& out) const = 0;
+  virtual void load(io::BinaryReader& in) = 0;
   const ParticleContactLoads& loads() const { return loads_; }
 
  protected:
@@ -157,6 +206,30 @@ class BodyContactOf final : public BodyContact {
     state.contacts = contacts_;
     state.kinetic_energy = kinetic_energy();
     return state;
+  }
+
+  SurfaceMesh surface(const ModelExtent& model, const SurfaceMeshResolution& resolution) const override {
+    return place_surface_mesh(body_, model, resolution);
+  }
+
+  RigidBodyDescription description() const override {
+    RigidBodyDescription description{shape_kind<Shape>(), motion_kind<Motion>(), 0.0};
+    if constexpr (Motion::free) description.mass = body_.motion().mass();
+    return description;
+  }
+  // The body's state, its contact history and the particles it touched in
+  // the last step; the chunk slots are rewritten by every step before use.
+  void save(io::BinaryWriter& out) const override {
+    body_.save(out);
+    contact_.save(out);
+    out(static_cast<std::uint64_t>(contacts_));
+  }
+  void load(io::BinaryReader& in) override {
+    body_.load(in);
+    contact_.load(in);
+    std::uint64_t contacts = 0;
+    in(contacts);
+    contacts_ = static_cast<std::size_t>(contacts);
   }
 
   // ½ m |v|² + ½ Σ I_k ω_k² (body frame); a body that is not free has no mass here.
@@ -284,9 +357,68 @@ class RigidBodySet {
 
   const ContactEnergy& energy() const { return energy_; }
 
+  // Checkpoints (solver/checkpoint_io.hpp). First what the bodies are, which
+  // a loading solver checks before it changes anything: the count, then each
+  // body's description, in the order added.
+  void save_descriptions(io::BinaryWriter& out) const {
+    out.write_size(bodies_.size());
+    for (const auto& body : bodies_) {
+      const RigidBodyDescription d = body->description();
+      out(d.shape, d.motion, d.mass);
+    }
+  }
+  // An Error naming the checkpoint and the first difference, if its bodies
+  // are not this run's.
+  void check_descriptions(io::BinaryReader& in, const std::string& path) const {
+    const std::string lead = "sphshell: checkpoint '" + path + "' ";
+    const std::string fix = ": add the checkpoint's bodies, in the order it had them, before loading it";
+    std::uint64_t count = 0;
+    in(count);
+    if (count != bodies_.size())
+      throw Error(lead + "has " + std::to_string(count) + " rigid bodies and this solver " +
+                  std::to_string(bodies_.size()) + fix);
+    for (std::size_t id = 0; id < bodies_.size(); ++id) {
+      RigidBodyDescription file;
+      in(file.shape, file.motion, file.mass);
+      const RigidBodyDescription here = bodies_[id]->description();
+      const std::string body = "rigid body " + std::to_string(id);
+      if (file.shape != here.shape || file.motion != here.motion)
+        throw Error(lead + "has a " + file.motion + " " + file.shape + " as " + body + " and this solver a " +
+                    here.motion + " " + here.shape + fix);
+      if (std::memcmp(&file.mass, &here.mass, sizeof(double)) != 0)
+        throw Error(lead + "has " + body + " of mass " + std::to_string(file.mass) + " kg and this solver of " +
+                    std::to_string(here.mass) + " kg" + fix);
+    }
+  }
+  // Then their state: every body's, and the energy terms of bodies and contact.
+  void save(io::BinaryWriter& out) const {
+    for (const auto& body : bodies_) body->save(out);
+    out(energy_.body_kinetic, energy_.spring, energy_.friction_dissipation, energy_.shell_contact_work,
+        energy_.body_work);
+  }
+  void load(io::BinaryReader& in) {
+    for (auto& body : bodies_) body->load(in);
+    in(energy_.body_kinetic, energy_.spring, energy_.friction_dissipation, energy_.shell_contact_work,
+       energy_.body_work);
+  }
+
   RigidBodyState state(RigidBodyId id) const {
     check(id);
     return bodies_[id]->state();
+  }
+
+  // Body `id`'s surface where it is now (world frame): a plane's patch sized
+  // to the model, whose extent is that of `positions` (the shell's particles).
+  SurfaceMesh surface(RigidBodyId id, const std::vector<Vector3>& positions,
+                      const SurfaceMeshResolution& resolution = {}) const {
+    check(id);
+    ModelExtent model;
+    if (!positions.empty()) model.lower = model.upper = positions.front();
+    for (const Vector3& x : positions) {
+      model.lower = model.lower.cwiseMin(x);
+      model.upper = model.upper.cwiseMax(x);
+    }
+    return bodies_[id]->surface(model, resolution);
   }
 
   // CSV time history of one body: written now and after every step.

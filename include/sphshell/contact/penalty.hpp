@@ -115,6 +115,18 @@ class PenaltyContact {
 
   const PenaltyOptions& options() const { return options_; }
 
+  // Checkpoints: the contact history (every particle's tangential spring
+  // force and last contact force), sized to the particle count by prepare().
+  template <class Writer>
+  void save(Writer& out) const {
+    out(tangential_force_, previous_force_);
+  }
+  template <class Reader>
+  void load(Reader& in) {
+    in.read_exact(tangential_force_, "rigid body contact history (tangential forces)");
+    in.read_exact(previous_force_, "rigid body contact history (last contact forces)");
+  }
+
   // The contact of every particle with the body at configuration n: prepare,
   // then compute_range over all particles.
   template <class Shape, class Motion>

@@ -197,6 +197,23 @@ class RigidBody {
     motion_.advance(kinematics_, contact_force_, contact_moment_, at, time_step, rotates);
   }
 
+  // Checkpoints (solver/checkpoint.hpp): where the body is, how it moves
+  // and the contact load and impulse it received. Shape and motion are the
+  // program's set-up, given again when the body is added before loading.
+  template <class Writer>
+  void save(Writer& out) const {
+    const Eigen::Vector4d orientation = kinematics_.orientation.coeffs();
+    out(kinematics_.position, orientation, kinematics_.velocity, kinematics_.angular_velocity, contact_force_,
+        contact_moment_, contact_impulse_);
+  }
+  template <class Reader>
+  void load(Reader& in) {
+    Eigen::Vector4d orientation;
+    in(kinematics_.position, orientation, kinematics_.velocity, kinematics_.angular_velocity, contact_force_,
+       contact_moment_, contact_impulse_);
+    kinematics_.orientation.coeffs() = orientation;
+  }
+
   const Shape& shape() const { return shape_; }
   const Motion& motion() const { return motion_; }
   const RigidKinematics& kinematics() const { return kinematics_; }

@@ -75,7 +75,9 @@ class FrameSeries {
 
   // A frame file of series k (its path as path() gives it) listed at `time`;
   // write() then rewrites the collections together.
-  void stage(std::size_t series, double time, const std::string& file) { collections_[series]->stage(time, file); }
+  void stage(std::size_t series, double time, const std::string& file, int part = 0) {
+    collections_[series]->stage(time, file, part);
+  }
   void write() const {
     std::vector<const PvdCollection*> collections;
     for (const auto& collection : collections_) collections.push_back(collection.get());
@@ -150,11 +152,16 @@ class FrameSeries {
 // pieces (every process its own: serially "<series>_N.vtu", distributed the
 // piece "<series>_N_rR.vtu" and, by the first process, a .pvtu naming the
 // pieces) or whole (written by the first process as "<series>_N.vtu").
+// A dataset may instead be listed in another series' collection
+// (`listed_in`) as part `part` of the frame's time, so that one collection
+// opens both (a ParaView multiblock); its files keep their own series name.
 struct FrameDataset {
   enum class Drawn { in_pieces, whole };
   std::string series;
   VtuGrid grid;
   Drawn drawn = Drawn::in_pieces;
+  std::string listed_in = {};  // empty: its own collection, "<series>.pvd"
+  int part = 0;
 };
 
 // The frames of a run in one output folder, written by the processes of a
@@ -200,7 +207,7 @@ class FrameSeriesWriter {
           for (int r = 0; r < group.size(); ++r) pieces.push_back(group.piece_file_of(frame, r));
           write_pvtu(listed, dataset.grid, pieces, format_.precision);
         }
-        series_->stage(k, time, listed);
+        series_->stage(collection_of(datasets, k), time, listed, dataset.part);
       }
       series_->write();
     });
@@ -229,9 +236,24 @@ class FrameSeriesWriter {
 
  private:
   std::string path(const std::string& name) const { return directory_ + "/" + name; }
+  // The collections are those of the datasets listed in their own, in order.
+  static std::vector<std::string> collection_names(const std::vector<FrameDataset>& datasets) {
+    std::vector<std::string> names;
+    for (const FrameDataset& dataset : datasets)
+      if (dataset.listed_in.empty()) names.push_back(dataset.series);
+    return names;
+  }
+  static std::size_t collection_of(const std::vector<FrameDataset>& datasets, std::size_t k) {
+    const std::vector<std::string> names = collection_names(datasets);
+    const std::string& listed = datasets[k].listed_in.empty() ? datasets[k].series : datasets[k].listed_in;
+    const auto found = std::find(names.begin(), names.end(), listed);
+    if (found == names.end())
+      throw Error("sphshell: frame dataset '" + datasets[k].series + "' is listed in series '" + listed +
+                  "', which this frame does not write");
+    return static_cast<std::size_t>(found - names.begin());
+  }
   void start(const std::vector<FrameDataset>& datasets, const std::vector<std::string>& known) {
-    std::vector<std::string> names, dropped;
-    for (const FrameDataset& dataset : datasets) names.push_back(dataset.series);
+    std::vector<std::string> names = collection_names(datasets), dropped;
     for (const std::string& name : known)
       if (std::find(names.begin(), names.end(), name) == names.end()) dropped.push_back(name);
     series_.emplace(directory_, names, notes_);

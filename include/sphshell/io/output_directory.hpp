@@ -39,8 +39,9 @@ inline std::string identity_of(const std::string& path) {
   return (error ? absolute.lexically_normal() : canonical).string();
 }
 
-// A frame file of this library's series: particles, stress_points or
-// cracks, then "_<number>.vtu", a distributed run's piece
+// A frame file of this library's series: particles, stress_points,
+// cracks or bodies (the rigid bodies' surfaces, part 1 of particles.pvd,
+// so no collection of their own), then "_<number>.vtu", a distributed run's piece
 // "_<number>_r<rank>.vtu" and parallel file "_<number>.pvtu", or ".pvd",
 // each optionally ".tmp" (a write cut short by a kill). The frame's number
 // (its digits), "" for a collection; nothing for a file of no series.
@@ -52,10 +53,13 @@ inline std::optional<std::string> frame_file_digits(std::string name) {
     return !text.empty() && std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
   };
   if (ends_with(name, ".tmp")) name.resize(name.size() - 4);
-  for (const std::string series : {"particles", "stress_points", "cracks"}) {
+  for (const std::string series : {"particles", "stress_points", "cracks", "bodies"}) {
     if (name.compare(0, series.size(), series) != 0) continue;
     const std::string rest = name.substr(series.size());
-    if (rest == ".pvd") return std::string();
+    if (rest == ".pvd") {
+      if (series == "bodies") return std::nullopt;
+      return std::string();
+    }
     for (const std::string extension : {".vtu", ".pvtu"}) {
       if (rest.empty() || rest[0] != '_' || !ends_with(rest, extension)) continue;
       std::string number = rest.substr(1, rest.size() - 1 - extension.size());

@@ -14,13 +14,15 @@
 //   payload  sections, each a four-letter tag, its size (u64) and its data:
 //            IDNT what the run is (counts, model fingerprints, material
 //                 constants, the options that change results, Δt),
+//            BDID the rigid bodies: count, each one's shape, motion and mass,
 //            TIME t0, step n, Δt, t, whether the forces are current, the step latch,
 //            PART particle state, FORC particle forces,
 //            PNTS the shape-function rows cracks rebuilt,
 //            SECT every integration point's section state, strains,
 //                 resultants and active flag,
 //            FRAC crack topology, fragments, fracture counters,
-//            ENRG energy ledger, STEP the stepper's own state (if any),
+//            ENRG energy ledger, BODY the rigid bodies' state and contact
+//                 history, their energy terms, STEP the stepper's own state (if any),
 //            OUTP output and probe schedules, frame series, probe files.
 // Each part of the solver (include/sphshell/solver/) writes and reads its own
 // section through save(Writer&) const / load(Reader&) members, so the parts
@@ -69,8 +71,8 @@ inline constexpr char magic[8] = {'S', 'P', 'H', 'S', 'H', 'C', 'K', 'P'};
 // of another version is refused (no silent reinterpretation). Version 2: the
 // identity lists transverse_shear and director_hourglass among the options
 // that change results (version 1 did not, so a restart with either changed
-// went on with other physics).
-inline constexpr std::uint32_t format_version = 2;
+// went on with other physics). Version 3: the rigid bodies (BDID, BODY).
+inline constexpr std::uint32_t format_version = 3;
 
 inline std::string library_version() {
 #ifdef SPHSHELL_VERSION_STRING

@@ -40,13 +40,10 @@ class CheckpointIO {
     using Stepper = typename Solver::stepper_type;
     const std::uint64_t stamp = s.domain_.save_stamp();
     s.domain_.collectively([&] {
-      // The bodies' state and contact history are not in the file format.
-      if (s.rigid_body_count() > 0)
-        sphshell::detail::invalid_parameter("checkpoint of a run with rigid bodies", s.rigid_body_count(),
-                                  "bodies cannot be checkpointed yet: save a run without rigid bodies");
       using checkpoint::write_section;
       io::BinaryWriter out;
       write_section(out, "IDNT", [&] { out(identity()); });
+      write_section(out, "BDID", [&] { s.bodies_.save_descriptions(out); });
       write_section(out, "TIME", [&] {
         if constexpr (distributed) out(stamp);
         out(s.start_time_, static_cast<std::int64_t>(s.steps_), s.time_step_, s.time_, s.forces_current_, s.latch_.message());
@@ -63,6 +60,7 @@ class CheckpointIO {
       write_section(out, "SECT", [&] { s.states_->save(out); });
       write_section(out, "FRAC", [&] { s.fracture_.save(out); });
       write_section(out, "ENRG", [&] { s.ledger_->save(out); });
+      write_section(out, "BODY", [&] { s.bodies_.save(out); });
       out.begin_section("STEP");
       if constexpr (!std::is_empty_v<Stepper>) {
         static_assert(checkpoint::has_save_load<Stepper>::value,
@@ -84,7 +82,10 @@ class CheckpointIO {
   // as this solver has them; pre-cracks come from the checkpoint (do not add
   // them again). Probes already added continue their files from the
   // checkpoint's rows; probes added later do too, when their file is one the
-  // checkpoint recorded. An Error after the file was accepted leaves the
+  // checkpoint recorded. Rigid bodies are added again, as the saving run had
+  // them, before loading (the checkpoint holds their state, not their shape
+  // or motion; an Error names a body count, kind or mass that differs); a
+  // body probe starts a file of its own. An Error after the file was accepted leaves the
   // solver stopped (step() refuses).
   void load_checkpoint(const std::string& path) {
     Solver& s = self();
@@ -95,6 +96,8 @@ class CheckpointIO {
       checkpoint::Identity file;
       checkpoint::read_section(*reader, "IDNT", [&] { (*reader)(file); });
       checkpoint::check_identity(file, identity(), file_path);
+      // The rigid bodies, added again by the program, must be the checkpoint's.
+      checkpoint::read_section(*reader, "BDID", [&] { s.bodies_.check_descriptions(*reader, file_path); });
     });
     try {
       std::uint64_t stamp = 0;
@@ -184,6 +187,7 @@ class CheckpointIO {
     read_section(in, "SECT", [&] { s.states_->load(in); });
     read_section(in, "FRAC", [&] { s.fracture_.load(in); });
     read_section(in, "ENRG", [&] { s.ledger_->load(in); });
+    read_section(in, "BODY", [&] { s.bodies_.load(in); });
     read_section(in, "STEP", [&] { if constexpr (!std::is_empty_v<Stepper>) s.stepper_.load(in); });
     read_section(in, "OUTP", [&] { s.output_->load(in, s); });
     if (!in.at_end()) in.fail("there are bytes after its last section");

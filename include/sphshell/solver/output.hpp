@@ -34,6 +34,7 @@
 #include <sphshell/io/directory_lock.hpp>
 #include <sphshell/io/frame_series.hpp>
 #include <sphshell/io/output_directory.hpp>
+#include <sphshell/io/rigid_body_surfaces.hpp>
 #include <sphshell/solver/frame_piece.hpp>
 #include <sphshell/solver/integration_points.hpp>
 #include <sphshell/solver/options.hpp>
@@ -204,6 +205,9 @@ class SolverOutput {
     datasets.push_back({series_names[1], piece.stress_point_grid(), Drawn::in_pieces});
     if constexpr (Solver::crack_type::enabled)
       datasets.push_back({series_names[2], piece.crack_grid(), Drawn::whole});  // collective
+    if (!solver.bodies_.empty())  // the rigid bodies' surfaces, listed in the particle series as its part 1
+      datasets.push_back({body_series, io::rigid_body_grid(solver.bodies_, solver.particles_.position, solver.time()),
+                          Drawn::whole, series_names[0], 1});
     frames_.write(solver.domain_, solver.time(), datasets, {series_names.begin(), series_names.end()});
     last_frame_step_ = solver.steps();
   }
@@ -217,6 +221,9 @@ class SolverOutput {
   // The series a run can write, in the order a checkpoint stores them, and
   // those a Solver's frames have (write_frame's datasets).
   static constexpr std::array<const char*, 3> series_names{"particles", "stress_points", "cracks"};
+  // The rigid bodies' frames: files of their own, listed in the particle
+  // series' collection (so ParaView opens shell and bodies together).
+  static constexpr const char* body_series = "bodies";
   template <class Solver>
   static std::vector<std::string> series_of() {
     return {series_names.begin(), series_names.begin() + (Solver::crack_type::enabled ? 3 : 2)};
