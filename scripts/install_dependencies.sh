@@ -6,11 +6,12 @@
 # frames with VTK's own reader (skipped without it; about 52 MB to download,
 # 250 MB installed). libopenmpi-dev (with openmpi-bin's mpirun) is for the
 # optional MPI layer sphshell::mpi and its tests on 1, 2 and 3 ranks (tests/mpi/).
+# ninja-build lets the test command keep every core busy across the build.
 # SPHSHELL_DOCS=1 also installs doxygen for the API reference and its test
 # (optional: with its LLVM/Clang libraries about 220 MB on a fresh system; the
 # test is skipped without it).
 set -euo pipefail
-packages=(g++ make cmake libeigen3-dev catch2 libbenchmark-dev pkg-config zlib1g-dev python3-vtk9 libopenmpi-dev openmpi-bin)
+packages=(g++ make cmake libeigen3-dev catch2 libbenchmark-dev pkg-config zlib1g-dev python3-vtk9 libopenmpi-dev openmpi-bin ninja-build)
 if [ "${SPHSHELL_DOCS:-0}" = 1 ]; then packages+=(doxygen); fi
 missing=()
 for package in "${packages[@]}"; do
