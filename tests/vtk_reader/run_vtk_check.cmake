@@ -1,10 +1,12 @@
-# Runs an example that writes ParaView frames of a fracture run, then reads
-# them with VTK's own reader (tests/vtk_reader/check_frames.py). The first
-# interpreter of CANDIDATES that can `import vtk` is used (ParaView's pvpython,
-# Debian's python3 with python3-vtk9, ...); with none the test prints
-# "SKIP: no Python with VTK" and ctest counts it as skipped.
-#   cmake -DEXAMPLE=<square_plate> -DWORK_DIR=<dir> -DSCRIPT=<check_frames.py>
-#         -DCANDIDATES="a;b" -DENCODING=zlib|binary -P run_vtk_check.cmake
+# Runs an example that writes ParaView frames, then reads them with VTK's own
+# reader: a fracture run (CASE fracture, the default: square_plate and
+# check_frames.py) or a rigid-body impact (CASE impact: mass_impact and
+# check_body_frames.py). The first interpreter of CANDIDATES that can
+# `import vtk` is used (ParaView's pvpython, Debian's python3 with
+# python3-vtk9, ...); with none the test prints "SKIP: no Python with VTK" and
+# ctest counts it as skipped.
+#   cmake -DEXAMPLE=<example> -DWORK_DIR=<dir> -DSCRIPT=<check script>
+#         -DCANDIDATES="a;b" -DENCODING=zlib|binary [-DCASE=impact] -P run_vtk_check.cmake
 cmake_minimum_required(VERSION 3.16)
 set(python "")
 foreach(candidate IN LISTS CANDIDATES)
@@ -25,6 +27,26 @@ message(STATUS "VTK reader: ${python}")
 
 file(REMOVE_RECURSE "${WORK_DIR}")
 file(MAKE_DIRECTORY "${WORK_DIR}")
+if(CASE STREQUAL "impact")
+  # A coarse plate and 1 ms: the striker is on the plate from the second frame on.
+  set(side 0.2)
+  set(thickness 0.002)
+  set(radius 0.0125)
+  execute_process(COMMAND "${EXAMPLE}" --n 15 --end-time 1e-3 --side ${side} --thickness ${thickness}
+                          --striker-radius ${radius} --output frames --frames
+                  WORKING_DIRECTORY "${WORK_DIR}" RESULT_VARIABLE result
+                  OUTPUT_FILE "${WORK_DIR}/stdout.txt" ERROR_VARIABLE errors)
+  if(NOT result EQUAL 0)
+    message(FATAL_ERROR "${EXAMPLE} failed (${result}): ${errors}")
+  endif()
+  execute_process(COMMAND "${python}" "${SCRIPT}" "${WORK_DIR}/frames" "${WORK_DIR}/frames/history.csv"
+                          ${side} ${thickness} ${radius}
+                  RESULT_VARIABLE result)
+  if(NOT result EQUAL 0)
+    message(FATAL_ERROR "VTK's reader found problems in the body frames (above)")
+  endif()
+  return()
+endif()
 set(end_time 1.5e-3)
 set(n 21)
 math(EXPR stress_points "(${n} - 1) * (${n} - 1)")
