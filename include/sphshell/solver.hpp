@@ -284,7 +284,8 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
   // rest with its forces and energy books restarted there (the exception's
   // result() describes it); any other Error (a free rigid-body mode, bad
   // parameters, a singular tangent) leaves the solver as it was before the
-  // call. A distributed run has none yet: an Error on every process.
+  // call. A distributed run relaxes (StaticMass::particle_bound), to the
+  // bit as one process does; StaticMass::tangent is one process's only.
   template <class Observer>
   solver::StaticResult solve_static(const solver::StaticParameters& parameters, Observer&& observer) {
     latch_.check();

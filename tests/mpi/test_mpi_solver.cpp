@@ -24,6 +24,7 @@
 #include <filesystem>
 #include <functional>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -523,4 +524,92 @@ TEST_CASE("Distributed stress queries and run observer: the serial Solver's valu
   CHECK_THROWS_WITH(distributed.membrane_force(static_cast<int>(model.stress_point_count())),
                     Catch::Contains("stress point index"));
   CHECK_THROWS_WITH(distributed.equivalent_stress(0, 3), Catch::Contains("thickness output point"));
+}
+
+TEST_CASE("Distributed static solution by dynamic relaxation: bitwise the serial Solver, Mindlin's deflection",
+          "[mpi][solver][static]") {
+  const mpi::Communicator comm;
+  SolverOptions options;
+  options.density = 7850.0;
+  const ShellModel model = plate();
+  const double q = 1e4, L = 0.5, d = 0.01;
+  const double D = steel_E * d * d * d / (12.0 * (1.0 - steel_nu * steel_nu));
+  const int centre = model.set("centre")[0];
+  solver::StaticParameters parameters;
+  parameters.progress_interval = 0;
+  SECTION("elastic, one load step") {
+    Serial<material::Elastic> serial(model, {steel_E, steel_nu}, options);
+    Distributed<material::Elastic> distributed(comm, model, {steel_E, steel_nu}, options);
+    clamped_pressure(serial, q);
+    clamped_pressure(distributed, q);
+    const solver::StaticResult s = serial.solve_static(parameters);
+    long observed = 0;
+    const solver::StaticResult r =
+        distributed.solve_static(parameters, [&](const solver::StaticIteration&) { ++observed; });
+    CHECK(r.iterations == s.iterations);
+    CHECK(observed == r.iterations + 1);  // the start of the load step, then each relaxation step
+    CHECK(std::memcmp(&r.residual, &s.residual, sizeof(double)) == 0);
+    CHECK(mpi_test::differing_components(distributed.positions(), serial.positions()) == 0);
+    CHECK(mpi_test::differing_components(distributed.directors(), serial.directors()) == 0);
+    // Clamped square plate, L/d = 50 (Mindlin: w D/(q L^4) = 0.0012754), within the 21 x 21 discretisation error.
+    const double coefficient = -serial.displacement(centre).z() * D / (q * L * L * L * L);
+    CHECK(coefficient == Approx(0.0012754).epsilon(0.04));
+    // At rest in equilibrium on every rank, the books restarted there.
+    CHECK(distributed.energy().kinetic == 0.0);
+    CHECK(relative(distributed.energy().elastic, serial.energy().elastic) < 1e-12);
+  }
+  SECTION("J2 plasticity, two load steps (a path)") {
+    const material::J2Plasticity::Parameters law{steel_E, steel_nu, steel_yield, steel_Ep};
+    Serial<material::J2Plasticity> serial(model, law, options);
+    Distributed<material::J2Plasticity> distributed(comm, model, law, options);
+    clamped_pressure(serial, 2.5e6);
+    clamped_pressure(distributed, 2.5e6);
+    parameters.load_factors = {0.5, 1.0};
+    const solver::StaticResult s = serial.solve_static(parameters);
+    const solver::StaticResult r = distributed.solve_static(parameters);
+    CHECK(r.iterations == s.iterations);
+    CHECK(mpi_test::differing_components(distributed.positions(), serial.positions()) == 0);
+    CHECK(mpi_test::differing_components(distributed.directors(), serial.directors()) == 0);
+    double largest = 0.0;
+    for (std::size_t p = 0; p < model.stress_point_count(); ++p)
+      largest = std::max(largest, serial.equivalent_plastic_strain(static_cast<int>(p), 0));
+    CHECK(largest > 0.0);  // the path is plastic: an elastic answer would prove nothing
+  }
+}
+
+TEST_CASE("Distributed static solution: Errors on every rank, the solver left as it was", "[mpi][solver][static]") {
+  const mpi::Communicator comm;
+  SolverOptions options;
+  options.density = 7850.0;
+  const ShellModel model = plate();
+  auto message_of = [](auto&& body) {
+    try {
+      body();
+    } catch (const Error& error) {
+      return std::string(error.what());
+    }
+    return std::string();
+  };
+  Distributed<material::Elastic> distributed(comm, model, {steel_E, steel_nu}, options);
+  distributed.add_uniform_pressure(model.all_particles(), 1e4);
+  // No supports: the free rigid-body modes are found on the whole model.
+  CHECK(message_of([&] { distributed.solve_static(); }).find("free rigid-body mode") != std::string::npos);
+  distributed.clamp("boundary");
+  solver::StaticParameters newton;
+  newton.mass = solver::StaticMass::tangent;
+  CHECK(message_of([&] { distributed.solve_static(newton); }).find("StaticMass::particle_bound") != std::string::npos);
+  // A load function that throws on the last rank only ends the solve on every rank with its message.
+  const int last = comm.size() - 1;
+  Distributed<material::Elastic> throwing(comm, model, {steel_E, steel_nu}, options);
+  throwing.clamp("boundary");
+  throwing.add_pressure(model.all_particles(), [&](const Vector3&, double) -> double {
+    if (comm.rank() == last) throw std::runtime_error("pressure table ends here");
+    return 1e4;
+  });
+  CHECK(message_of([&] { throwing.solve_static(); }).find("pressure table ends here") != std::string::npos);
+  // Left as it was: at rest in the reference configuration.
+  double largest = 0.0;
+  for (std::size_t i = 0; i < model.particle_count(); ++i)
+    largest = std::max(largest, throwing.displacement(static_cast<int>(i)).norm());
+  CHECK(largest == 0.0);
 }

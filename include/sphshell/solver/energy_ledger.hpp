@@ -304,15 +304,19 @@ class EnergyBooks : public EnergyLedger {
     }
   }
 
-  // After a static solve (solver/static_solution.hpp, one process): the
-  // shell at rest holding `elastic`, booked as work the loads did, so the
-  // balance of a run that follows starts at zero.
-  void restart_at_rest(double elastic) {
-    static_assert(!distributed, "restart_at_rest: one process only");
-    previous_internal_ = internal_ = elastic;
-    external_work_ = elastic;
-    damping_work_ = 0.0;
-    kinetic_ = 0.0;
+  // After a static solve (solver/static_solution.hpp): the shell at rest
+  // holding `elastic` (the total over the processes), booked as work the
+  // loads did, so the balance of a run that follows starts at zero.
+  // Distributed, process 0's books hold the totals, the others' nothing.
+  void restart_at_rest(const Domain& domain, double elastic) {
+    Sum held{}, zero{};
+    if constexpr (distributed) {
+      if (domain.is_root()) held.add(elastic);
+    } else {
+      held = elastic;
+    }
+    previous_internal_ = internal_ = external_work_ = held;
+    damping_work_ = kinetic_ = zero;
   }
 
   // The books (over all processes: collective), with the elastic energy now

@@ -15,7 +15,6 @@
 namespace sphshell::solver {
 
 using statics::automatic_relaxation_steps;
-using statics::is_path_independent_v;
 using statics::StaticDamping;
 using statics::StaticIteration;
 using statics::StaticMass;
@@ -28,65 +27,56 @@ using statics::validate;
 
 // The static solve of a Solver (a friend of it): the loads at the load time
 // scaled by the load factor, the internal forces at the quasi-static limit,
-// the material states kept at the last converged point for laws whose state
-// depends on the path; afterwards the solver at rest at the result, or as it
-// was before the call when the solve fails other than by its budget.
+// the material states kept at the last converged point; afterwards the
+// solver at rest at the result, or as it was before the call when the solve
+// fails other than by its budget.
 template <class Solver>
 class StaticSolution {
  public:
   template <class Observer>
   static StaticResult solve(Solver& s, const StaticParameters& parameters, Observer& observer) {
-    if constexpr (Solver::distributed) {
-      s.domain_.collectively([&] {
-        throw Error("sphshell: solve_static: a distributed run has no static solver yet: neither the tangent "
-                    "(StaticMass::tangent, Newton steps) nor the dynamic relaxation (StaticMass::particle_bound) "
-                    "runs over a domain's processes; solve on one process and load its state, or run the "
-                    "dynamics to rest with damping");
-      });
-      return {};
-    } else {
-      using Material = typename Solver::material_type;
+    s.domain_.collectively([&] {
       validate(parameters);
-      const double load_time = std::isnan(parameters.load_time) ? s.time_ : parameters.load_time;
-      const auto start = s.particles_;
-      const auto start_states = *s.states_;
-      auto converged = *s.states_;
-      auto evaluate = [&](double load_factor) {
-        s.apply_loads_now({s.steps_, load_time});
-        for (std::size_t i = 0; i < s.particles_.size(); ++i) {
-          s.forces_.external[i] *= load_factor;
-          s.forces_.external_moment[i] *= load_factor;
-        }
-        // Equilibrium is quasi-static: no strain rate (rate-dependent laws at their static limit).
-        s.assembler_->set_time_step(std::numeric_limits<double>::infinity());
-        s.assembler_->compute(s.now(), s.particles_, *s.points_, *s.states_, s.forces_);
-      };
-      auto save = [&] {
-        if constexpr (!is_path_independent_v<Material>) converged = *s.states_;
-      };
-      auto restore = [&] {
-        if constexpr (!is_path_independent_v<Material>) *s.states_ = converged;
-      };
-      StaticSystem<typename Solver::approximation_type, decltype(evaluate), decltype(save), decltype(restore)> system{
-          s.model_, s.particles_, s.forces_, s.constraints_, *s.points_, evaluate, save, restore,
-          s.options_.progress_stream};
-      try {
-        const StaticResult result = solve_static(system, parameters, observer);
-        s.forces_current_ = true;
-        s.ledger_->restart_at_rest(s.energy().elastic);
-        return result;
-      } catch (const StaticNotConverged&) {
-        // The solve left the failed load step's best state with its material
-        // state and internal forces; the books restart at rest there.
-        s.forces_current_ = true;
-        s.ledger_->restart_at_rest(s.energy().elastic);
-        throw;
-      } catch (...) {
-        s.particles_ = start;
-        *s.states_ = start_states;
-        s.compute_internal_forces();
-        throw;
+      if (Solver::distributed && parameters.mass == StaticMass::tangent)
+        throw Error("sphshell: solve_static: StaticMass::tangent (Newton steps on the assembled tangent) runs on "
+                    "one process only; a distributed run relaxes: StaticMass::particle_bound (the default)");
+    });
+    const double load_time = std::isnan(parameters.load_time) ? s.time_ : parameters.load_time;
+    const auto start = s.particles_;
+    const auto start_states = *s.states_;
+    auto converged = *s.states_;
+    auto evaluate = [&](double load_factor) {
+      s.apply_loads_now({s.steps_, load_time});
+      for (std::size_t i = 0; i < s.particles_.size(); ++i) {
+        s.forces_.external[i] *= load_factor;
+        s.forces_.external_moment[i] *= load_factor;
       }
+      // Equilibrium is quasi-static: no strain rate (rate-dependent laws at their static limit).
+      s.assembler_->set_time_step(std::numeric_limits<double>::infinity());
+      s.assembler_->compute(s.now(), s.particles_, *s.points_, *s.states_, s.forces_);
+    };
+    auto save = [&] { converged = *s.states_; };
+    auto restore = [&] { *s.states_ = converged; };
+    StaticSystem<typename Solver::domain_type, typename Solver::approximation_type, decltype(evaluate),
+                 decltype(save), decltype(restore)>
+        system{s.domain_,   s.model_, s.particles_, s.forces_, s.constraints_, *s.points_,
+               evaluate,    save,     restore,      s.options_.progress_stream};
+    try {
+      const StaticResult result = solve_static(system, parameters, observer);
+      s.forces_current_ = true;
+      s.ledger_->restart_at_rest(s.domain_, s.energy().elastic);
+      return result;
+    } catch (const StaticNotConverged&) {
+      // The solve left the failed load step's best state with its material
+      // state and internal forces; the books restart at rest there.
+      s.forces_current_ = true;
+      s.ledger_->restart_at_rest(s.domain_, s.energy().elastic);
+      throw;
+    } catch (...) {
+      s.particles_ = start;
+      *s.states_ = start_states;
+      s.compute_internal_forces();
+      throw;
     }
   }
 };

@@ -26,10 +26,13 @@
 // at the lever arm of the largest particle spacing ℓ. A load step has
 // converged when ‖r‖ ≤ tolerance ‖λ f_ext‖.
 //
-// Path-dependent laws (J2 plasticity, damage): every force evaluation of a
-// load step starts from the material state of the last converged step, so a
-// load step is one increment of the law (backward Euler over the step) and
-// the answer depends on the load stepping as a plastic path does.
+// Every force evaluation of a load step starts from the material state of
+// the last converged step. For path-dependent laws (J2 plasticity, damage) a
+// load step is thus one increment of the law (backward Euler over the step)
+// and the answer depends on the load stepping as a plastic path does; for
+// all laws (the elastic one too updates its stress by increments) the forces
+// of a configuration do not depend on the evaluations before it, so the
+// order in which a share perturbs its particles leaves no trace.
 //
 // Numbering, the same in StaticIteration, StaticResult, the progress lines
 // and every Error: load steps count from 1 (load step k has λ =
@@ -43,13 +46,13 @@
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/frame.hpp>
 #include <sphshell/core/types.hpp>
-#include <sphshell/material/elastic.hpp>
 #include <sphshell/shell/constraints.hpp>
 #include <sphshell/shell/model.hpp>
 #include <sphshell/solver/integration_points.hpp>
 #include <sphshell/solver/particles.hpp>
 #include <sphshell/solver/run_checks.hpp>
 #include <sphshell/statics/coupling.hpp>
+#include <sphshell/statics/static_share.hpp>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Sparse>
@@ -147,13 +150,6 @@ class StaticNotConverged : public Error {
   StaticResult kept_;
 };
 
-// Whether a law's stress follows from the strain alone (no history), so the
-// solve need not bring back the converged material state before each evaluation.
-template <class Law>
-inline constexpr bool is_path_independent_v = false;
-template <>
-inline constexpr bool is_path_independent_v<material::Elastic> = true;
-
 // Checked before anything moves: an Error naming the parameter.
 inline void validate(const StaticParameters& p) {
   if (p.load_factors.empty())
@@ -179,14 +175,17 @@ inline void validate(const StaticParameters& p) {
   if (!std::isnan(p.load_time)) sphshell::detail::require_finite("StaticParameters::load_time", p.load_time);
 }
 
-// What the solve works on, handed by the Solver: the model, its particles and
-// forces, the kinematic conditions, the integration points (whose rows give
-// the coupling), and three actions: evaluate(λ) sets the external loads × λ
-// and recomputes the internal forces of the current configuration;
+// What the solve works on, handed by the Solver: its domain part (the
+// process's share: owned particles, then ghosts; statics/static_share.hpp),
+// the model, the share's particles and forces, the kinematic conditions, the
+// integration points (whose rows give the coupling), and three actions:
+// evaluate(λ) sets the external loads × λ and recomputes the internal forces
+// of the current configuration, ghosts as they are (no exchange);
 // save_material() / restore_material() keep and bring back the material
 // state of the last converged load step (no-ops for a path-independent law).
-template <class Approx, class Evaluate, class SaveMaterial, class RestoreMaterial>
+template <class Domain, class Approx, class Evaluate, class SaveMaterial, class RestoreMaterial>
 struct StaticSystem {
+  Domain& domain;
   const ShellModel& model;
   solver::ParticleState& particles;
   const solver::ParticleForces& forces;
@@ -425,29 +424,48 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
   using SparseMatrix = Eigen::SparseMatrix<double>;
   validate(parameters);
   const ShellModel& model = system.model;
+  auto& domain = system.domain;
   solver::ParticleState& particles = system.particles;
   const solver::ParticleForces& forces = system.forces;
-  for (std::size_t k = 0; k < system.constraints.particles().size(); ++k)
-    if (!system.constraints.at(k).motions.empty())
-      sphshell::detail::invalid_parameter("prescribed motion at particle " + std::to_string(system.constraints.particles()[k]),
-                                "(prescribe_displacement / prescribe_velocity)",
-                                "solve_static takes loads and fixed conditions, not prescribed motions");
-  const std::size_t n = particles.size();
+  domain.collectively([&] {
+    for (std::size_t k = 0; k < system.constraints.particles().size(); ++k)
+      if (!system.constraints.at(k).motions.empty())
+        sphshell::detail::invalid_parameter(
+            "prescribed motion at particle " +
+                std::to_string(domain.global_of(static_cast<std::size_t>(system.constraints.particles()[k]))),
+            "(prescribe_displacement / prescribe_velocity)",
+            "solve_static takes loads and fixed conditions, not prescribed motions");
+  });
+  // The share's particles: the owned ones first, then the ghosts, whose
+  // residual rows are another process's (zero here).
+  const std::size_t n = particles.size(), owned = domain.owned_count();
+  domain.exchange({&particles.position, &particles.director});
   const double lever = model.maximum_spacing();  // ℓ: moments count as forces at this arm
   const double step_translation = parameters.perturbation * lever;
   const double step_rotation = parameters.perturbation;
 
   const Coupling coupling = coloured_coupling(system.points, n);
-  check_rigid_body_modes(connected_parts(coupling.near), particles, make_basis(particles, system.constraints));
+  // The free directions of the share's particles, the ghosts' from their owners (collective).
+  auto free_basis = [&] {
+    Basis b = make_basis(particles, system.constraints);
+    share_basis(domain, b);
+    return b;
+  };
+  if constexpr (std::decay_t<decltype(domain)>::is_distributed) {
+    const auto whole = whole_model(domain, model.particle_count(), coupling.near, particles, free_basis());
+    domain.collectively([&] { check_rigid_body_modes(connected_parts(whole.coupled), whole.particles, whole.basis); });
+  } else {
+    check_rigid_body_modes(connected_parts(coupling.near), particles, free_basis());
+  }
 
   StaticResult result;
   Basis basis;
   Eigen::VectorXd r, external;
   // The reduced residual r and external load (both scaled) of the forces last evaluated.
   auto project = [&]() {
-    r.resize(basis.size);
-    external.resize(basis.size);
-    for (std::size_t i = 0; i < n; ++i) {
+    r.setZero(basis.size);
+    external.setZero(basis.size);
+    for (std::size_t i = 0; i < owned; ++i) {
       const Vector3 f = forces.external[i] - forces.internal[i];
       const Vector3 m = forces.external_moment[i] - particles.director[i].cross(forces.internal_director[i]);
       const int o = basis.offset[i];
@@ -468,6 +486,11 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
     ++result.force_evaluations;
     project();
   };
+  // The same on every process together: a load function or a point that
+  // throws on one stops all (collective).
+  auto residual_everywhere = [&](double lambda) { domain.collectively([&] { residual(lambda); }); };
+  auto norm = [&](const Eigen::VectorXd& v) { return global_norm(domain, v); };
+  auto dot = [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b) { return global_dot(domain, a, b); };
   // Moves the configuration by the reduced increment dq (rotations in rad; the
   // residual's rotation rows are moments / ℓ, so the rotation unknowns are ℓ θ).
   auto move = [&](const Eigen::VectorXd& dq) {
@@ -482,10 +505,14 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
       if (angle > 0.0)
         particles.director[i] = (Eigen::AngleAxisd(angle, theta / angle) * particles.director[i]).normalized();
     }
+    domain.exchange({&particles.position, &particles.director});
   };
-  // The tangent K = −∂r/∂q (statics/coupling.hpp); the configuration is
-  // restored, the forces are those of the last perturbed one.
-  auto tangent = [&](double lambda) {
+  // The tangent K = −∂r/∂q (statics/coupling.hpp), the rows of the owned
+  // particles (a process perturbs its ghosts as their owners do: the forces
+  // of an owned particle are those of its coupled particles alone); the
+  // configuration is restored, the forces are those of the last perturbed
+  // one. Entries below `negligible` of their column's largest are left out.
+  auto tangent = [&](double lambda, double negligible) {
     const std::vector<Vector3> x0 = particles.position, d0 = particles.director;
     const SparseMatrix K = difference_tangent(
         coupling, basis.offset,
@@ -509,7 +536,7 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
           residual(lambda);
           return Eigen::VectorXd(-r);
         },
-        negligible_tangent_entry);
+        negligible);
     particles.position = x0;
     particles.director = d0;
     return K;
@@ -531,9 +558,9 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
   for (int step = 0; step < steps; ++step) {
     const double lambda = parameters.load_factors[static_cast<std::size_t>(step)];
     const int load_step = step + 1;  // the numbering of every message
-    basis = make_basis(particles, system.constraints);
-    residual(lambda);
-    const double load = external.norm();
+    basis = free_basis();
+    residual_everywhere(lambda);
+    const double load = norm(external);
     if (!(load > 0.0))
       sphshell::detail::invalid_parameter("StaticParameters::load_time",
                                 std::isnan(parameters.load_time) ? std::string("(the solver's time)")
@@ -553,7 +580,7 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
         best_position = particles.position;
         best_director = particles.director;
       }
-      if (parameters.progress_interval > 0 && iteration % parameters.progress_interval == 0) {
+      if (domain.is_root() && parameters.progress_interval > 0 && iteration % parameters.progress_interval == 0) {
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
         std::ostringstream line;
         line.precision(4);
@@ -568,8 +595,8 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
     auto fail_budget = [&](const char* method, const char* budget, long value, bool automatic, double last) {
       particles.position = best_position;
       particles.director = best_director;
-      basis = make_basis(particles, system.constraints);
-      residual(lambda);
+      basis = free_basis();
+      residual_everywhere(lambda);
       stop_at_rest();
       StaticResult kept = result;
       kept.residual = best_relative;
@@ -589,7 +616,7 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
                  "load steps, or check the supports and loads";
       throw StaticNotConverged(message.str(), kept);
     };
-    double relative = r.norm() / load;
+    double relative = norm(r) / load;
     report(relative);
     if (parameters.mass == StaticMass::tangent) {
       while (!(relative <= parameters.tolerance)) {
@@ -597,7 +624,7 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
           fail_budget("Newton, StaticMass::tangent", "max_newton_iterations", parameters.max_newton_iterations,
                       false, relative);
         const Eigen::VectorXd r0 = r;
-        const SparseMatrix K = tangent(lambda);
+        const SparseMatrix K = tangent(lambda, negligible_tangent_entry);
         const Eigen::VectorXd dq = newton_step(K, r0, load_step, lambda);
         // Backtracking: the longest of 1, 1/2, 1/4, ... that lowers ‖r‖, else the best tried.
         const std::vector<Vector3> x0 = particles.position, d0 = particles.director;
@@ -608,9 +635,9 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
           particles.director = d0;
           move(scale * dq);
           residual(lambda);
-          const double norm = r.norm();
-          if (norm < best_norm) best_norm = norm, best_scale = scale;
-          lowered = norm < r0.norm();
+          const double tried = r.norm();
+          if (tried < best_norm) best_norm = tried, best_scale = scale;
+          lowered = tried < r0.norm();
         }
         if (!lowered) {
           particles.position = x0;
@@ -621,9 +648,9 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
         ++iteration;
         ++result.iterations;
         // The rotation directions follow the turned directors.
-        basis = make_basis(particles, system.constraints);
+        basis = free_basis();
         project();
-        relative = r.norm() / load;
+        relative = norm(r) / load;
         report(relative);
       }
     } else {
@@ -631,15 +658,25 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
       // pseudo step h = 1: m_a = (h²/2) Σ_b |K_ab|, twice the stability limit
       // h²/4 Σ|K| (Underwood 1983), since the bound of the step's start serves
       // the whole step while the stiffness changes along a nonlinear path.
-      const SparseMatrix K = tangent(lambda);
-      residual(lambda);
-      Eigen::VectorXd mass = Eigen::VectorXd::Zero(basis.size);
-      for (int column = 0; column < K.outerSize(); ++column)
-        for (SparseMatrix::InnerIterator it(K, column); it; ++it) mass[it.row()] += gershgorin_mass_factor * std::abs(it.value());
-      for (int row = 0; row < basis.size; ++row)
-        if (!(mass[row] > 0.0))
-          throw Error("sphshell: static solve: degree of freedom " + std::to_string(row) +
-                      " of the free ones has no stiffness (a mechanism): add supports");
+      // Every entry and each row summed in the global order of the columns,
+      // so that the masses do not depend on the share.
+      SparseMatrix K;
+      domain.collectively([&] { K = tangent(lambda, 0.0); });
+      residual_everywhere(lambda);
+      Eigen::VectorXd mass = Eigen::VectorXd::Ones(basis.size);  // a ghost's row is never used
+      mass.head(basis.offset[owned]).setZero();
+      for (std::size_t p : in_global_order(domain, n))
+        for (int column = basis.offset[p]; column < basis.offset[p + 1]; ++column)
+          for (SparseMatrix::InnerIterator it(K, column); it; ++it)
+            mass[it.row()] += gershgorin_mass_factor * std::abs(it.value());
+      domain.collectively([&] {
+        for (std::size_t i = 0; i < owned; ++i)
+          for (int row = basis.offset[i]; row < basis.offset[i + 1]; ++row)
+            if (!(mass[row] > 0.0))
+              throw Error("sphshell: static solve: free degree of freedom " + std::to_string(row - basis.offset[i]) +
+                          " of particle " + std::to_string(domain.global_of(i)) +
+                          " has no stiffness (a mechanism): add supports");
+      });
       const Eigen::VectorXd r_start = r;
       Eigen::VectorXd velocity = Eigen::VectorXd::Zero(basis.size), moved = Eigen::VectorXd::Zero(basis.size);
       double kinetic_before = 0.0;
@@ -651,19 +688,19 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
           velocity += r.cwiseQuotient(mass);
         } else {
           // Underwood: ω₀² = Δqᵀ K Δq / Δqᵀ M Δq with K Δq ≈ −(r − r_start).
-          const double stiffness = -moved.dot(r - r_start);
-          const double inertia = moved.dot(mass.cwiseProduct(moved));
+          const double stiffness = -dot(moved, r - r_start);
+          const double inertia = dot(moved, mass.cwiseProduct(moved));
           const double omega_squared = inertia > 0.0 ? std::max(0.0, stiffness / inertia) : 0.0;
           const double c = std::min(largest_damping, 2.0 * std::sqrt(omega_squared));
           velocity = ((2.0 - c) * velocity + 2.0 * r.cwiseQuotient(mass)) / (2.0 + c);
         }
         move(velocity);
         moved += velocity;
-        residual(lambda);
+        residual_everywhere(lambda);
         ++iteration;
         ++result.iterations;
         if (parameters.damping == StaticDamping::kinetic) {
-          const double kinetic = 0.5 * velocity.dot(mass.cwiseProduct(velocity));
+          const double kinetic = 0.5 * dot(velocity, mass.cwiseProduct(velocity));
           if (kinetic < kinetic_before) {
             velocity.setZero();
             kinetic_before = 0.0;
@@ -671,7 +708,7 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
             kinetic_before = kinetic;
           }
         }
-        relative = r.norm() / load;
+        relative = norm(r) / load;
         report(relative);
       }
     }
