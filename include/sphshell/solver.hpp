@@ -73,17 +73,9 @@
 
 #include <cmath>
 #include <cstddef>
-#include <cstdint>
-#include <cstring>
-#include <limits>
-#include <array>
-#include <atomic>
 #include <exception>
-#include <memory>
-#include <mutex>
 #include <new>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <type_traits>
 #include <utility>

@@ -37,17 +37,24 @@ std::string file_text(const std::string& path) {
   return text.str();
 }
 
+// An empty directory "<stem><rank count>" with an empty "serial" inside,
+// made by rank 0 before any rank goes on.
+std::string fresh_directories(const mpi::Communicator& comm, const std::string& stem) {
+  const std::string directory = stem + std::to_string(comm.size());
+  if (comm.is_root()) {
+    std::filesystem::remove_all(directory);
+    std::filesystem::create_directories(directory + "/serial");
+  }
+  comm.barrier();
+  return directory;
+}
+
 }  // namespace
 
 TEST_CASE("Distributed frames and probes", "[mpi][output]") {
   const mpi::Communicator comm;
   namespace fs = std::filesystem;
-  const std::string directory = "mpi_output_np" + std::to_string(comm.size());
-  if (comm.is_root()) {
-    fs::remove_all(directory);
-    fs::create_directories(directory + "/serial");
-  }
-  comm.barrier();
+  const std::string directory = fresh_directories(comm, "mpi_output_np");
   const ShellModel model = ShellModel::rectangular_plate(0.5, 0.5, 21, 21, 0.01);
   SolverOptions options;
   options.density = 7850.0;
@@ -224,12 +231,7 @@ TEST_CASE("Distributed probes continue their files after load_checkpoint: the se
           "[mpi][output][checkpoint]") {
   const mpi::Communicator comm;
   namespace fs = std::filesystem;
-  const std::string directory = "mpi_probe_restart_np" + std::to_string(comm.size());
-  if (comm.is_root()) {
-    fs::remove_all(directory);
-    fs::create_directories(directory + "/serial");
-  }
-  comm.barrier();
+  const std::string directory = fresh_directories(comm, "mpi_probe_restart_np");
   const ShellModel model = ShellModel::rectangular_plate(0.5, 0.5, 21, 21, 0.01);
   SolverOptions options;
   options.density = 7850.0;

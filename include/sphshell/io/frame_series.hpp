@@ -192,6 +192,7 @@ class FrameSeriesWriter {
     });
     group.collectively([&] {
       if (!group.is_root()) return;
+      const std::vector<std::string> names = collection_names(datasets);
       for (std::size_t k = 0; k < datasets.size(); ++k) {
         const FrameDataset& dataset = datasets[k];
         const std::string frame = dataset.series + "_" + number;
@@ -207,7 +208,7 @@ class FrameSeriesWriter {
           for (int r = 0; r < group.size(); ++r) pieces.push_back(group.piece_file_of(frame, r));
           write_pvtu(listed, dataset.grid, pieces, format_.precision);
         }
-        series_->stage(collection_of(datasets, k), time, listed, dataset.part);
+        series_->stage(collection_of(names, dataset), time, listed, dataset.part);
       }
       series_->write();
     });
@@ -243,12 +244,12 @@ class FrameSeriesWriter {
       if (dataset.listed_in.empty()) names.push_back(dataset.series);
     return names;
   }
-  static std::size_t collection_of(const std::vector<FrameDataset>& datasets, std::size_t k) {
-    const std::vector<std::string> names = collection_names(datasets);
-    const std::string& listed = datasets[k].listed_in.empty() ? datasets[k].series : datasets[k].listed_in;
+  // The collection a dataset is listed in, among the frame's `names`.
+  static std::size_t collection_of(const std::vector<std::string>& names, const FrameDataset& dataset) {
+    const std::string& listed = dataset.listed_in.empty() ? dataset.series : dataset.listed_in;
     const auto found = std::find(names.begin(), names.end(), listed);
     if (found == names.end())
-      throw Error("sphshell: frame dataset '" + datasets[k].series + "' is listed in series '" + listed +
+      throw Error("sphshell: frame dataset '" + dataset.series + "' is listed in series '" + listed +
                   "', which this frame does not write");
     return static_cast<std::size_t>(found - names.begin());
   }

@@ -17,7 +17,6 @@
 #include <sphshell/mpi/reductions.hpp>
 #include <sphshell/solver/integration_points.hpp>
 
-#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cstddef>

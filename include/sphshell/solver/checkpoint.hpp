@@ -57,7 +57,6 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
-#include <sstream>
 #include <string>
 #include <type_traits>
 #include <typeinfo>

@@ -20,7 +20,6 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
-#include <ostream>
 #include <sstream>
 #include <string>
 #include <utility>

@@ -34,7 +34,6 @@
 #include <sphshell/solver/section_states.hpp>
 
 #include <algorithm>
-#include <array>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>

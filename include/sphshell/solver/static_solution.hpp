@@ -21,9 +21,6 @@ using statics::StaticMass;
 using statics::StaticNotConverged;
 using statics::StaticParameters;
 using statics::StaticResult;
-using statics::StaticSystem;
-using statics::solve_static;
-using statics::validate;
 
 // The static solve of a Solver (a friend of it): the loads at the load time
 // scaled by the load factor, the internal forces at the quasi-static limit,
@@ -36,7 +33,7 @@ class StaticSolution {
   template <class Observer>
   static StaticResult solve(Solver& s, const StaticParameters& parameters, Observer& observer) {
     s.domain_.collectively([&] {
-      validate(parameters);
+      statics::validate(parameters);
       if (Solver::distributed && parameters.mass == StaticMass::tangent)
         throw Error("sphshell: solve_static: StaticMass::tangent (Newton steps on the assembled tangent) runs on "
                     "one process only; a distributed run relaxes: StaticMass::particle_bound (the default)");
@@ -57,20 +54,22 @@ class StaticSolution {
     };
     auto save = [&] { converged = *s.states_; };
     auto restore = [&] { *s.states_ = converged; };
-    StaticSystem<typename Solver::domain_type, typename Solver::approximation_type, decltype(evaluate),
-                 decltype(save), decltype(restore)>
-        system{s.domain_,   s.model_, s.particles_, s.forces_, s.constraints_, *s.points_,
-               evaluate,    save,     restore,      s.options_.progress_stream};
-    try {
-      const StaticResult result = solve_static(system, parameters, observer);
+    statics::StaticSystem<typename Solver::domain_type, typename Solver::approximation_type, decltype(evaluate),
+                          decltype(save), decltype(restore)>
+        system{s.domain_, s.model_, s.particles_, s.forces_, s.constraints_, *s.points_,
+               evaluate,  save,     restore,      s.options_.progress_stream};
+    // The solve leaves its result (or a failed load step's best state) with
+    // its material state and internal forces; the books restart at rest there.
+    auto at_rest = [&] {
       s.forces_current_ = true;
       s.ledger_->restart_at_rest(s.domain_, s.energy().elastic);
+    };
+    try {
+      const StaticResult result = statics::solve_static(system, parameters, observer);
+      at_rest();
       return result;
     } catch (const StaticNotConverged&) {
-      // The solve left the failed load step's best state with its material
-      // state and internal forces; the books restart at rest there.
-      s.forces_current_ = true;
-      s.ledger_->restart_at_rest(s.domain_, s.energy().elastic);
+      at_rest();
       throw;
     } catch (...) {
       s.particles_ = start;
