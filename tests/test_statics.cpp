@@ -7,10 +7,15 @@
 #include <sphshell/statics/all.hpp>
 #include <sphshell/thickness/gauss.hpp>
 
+#include "support/vtu_reader.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
 #include <vector>
 
 using namespace sphshell;
@@ -127,6 +132,37 @@ TEST_CASE("Statics: linear buckling of an Euler strip", "[validation][statics]")
   CHECK(std::abs(motion.z()) == Approx(1.0));
   CHECK(std::abs(motion.x()) < 1e-6);
   CHECK(same_configuration(solver, x0, d0));
+
+  // The modes as frames, read back by the tests' own VTU reader: one file
+  // per mode over the strip's cells, listed by mode number, the load factors
+  // in the table to the last digit.
+  const std::string folder = "statics_buckling_modes";
+  std::filesystem::remove_all(folder);
+  io::VtuFormat exact;
+  exact.precision = io::VtuPrecision::float64;
+  statics::write_buckling_modes(folder, strip.model, x0, result, exact);
+  const std::vector<test_support::PvdEntry> listed = test_support::read_pvd(folder + "/buckling_modes.pvd");
+  REQUIRE(listed.size() == 2);
+  for (std::size_t k = 0; k < listed.size(); ++k) {
+    CHECK(listed[k].time == static_cast<double>(k + 1));
+    const test_support::Vtu vtu = test_support::read_vtu(folder + "/" + listed[k].file);
+    CHECK(vtu.points() == strip.model.particle_count());
+    CHECK(vtu.cells() == strip.model.cells().size());
+    const std::vector<double>& written = vtu.array("PointData", "mode_translation").values;
+    REQUIRE(written.size() == 3 * strip.model.particle_count());
+    std::size_t differing = 0;
+    for (std::size_t i = 0; i < strip.model.particle_count(); ++i)
+      for (int c = 0; c < 3; ++c) differing += written[3 * i + c] != result.modes[k].translation[i][c];
+    CHECK(differing == 0);
+  }
+  std::ifstream table(folder + "/buckling_modes.csv");
+  std::string header, row1;
+  std::getline(table, header);
+  std::getline(table, row1);
+  CHECK(header == "mode,load_factor,file");
+  CHECK(std::stod(row1.substr(2)) == first);
+  CHECK_THROWS_WITH(statics::write_buckling_modes(folder, strip.model, x0, statics::BucklingResult{}),
+                    Catch::Contains("BucklingResult::modes"));
 }
 
 TEST_CASE("Statics: linear buckling of a simply supported square plate under uniaxial compression",

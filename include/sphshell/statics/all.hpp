@@ -3,6 +3,7 @@
 #include <sphshell/statics/statics.hpp>
 
 #include <sphshell/statics/buckling.hpp>
+#include <sphshell/statics/buckling_frames.hpp>
 #include <sphshell/statics/conditions.hpp>
 #include <sphshell/statics/coupling.hpp>
 #include <sphshell/statics/path_following.hpp>
