@@ -1,6 +1,9 @@
 #pragma once
 // What several benchmarks share: the calling thread's CPU time, the median
-// of repeated measurements, and pinning a thread to a processor (Linux).
+// of repeated measurements, the machine's multiply-add peak, and pinning a
+// thread to a processor (Linux).
+
+#include <benchmark/benchmark.h>
 
 #include <algorithm>
 #include <cstddef>
@@ -28,6 +31,39 @@ inline double median(std::vector<double> values) {
   std::sort(values.begin(), values.end());
   const std::size_t n = values.size();
   return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+// The floating-point roof of one thread: 16 independent multiply-add chains
+// x = x·m + a over 8 doubles each, 2 flops per element and pass, in whatever
+// vector width the build allows (the compiler vectorizes the inner loop and,
+// with FMA, contracts each pair into one instruction). Returns the flops of
+// one call; `passes` sets its length (4096: about 50 µs at 20 GFLOP/s).
+inline double multiply_add_chains(int passes = 4096) {
+  constexpr int chains = 16, lanes = 8;
+  alignas(64) double x[chains][lanes];
+  for (int c = 0; c < chains; ++c)
+    for (int l = 0; l < lanes; ++l) x[c][l] = 1.0 + 1e-3 * (c + l);
+  const double m = 0.999999, add = 1e-6;
+  for (int r = 0; r < passes; ++r)
+    for (int c = 0; c < chains; ++c)
+      for (int l = 0; l < lanes; ++l) x[c][l] = x[c][l] * m + add;
+  benchmark::DoNotOptimize(x);
+  return 2.0 * chains * lanes * passes;
+}
+
+// The multiply-add peak in flop/s, CPU time of the calling thread, the best
+// of `tries` calls of multiply_add_chains (the best, not the median: the
+// roof is what the processor can do, and a call slowed by another process
+// measures that process).
+inline double multiply_add_peak(int tries = 50) {
+  double best = 0.0;
+  for (int k = 0; k < tries; ++k) {
+    const double start = thread_seconds();
+    const double flops = multiply_add_chains();
+    const double seconds = thread_seconds() - start;
+    if (seconds > 0.0) best = std::max(best, flops / seconds);
+  }
+  return best;
 }
 
 // Pinning threads to processors, for the benchmarks that compare processors

@@ -4,9 +4,13 @@
 // declaration is the default. --help is printed from that same table, so the
 // help cannot drift from what is parsed. A malformed value ("abc", "1e-3x",
 // "nan"), a missing value, an unknown option or a stray argument is an Error
-// naming it, never silently ignored or truncated.
+// naming it, never silently ignored or truncated. Once the arguments are
+// accepted, the run's first line of output names the library version and the
+// instruction set the example was compiled for (build_line()).
 
 #include <sphshell/core/error.hpp>
+#include <sphshell/core/simd.hpp>
+#include <sphshell/version.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -111,6 +115,16 @@ inline double shown_energy(double value, double scale) {
   return std::abs(value) < energy_round_off * scale ? 0.0 : value;
 }
 
+// The first line every example prints: what built it, so that a printed
+// figure can be traced to its code ("#" keeps a CSV on standard output
+// readable). The set in use comes from the compiler; the configured one from
+// SPHSHELL_SIMD through the sphshell::sphshell target (NONE leaves the
+// compiler's default, SSE2 on x86-64).
+inline std::string build_line() {
+  return std::string("# sphshell ") + SPHSHELL_VERSION_STRING + ", instruction set " + simd::instruction_set() +
+         " (SPHSHELL_SIMD: " + simd::configured_instruction_set() + ")";
+}
+
 // The options of one example, its --help text and the parse.
 class CommandLine {
  public:
@@ -164,6 +178,7 @@ class CommandLine {
 
   // Applies argv to the bound variables. Returns false when --help was asked
   // for: the help is then on stdout and the program should exit with 0.
+  // Otherwise build_line() is printed, the run's first line.
   bool parse(int argc, char** argv) const {
     for (int k = 1; k < argc; ++k) {
       std::string name = argv[k];
@@ -197,6 +212,7 @@ class CommandLine {
       }
       option->set(value);
     }
+    std::cout << build_line() << '\n';
     return true;
   }
 

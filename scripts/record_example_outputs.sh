@@ -9,9 +9,19 @@
 # is replaced. Wall-clock figures are masked in the printed output
 # (stdout.txt), so two runs of the same binaries give the same OUT_DIR/SHA256SUMS.
 # Compare two records with: diff A/SHA256SUMS B/SHA256SUMS.
+#
+# The records are made with BUILD_DIR configured with -DSPHSHELL_SIMD=NONE (the
+# compiler's default target): another instruction set contracts multiply-adds
+# and changes round-off, hence the bytes. The script refuses any other build.
 set -uo pipefail
 if [ $# -lt 2 ]; then
   echo "usage: $0 BUILD_DIR OUT_DIR [THREADS]" >&2
+  exit 2
+fi
+simd=$(sed -n 's/^SPHSHELL_SIMD_CHOSEN:INTERNAL=//p' "$1/CMakeCache.txt" 2>/dev/null)
+if [ "$simd" != "NONE" ]; then
+  echo "$0: $1 is configured for the instruction set '${simd:-unknown}'; the records are made with" >&2
+  echo "  SPHSHELL_SIMD=NONE: cmake -S . -B $1 -DSPHSHELL_SIMD=NONE" >&2
   exit 2
 fi
 bin=$(cd "$1" && pwd)/examples
