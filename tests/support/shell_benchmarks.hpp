@@ -13,8 +13,9 @@
 // up by an end moment. Their references are computed here (the elastica by
 // shooting, the circle in closed form). Also from that paper, against its
 // tables: the slit annular plate (§3.3), the hemisphere with an 18° hole under
-// alternating forces (§3.4), the pull-out of an open-ended cylinder (§3.5) and
-// the pinched cylinder on rigid diaphragms (§3.6).
+// alternating forces (§3.4), the pull-out of an open-ended cylinder (§3.5),
+// the pinched cylinder on rigid diaphragms (§3.6) and the hinged cylindrical
+// roof's snap-through and snap-back (§3.8, its whole path).
 //
 // The inputs are the benchmarks' own numbers; they are unit-consistent (any
 // consistent system), so they go into the SI-labelled solver unchanged.
