@@ -4,7 +4,8 @@
 // nonlinear cantilevers of Sze, Liu & Lo (2004) (end shear, rolled into a
 // circle by an end moment; and, against the paper's tables, the slit annular
 // plate, the hemisphere under alternating forces and the pull-out of an
-// open-ended cylinder). Each case runs at three resolutions; the table
+// open-ended cylinder; with --cases hinged-roof, the hinged cylindrical roof's
+// snap-through and snap-back). Each case runs at three resolutions; the table
 // printed (Markdown) gives the finest one's value, reference and error with
 // the two coarser ones' errors beside it, as in docs/validation.md. The cases and the
 // static Newton solution on the solver's own forces are the validation tests'
@@ -52,13 +53,15 @@ std::optional<Arguments> parse(int argc, char** argv) {
   command_line.flag("--coarse", arguments.coarse,
                     "three coarse resolutions per case, without the slit annular plate (a quick run, for checks)");
   command_line.choice("--cases", arguments.cases,
-                      {"all", "linear", "nonlinear", "paths", "hemisphere-path", "pullout-stability"},
+                      {"all", "linear", "nonlinear", "paths", "hemisphere-path", "pullout-stability", "hinged-roof"},
                       "which benchmarks to run: all is linear and nonlinear; paths follows the whole load paths of "
                       "Sze et al.'s hemisphere (at three resolutions), pull-out and pinched cylinder (one each) by "
                       "displacement control; hemisphere-path follows only the hemisphere's, at 33², "
                       "41² and 45² (finer than paths) with the director hourglass; pullout-stability follows the pull-out without the director "
                       "hourglass at 13×9 and 22×15 and with it at 22×15 by displacement control with the tangent's "
-                      "stability after every step, then (without it) by arc length");
+                      "stability after every step, then (without it) by arc length; hinged-roof follows Sze et al.'s "
+                      "hinged cylindrical roof (§3.8) at t = 12.7 by displacement control of the centre and at t = 6.35 "
+                      "by arc length, each at 9², 13² and 17², to the end of the paper's table");
   command_line.output_folder(arguments.output);
   command_line.writes("benchmarks.csv", "every run: case, resolution, value, reference, error, seconds");
   command_line.writes("end_shear.csv", "cantilever under end shear: P/Pmax, tip w and -u, the elastica's");
@@ -92,6 +95,11 @@ std::optional<Arguments> parse(int argc, char** argv) {
                       "--cases pullout-stability, without the hourglass: that mode where the control stalled, per "
                       "particle: x, y, z, its radial, circumferential and axial translation and its director "
                       "rotations about the axis and about the circumference times the spacing (largest 1)");
+  command_line.writes("hinged_roof_thick.csv, hinged_roof_thin.csv",
+                      "--cases hinged-roof: the finest path of t = 12.7 and of t = 6.35: control, P/Pmax, -W at the "
+                      "centre and at the free edge's midpoint");
+  command_line.writes("hinged_roof_thick.svg, hinged_roof_thin.svg",
+                      "their charts, P/Pmax against the centre's -W at the three resolutions, with the paper's points");
   if (!command_line.parse(argc, argv)) return std::nullopt;
   return arguments;
 }
@@ -151,6 +159,7 @@ int run(const Arguments& arguments) {
   const bool hemisphere_only = arguments.cases == "hemisphere-path";
   const bool paths = arguments.cases == "paths" || hemisphere_only;
   const bool pullout_stability = arguments.cases == "pullout-stability";
+  const bool hinged_roof = arguments.cases == "hinged-roof";
   // Runs: resolution (particles), value, reference, error %, seconds; one file per case kind.
   io::CsvProbe csv(arguments.output + "/benchmarks.csv",
                    {"particles", "value", "reference", "error [%]", "seconds"});
@@ -638,6 +647,68 @@ int run(const Arguments& arguments) {
                 << arc.path.back().load_factor << (arc.stopped.empty() ? "" : "; stopped: " + arc.stopped) << " ("
                 << seconds_since(start) << " s in all)\n";
     }
+  }
+
+  if (hinged_roof) {
+    // §3.8, the hinged roof: the paper's points against the followed curve,
+    // each point's distance to it measured in the table's limit load and the
+    // roof's rise (tests/support/shell_benchmarks.hpp, distance_to_path).
+    statics::NewtonOptions newton;
+    newton.tolerance = 1e-5;
+    newton.max_iterations = 12;
+    struct RoofRow {
+      std::string roof, grid;
+      double largest, limit_load, limit_error, seconds;
+      std::size_t steps;
+      int iterations;
+    };
+    std::vector<RoofRow> rows;
+    struct RoofCase {
+      HingedRoofCase roof;
+      const char* name;
+      const char* file;
+      double step;
+    };
+    for (const RoofCase& roof : {RoofCase{HingedRoofCase::thick, "t = 12.7 (snap-through)", "hinged_roof_thick", 1.0},
+                                 RoofCase{HingedRoofCase::thin, "t = 6.35 (snap-back)", "hinged_roof_thin", 0.5}}) {
+      const std::vector<LoadDeflection> paper = sze_hinged_roof_table(roof.roof);
+      const double load_scale = limit_load_factor(paper);
+      std::vector<io::PlotSeries> series;
+      PathRun finest;
+      for (int n : {9, 13, 17}) {
+        const std::string grid = std::to_string(n) + "²";
+        std::cerr << "Hinged roof (Sze), " << roof.name << ", " << grid << "\n";
+        finest = follow_sze_hinged_roof<NonlinearSolver>(roof.roof, n, roof.step, newton);
+        if (!finest.stopped.empty()) std::cerr << "  stopped: " << finest.stopped << "\n";
+        const double rise = sze_hinged_roof(roof.roof, n).rise;
+        double largest = 0.0, limit = 0.0;
+        for (const LoadDeflection& point : paper)
+          largest = std::max(largest, 100.0 * distance_to_path(finest.path, 0, point, load_scale, rise));
+        for (std::size_t k = 1; k < finest.path.size() && finest.path[k].load_factor >= limit; ++k)
+          limit = finest.path[k].load_factor;
+        rows.push_back({roof.name, grid, largest, limit, 100.0 * (limit / load_scale - 1.0), finest.seconds,
+                        finest.path.size() - 1, finest.report.iterations});
+        io::PlotSeries line{"SPH " + grid, {}, {}, io::PlotStyle::line};
+        for (const PathPoint& point : finest.path) line.x.push_back(point.values[0]), line.y.push_back(point.load_factor);
+        series.push_back(line);
+        std::cerr << "  largest distance " << largest << " %, limit load " << limit << ", " << finest.seconds << " s\n";
+      }
+      io::CsvProbe roof_csv(arguments.output + "/" + roof.file + ".csv",
+                            {"control", "P/Pmax", "-W centre", "-W free edge midpoint"});
+      for (const PathPoint& point : finest.path)
+        roof_csv.write_row({point.control, point.load_factor, point.values[0], point.values[1]});
+      io::PlotSeries points{"Sze et al. 2004", {}, {}, io::PlotStyle::points};
+      for (const LoadDeflection& point : paper) points.x.push_back(point.deflection), points.y.push_back(point.load_factor);
+      series.push_back(points);
+      io::write_svg_plot(arguments.output + "/" + roof.file + ".svg",
+                         {{std::string("Hinged cylindrical roof, ") + roof.name + " (Sze et al. 2004)",
+                           "centre's deflection −W_C", "P / Pmax", series}});
+    }
+    std::printf("\n| hinged roof | resolution | largest distance of the paper's points | limit load P/Pmax (error) | "
+                "steps | Newton iterations | time |\n|---|---|---|---|---|---|---|\n");
+    for (const RoofRow& row : rows)
+      std::printf("| %s | %s | %.2f %% | %.4f (%+.2f %%) | %zu | %d | %.1f s |\n", row.roof.c_str(), row.grid.c_str(),
+                  row.largest, row.limit_load, row.limit_error, row.steps, row.iterations, row.seconds);
   }
 
   std::printf("\n| benchmark | quantity | resolution | value | reference | error | coarser | time |\n");

@@ -301,9 +301,10 @@ TEST_CASE("Statics: Newton on the thin clamped plate (L/d = 500) reaches 1e-8 at
   // a finite rotation); then the iteration converges. At 51 x 51 the
   // residual stays near 2.4e-10 however long Newton goes on (a tangent
   // error would shrink it by a constant factor per iteration): the rounding
-  // of the force evaluation against the small load per particle
-  // (docs/validation.md, "Newton on a thin plate"), so 51 x 51 is asked
-  // 1e-8 and 31 x 31, whose floor is lower, 1e-10.
+  // of forces that are differences of terms (L/d)^2 larger than themselves
+  // (the shear strain w' - theta), about 5 eps (L/d)^2 of them whatever the
+  // load or the difference step (docs/validation.md, "Newton on a thin
+  // plate"), so 51 x 51 is asked 1e-8 and 31 x 31, whose floor is lower, 1e-10.
   const ThinPlateSolve fine = thin_plate_newton(51, 1e-8);
   std::printf("Thin clamped plate 51 x 51, L/d = 500: w D/(qL^4) = %.8f (%+.3f %% from Kirchhoff); residual %.3e "
               "after %ld Newton iterations, %ld force evaluations\n",

@@ -429,3 +429,55 @@ TEST_CASE("Benchmark: pull-out of an open-ended cylinder, the whole path (Sze, L
   CHECK(worst_elsewhere < 1.2);
   CHECK(worst < 2.2);
 }
+
+namespace {
+
+// The hinged roof's path against the paper's table: each tabulated point's
+// distance to the followed curve, the load factor measured in the table's
+// limit load and the deflection in the roof's rise. Prints every point and
+// returns the largest distance.
+double hinged_roof_largest_distance(HingedRoofCase roof, const char* name, int n, double step) {
+  statics::NewtonOptions newton;
+  newton.tolerance = 1e-5;
+  newton.max_iterations = 12;
+  const PathRun run = follow_sze_hinged_roof<NonlinearSolver>(roof, n, step, newton);
+  INFO("stopped: " << run.stopped);
+  REQUIRE(run.stopped.empty());
+  const std::vector<LoadDeflection> table = sze_hinged_roof_table(roof);
+  const double load_scale = limit_load_factor(table), rise = sze_hinged_roof(roof, n).rise;
+  double worst = 0.0;
+  for (const LoadDeflection& point : table) {
+    const double distance = 100.0 * distance_to_path(run.path, 0, point, load_scale, rise);
+    std::printf("Hinged roof (Sze), %s, %d x %d: P/P_max %+.4f, -W_C %.3f: %.2f %% off the path\n", name, n, n,
+                point.load_factor, point.deflection, distance);
+    worst = std::max(worst, distance);
+  }
+  double first_maximum = 0.0;
+  for (std::size_t k = 1; k < run.path.size() && run.path[k].load_factor >= first_maximum; ++k)
+    first_maximum = run.path[k].load_factor;
+  std::printf("Hinged roof (Sze), %s, %d x %d: largest distance %.2f %% (of the limit load %.4f and the rise %.2f); "
+              "limit load %.4f (%+.2f %%); %zu steps, %d Newton iterations, %.1f s\n",
+              name, n, n, worst, load_scale, rise, first_maximum, error_percent(first_maximum, load_scale),
+              run.path.size() - 1, run.report.iterations, run.seconds);
+  return worst;
+}
+
+}  // namespace
+
+TEST_CASE("Benchmark: hinged cylindrical roof, t = 12.7, snap-through (Sze, Liu & Lo 2004, nonlinear)",
+          "[validation][benchmarks]") {
+  // §3.8: the centre's deflection −W_C prescribed in steps of 1 (the load
+  // factor solved for) through the load's maximum and minimum to the
+  // table's last point, P/P_max = 1.0835; every tabulated point within 2 %
+  // of the followed curve (distances in the limit load and the rise).
+  CHECK(hinged_roof_largest_distance(HingedRoofCase::thick, "t = 12.7", 13, 1.0) < 2.0);
+}
+
+TEST_CASE("Benchmark: hinged cylindrical roof, t = 6.35, snap-back (Sze, Liu & Lo 2004, nonlinear)",
+          "[validation][benchmarks]") {
+  // §3.8: by arc length (steps of at most 0.5 of the particles'
+  // root-mean-square motion) through the snap-back, where the load factor
+  // turns negative and the centre's deflection turns back, to the table's
+  // last point, P/P_max = 1.0313.
+  CHECK(hinged_roof_largest_distance(HingedRoofCase::thin, "t = 6.35", 17, 0.5) < 2.0);
+}

@@ -13,8 +13,9 @@
 // up by an end moment. Their references are computed here (the elastica by
 // shooting, the circle in closed form). Also from that paper, against its
 // tables: the slit annular plate (§3.3), the hemisphere with an 18° hole under
-// alternating forces (§3.4), the pull-out of an open-ended cylinder (§3.5) and
-// the pinched cylinder on rigid diaphragms (§3.6).
+// alternating forces (§3.4), the pull-out of an open-ended cylinder (§3.5),
+// the pinched cylinder on rigid diaphragms (§3.6) and the hinged cylindrical
+// roof's snap-through and snap-back (§3.8, its whole path).
 //
 // The inputs are the benchmarks' own numbers; they are unit-consistent (any
 // consistent system), so they go into the SI-labelled solver unchanged.
@@ -29,6 +30,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -684,6 +686,144 @@ inline std::vector<double> readings_at_load_factor(const std::vector<PathPoint>&
   for (std::size_t r = 0; r < path[k].values.size(); ++r)
     values.push_back(lagrange(s, [r](const PathPoint& point) { return point.values[r]; }));
   return values;
+}
+
+// Sze, Liu & Lo (2004), §3.8, the hinged cylindrical roof under a central
+// point force: radius R = 2540, straight edges 2L = 508 long and hinged
+// (translations held, rotations free), an opening of θ = 0.1 rad either side
+// of the crown (the arc is 508 long, the rise R(1 − cos θ) = 12.69), curved
+// edges free, E = 3102.75, ν = 0.3, the force inward at the centre, P_max =
+// 3000 for both thicknesses. At t = 12.7 the load passes a maximum and a
+// minimum while the centre goes on down (a snap-through: displacement control
+// of the centre follows it); at t = 6.35 the centre's deflection turns back
+// as well (a snap-back: arc length).
+enum class HingedRoofCase {
+  thick,  // t = 12.7
+  thin,   // t = 6.35
+};
+// One quarter, n × n particles (its 254 × 254 is square): the crown along the
+// x-axis at θ = 0 (a symmetry plane, y = 0) to the hinged edge at θ = 0.1,
+// the mid-length section z = 0 (a symmetry plane) to the free curved edge at
+// z = L. The quarter carries P/4 at the centre C = (R, 0, 0), applied through
+// the shape functions; the deflections are read the same way at C and at the
+// free edge's midpoint (R, 0, L), inward (−x) positive.
+struct SzeHingedRoof {
+  ShellModel model;
+  statics::Conditions conditions;
+  ParticleWeights centre, free_edge;
+  double E, nu;
+  double rise;  // R(1 − cos θ)
+};
+inline SzeHingedRoof sze_hinged_roof(HingedRoofCase roof, int n) {
+  const double R = 2540.0, L = 254.0, theta = 0.1, P_max = 3000.0;
+  const double t = roof == HingedRoofCase::thick ? 12.7 : 6.35;
+  ShellModel model = ShellModel::cylindrical_panel(R, L, theta, n, n, t);
+  statics::Conditions conditions(model.particle_count());
+  conditions.symmetry_plane(model.set("theta_min"), Vector3::UnitY());
+  conditions.symmetry_plane(model.set("z_min"), Vector3::UnitZ());
+  const ParticleSet hinged = model.set("theta_max");
+  conditions.hold_translation(hinged, Vector3::UnitX());
+  conditions.hold_translation(hinged, Vector3::UnitY());
+  conditions.hold_translation(hinged, Vector3::UnitZ());
+  const int centre = 0, free_edge = (n - 1) * n;
+  ParticleWeights at_centre =
+      add_point_force(model, conditions, centre, Vector3(-P_max / 4, 0.0, 0.0), PointLoad::shape_functions);
+  ParticleWeights at_edge =
+      shape_function_weights(model, model.particle_position[free_edge], model.particle_normal[free_edge]);
+  return {std::move(model), std::move(conditions), std::move(at_centre), std::move(at_edge), 3102.75, 0.3,
+          R * (1.0 - std::cos(theta))};
+}
+
+// A point of a tabulated load-deflection path.
+struct LoadDeflection {
+  double load_factor, deflection;
+};
+// The paper's table of the isotropic roofs (§3.8): P/P_max and −W_C, the
+// centre's inward deflection, along the path (the load factor falls and, at
+// t = 6.35, turns negative; there the deflection turns back too). As
+// transcribed in MBDyn's test suite (tests/plates/sze2004/sze38/
+// sze38_ref_a.dat and sze38_ref_d.dat, github.com/zanoni-mbdyn/MBDyn), whose
+// transcription of the §3.6 table matches sze_pinched_cylinder_table digit
+// for digit.
+inline std::vector<LoadDeflection> sze_hinged_roof_table(HingedRoofCase roof) {
+  if (roof == HingedRoofCase::thick)
+    return {{0.0877, 0.693},  {0.1980, 1.638},  {0.3473, 3.087},  {0.4686, 4.477},  {0.5647, 5.802},
+            {0.6381, 7.057},  {0.6908, 8.237},  {0.7246, 9.339},  {0.7412, 10.358}, {0.7421, 11.293},
+            {0.7286, 12.141}, {0.7023, 12.903}, {0.6649, 13.583}, {0.6182, 14.188}, {0.5643, 14.728},
+            {0.5055, 15.217}, {0.4442, 15.676}, {0.3830, 16.125}, {0.3245, 16.590}, {0.2717, 17.094},
+            {0.2272, 17.657}, {0.1940, 18.299}, {0.1750, 19.028}, {0.1729, 19.852}, {0.1905, 20.771},
+            {0.2303, 21.780}, {0.2950, 22.875}, {0.3871, 24.049}, {0.4443, 24.663}, {0.5093, 25.293},
+            {0.5826, 25.940}, {0.6644, 26.601}, {0.7551, 27.276}, {0.8549, 27.964}, {0.9643, 28.663},
+            {1.0835, 29.374}};
+  return {{0.0517, 1.846},   {0.1182, 5.271},   {0.1583, 8.257},   {0.1837, 10.799},  {0.1914, 11.904},
+          {0.1953, 12.892},  {0.1950, 13.752},  {0.1901, 14.472},  {0.1806, 15.050},  {0.1671, 15.501},
+          {0.1323, 16.145},  {0.0923, 16.602},  {0.0504, 16.915},  {0.0083, 17.008},  {-0.0312, 16.697},
+          {-0.0622, 15.780}, {-0.0739, 15.206}, {-0.0861, 14.767}, {-0.1001, 14.520}, {-0.1142, 14.451},
+          {-0.1247, 14.862}, {-0.1288, 15.778}, {-0.1271, 16.961}, {-0.1196, 18.320}, {-0.1055, 19.817},
+          {-0.0825, 21.420}, {-0.0484, 23.100}, {-0.0006, 24.824}, {0.0626, 26.565},  {0.1427, 28.302},
+          {0.2403, 30.023},  {0.3559, 31.720},  {0.4898, 33.388},  {0.6417, 35.024},  {0.8114, 36.626},
+          {1.0313, 38.450}};
+}
+// The table's limit load, its first maximum of P/P_max: the scale its load factors are compared on.
+inline double limit_load_factor(const std::vector<LoadDeflection>& table) {
+  double largest = 0.0;
+  for (std::size_t k = 0; k < table.size() && table[k].load_factor >= largest; ++k) largest = table[k].load_factor;
+  return largest;
+}
+
+// The distance from a tabulated point to a followed path in the plane of
+// (load factor / load_scale, reading `reading` / deflection_scale): a path
+// that turns back in both (a snap-back) has no single value at a load or a
+// deflection, so a point is compared with the nearest point of the curve.
+// Between steps the curve is the quadratic in the control through the step's
+// two ends and the next point (the one before, at the end), as in
+// readings_at_load_factor, sampled finely.
+inline double distance_to_path(const std::vector<PathPoint>& path, std::size_t reading, const LoadDeflection& point,
+                               double load_scale, double deflection_scale) {
+  constexpr int samples = 128;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 1; k < path.size(); ++k) {
+    const std::size_t first = k + 1 < path.size() ? k - 1 : (k >= 2 ? k - 2 : k - 1);
+    const std::size_t count = std::min<std::size_t>(3, path.size() - first);
+    auto lagrange = [&](double s, auto&& value_of) {
+      double sum = 0.0;
+      for (std::size_t i = first; i < first + count; ++i) {
+        double basis = 1.0;
+        for (std::size_t j = first; j < first + count; ++j)
+          if (j != i) basis *= (s - path[j].control) / (path[i].control - path[j].control);
+        sum += basis * value_of(path[i]);
+      }
+      return sum;
+    };
+    for (int m = 0; m <= samples; ++m) {
+      const double s = path[k - 1].control + (path[k].control - path[k - 1].control) * m / samples;
+      const double load = lagrange(s, [](const PathPoint& p) { return p.load_factor; });
+      const double deflection = lagrange(s, [reading](const PathPoint& p) { return p.values[reading]; });
+      nearest = std::min(nearest, std::hypot((load - point.load_factor) / load_scale,
+                                             (deflection - point.deflection) / deflection_scale));
+    }
+  }
+  return nearest;
+}
+
+// The roof's path followed to the table's last load factor: the thick roof by
+// prescribing the centre's deflection in steps of `step`, the thin one by arc
+// length (steps of at most `step` of the particles' root-mean-square motion).
+// Readings: −W at the centre, then at the free edge's midpoint.
+template <class NonlinearSolver>
+PathRun follow_sze_hinged_roof(HingedRoofCase roof_case, int n, double step, statics::NewtonOptions newton = {},
+                               const std::function<void(const PathPoint&, const statics::NewtonReport&)>& progress = {}) {
+  const SzeHingedRoof roof = sze_hinged_roof(roof_case, n);
+  const statics::ControlDisplacement centre{roof.centre, -Vector3::UnitX()}, free_edge{roof.free_edge, -Vector3::UnitX()};
+  const double last_factor = sze_hinged_roof_table(roof_case).back().load_factor;
+  // The paths are about 3 rises long in the centre's deflection (thick) and
+  // 2 in the root-mean-square motion (thin); four times the steps that needs.
+  const int max_steps = static_cast<int>(4.0 * 3.0 * roof.rise / step) + 10;
+  if (roof_case == HingedRoofCase::thick)
+    return follow_path<NonlinearSolver>(roof.model, roof.E, roof.nu, {}, roof.conditions, centre, {centre, free_edge},
+                                        step, last_factor, max_steps, newton, progress);
+  return follow_arc_length<NonlinearSolver>(roof.model, roof.E, roof.nu, {}, roof.conditions, {centre, free_edge}, step,
+                                            last_factor, max_steps, newton, progress);
 }
 
 }  // namespace sphshell::test_support
