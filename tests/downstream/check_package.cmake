@@ -8,6 +8,11 @@
 #                   MPI consumer tests/mpi/downstream and run it with MPIEXEC (a list)
 #   find_package-without-mpi  install and move; the plain consumer, configured as if
 #                   MPI were absent (CMAKE_DISABLE_FIND_PACKAGE_MPI), must still build
+#   install         only install into a scratch prefix and move it to WORK_DIR/moved-prefix,
+#                   for the consumers given it as PREFIX (one install shared by several checks)
+# PREFIX: an installed and moved prefix (made by CONSUMER=install) that the
+# find_package* (but find_package-simd) and pkg-config consumers use instead of
+# installing one of their own.
 #   cmake -DCONSUMER=<mode> -DSOURCE_DIR=<sphshell> -DWORK_DIR=<dir> -DGENERATOR=<gen>
 #         -DCXX_COMPILER=<c++> -DEXPECTED_VERSION=<x.y.z> [-DPKG_CONFIG=<pkg-config>]
 #         [-DEIGEN_INCLUDE_DIRS=<dirs>] -P check_package.cmake
@@ -41,7 +46,9 @@ if(CONSUMER STREQUAL "find_package-simd")
   set(simd_option -DSPHSHELL_SIMD=SSE2)
 endif()
 
-if(CONSUMER MATCHES "^find_package" OR CONSUMER STREQUAL "pkg-config")
+set(moved_prefix ${WORK_DIR}/moved-prefix)
+if(CONSUMER STREQUAL "find_package-simd" OR CONSUMER STREQUAL "install"
+   OR (NOT PREFIX AND (CONSUMER MATCHES "^find_package" OR CONSUMER STREQUAL "pkg-config")))
   run_step(${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${WORK_DIR}/sphshell-build -G ${GENERATOR}
            -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
            -DSPHSHELL_BUILD_TESTS=OFF -DSPHSHELL_BUILD_EXAMPLES=OFF -DSPHSHELL_BUILD_BENCHMARKS=OFF
@@ -49,7 +56,15 @@ if(CONSUMER MATCHES "^find_package" OR CONSUMER STREQUAL "pkg-config")
   run_step(${CMAKE_COMMAND} --install ${WORK_DIR}/sphshell-build)
   # Relocatability: the consumer sees the prefix only through CMAKE_PREFIX_PATH
   # or PKG_CONFIG_PATH, after the installed tree has been moved.
-  file(RENAME ${WORK_DIR}/prefix ${WORK_DIR}/moved-prefix)
+  file(RENAME ${WORK_DIR}/prefix ${moved_prefix})
+  if(CONSUMER STREQUAL "install")
+    return()
+  endif()
+elseif(PREFIX)
+  if(NOT EXISTS ${PREFIX}/share/sphshell/cmake/sphshellConfig.cmake)
+    message(FATAL_ERROR "PREFIX ${PREFIX} holds no installed sphshell (its fixture, CONSUMER=install, did not run or failed)")
+  endif()
+  set(moved_prefix ${PREFIX})
 endif()
 
 if(CONSUMER STREQUAL "find_package" OR CONSUMER STREQUAL "find_package-simd")
@@ -61,30 +76,30 @@ if(CONSUMER STREQUAL "find_package" OR CONSUMER STREQUAL "find_package-simd")
   set(expected_simd -DEXPECTED_SIMD=${chosen})
   run_step(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/downstream -B ${WORK_DIR}/downstream-build
            -G ${GENERATOR} -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
-           -DCMAKE_PREFIX_PATH=${WORK_DIR}/moved-prefix -DEXPECTED_VERSION=${EXPECTED_VERSION}
+           -DCMAKE_PREFIX_PATH=${moved_prefix} -DEXPECTED_VERSION=${EXPECTED_VERSION}
            ${expected_simd})
   run_step(${CMAKE_COMMAND} --build ${WORK_DIR}/downstream-build)
   run_step(${WORK_DIR}/downstream-build/downstream)
 elseif(CONSUMER STREQUAL "find_package-mpi")
   run_step(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/mpi/downstream -B ${WORK_DIR}/downstream-build
            -G ${GENERATOR} -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
-           -DCMAKE_PREFIX_PATH=${WORK_DIR}/moved-prefix -DEXPECTED_VERSION=${EXPECTED_VERSION})
+           -DCMAKE_PREFIX_PATH=${moved_prefix} -DEXPECTED_VERSION=${EXPECTED_VERSION})
   run_step(${CMAKE_COMMAND} --build ${WORK_DIR}/downstream-build)
   run_step(${MPIEXEC} ${WORK_DIR}/downstream-build/downstream_mpi)
 elseif(CONSUMER STREQUAL "find_package-without-mpi")
-  if(NOT EXISTS ${WORK_DIR}/moved-prefix/share/sphshell/cmake/sphshellMpiTargets.cmake)
+  if(NOT EXISTS ${moved_prefix}/share/sphshell/cmake/sphshellMpiTargets.cmake)
     message(FATAL_ERROR "the installed package has no MPI layer: nothing to check without it")
   endif()
   run_step(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/downstream -B ${WORK_DIR}/downstream-build
            -G ${GENERATOR} -DCMAKE_CXX_COMPILER=${CXX_COMPILER} -DCMAKE_DISABLE_FIND_PACKAGE_MPI=ON
-           -DCMAKE_PREFIX_PATH=${WORK_DIR}/moved-prefix -DEXPECTED_VERSION=${EXPECTED_VERSION})
+           -DCMAKE_PREFIX_PATH=${moved_prefix} -DEXPECTED_VERSION=${EXPECTED_VERSION})
   run_step(${CMAKE_COMMAND} --build ${WORK_DIR}/downstream-build)
   run_step(${WORK_DIR}/downstream-build/downstream)
 elseif(CONSUMER STREQUAL "pkg-config")
   if(NOT PKG_CONFIG)
     message(FATAL_ERROR "pkg-config not found (scripts/install_dependencies.sh installs it)")
   endif()
-  set(ENV{PKG_CONFIG_PATH} ${WORK_DIR}/moved-prefix/share/pkgconfig)
+  set(ENV{PKG_CONFIG_PATH} ${moved_prefix}/share/pkgconfig)
   run_step(${PKG_CONFIG} --modversion sphshell)
   string(STRIP "${step_output}" version)
   if(NOT version STREQUAL EXPECTED_VERSION)
@@ -94,7 +109,7 @@ elseif(CONSUMER STREQUAL "pkg-config")
   string(STRIP "${step_output}" cflags)
   # The include directory must be the moved prefix's, found from the .pc
   # file's place, not the prefix it was installed to.
-  file(REAL_PATH ${WORK_DIR}/moved-prefix/include moved_include)
+  file(REAL_PATH ${moved_prefix}/include moved_include)
   separate_arguments(cflag_list UNIX_COMMAND "${cflags}")
   set(found_include OFF)
   foreach(flag IN LISTS cflag_list)
