@@ -14,10 +14,20 @@
 //   |r − g d_b| ≤ r_b       (a lies over b's patch) and
 //   |g| < (h_a + h_b)/2     (the mid-surfaces are closer than the two half thicknesses):
 // penetration δ = (h_a + h_b)/2 − |g|, normal n = sign(g) d_b (from b towards a).
-// Each particle a takes, of the patches it meets, the nearest one (smallest
-// |r|, then the lowest index) — node against surface, as a penalty contact's
-// slave node against its master segment — and every particle plays both
+// A particle a meets the surface as a weighted mean of the patches it lies
+// over (node against surface, as a penalty contact's slave node against its
+// master segments), so that its force changes continuously as it slides from
+// patch to patch (taking the nearest patch alone made the penetration jump by
+// the surface's sag over a spacing, κ Δ²/8, at each change: energy put in at
+// every switch, enough to blow a folding tube apart). Patch b's weight is
+//   w_b = (1 − ρ²/r_b²)² · w_n(|g|),  w_n = 1 for |g| ≤ c, (1 − ((|g| − c)/c)²)²
+//   up to 2c, 0 beyond  (ρ = |r − g d_b|, c = (h_a + h_b)/2),
+// so a patch enters and leaves with weight 0 both sideways and along its normal;
+// pair ab carries the share w_b / Σ w of a's spring. Every particle plays both
 // parts (a symmetric contact): on two matching sheets a pair is met twice.
+// At most max_patches_per_particle patches count per particle (the first in
+// the search's order): a sheet's patches of radius 0.75 Δ overlap at most four
+// deep, two sheets' eight.
 //
 // Material neighbours never touch: particle a's neighbours are the particles
 // connected to it through the model's cells (corners of a common cell, step
@@ -33,18 +43,23 @@
 //
 // Forces. The pair's spring k = s m_ab / Δt² (penalty.hpp's rule, with the
 // reduced mass m_ab = m_a m_b / (m_a + m_b): the pair oscillates at ω Δt = √s)
-// gives f = k δ n on a and −f on b, exactly opposite, so the pair's forces sum
-// to zero in floating point (momentum is conserved to round-off). Each acts at
-// its particle's face towards the other (offset h/2 along ±d, as the rigid
-// contact's), so it also has a moment (c − x) × f on the rotation. A
-// particle meeting several patches (and met by several particles) carries
-// several springs: with the default s = 0.1 four of them leave (ω Δt)² = 0.4
-// of the 4 the central difference allows beside the shell's 2.56
-// (penalty.hpp). No friction: the contact is frictionless.
+// and share w gives f = w k δ n on a and −f on b, exactly opposite, so the
+// pair's forces sum to zero in floating point (momentum is conserved to
+// round-off). They act on the translations only: at the faces (offset h/2
+// along ±d, as the rigid contact's) an inclined pair's forces would also turn
+// the particles, and a particle's small rotational inertia (m h²/12) on that
+// arm makes a spring 3 times as stiff as on its translation — in a fold,
+// where directors meet at an angle, it broke the step's stability. The
+// offsets are in the gap; momentum is conserved, angular momentum is not
+// exactly (the pair's forces are along n, not along x_a − x_b). A particle
+// carries the shares of its own spring (summing to 1) and of the springs of
+// the particles that meet its patch: with the default s = 0.1 a few leave
+// (ω Δt)² well below the 4 the central difference allows beside the shell's
+// 2.56 (penalty.hpp). No friction: the contact is frictionless.
 //
 // Search: a cell list (approx/neighbour_search.hpp) rebuilt from the current
-// positions every step, with cells as wide as the farthest a patch can be met
-// from, √(h_max² + (patch_spacings Δ_max)²): each particle visits the 27 cells
+// positions every step, with cells as wide as the farthest a patch can weigh
+// from, √((2 h_max)² + (patch_spacings Δ_max)²): each particle visits the 27 cells
 // around it, so a step costs O(N). candidate_pairs() counts the pairs within
 // that reach (each ordered pair once), the work the search does per step.
 //
@@ -79,6 +94,8 @@ inline constexpr double default_patch_spacings = 0.75;
 // beyond the solver's default support radius (2 spacings,
 // SolverOptions::support_radius_factor).
 inline constexpr double default_exclusion_spacings = 3.0;
+// Patches that count per particle (see the header comment).
+inline constexpr std::size_t max_patches_per_particle = 8;
 
 struct ShellContactOptions {
   double stiffness_scale = default_penalty_stiffness_scale;  // s in k = s m_ab / Δt², 0 < s < 4
@@ -97,14 +114,12 @@ inline void validate(const ShellContactOptions& options) {
                                             "): a particle would meet its own sheet's patches");
 }
 
-// One particle's contact with the patch it meets (none: partner < 0).
+// One particle's contact with a patch it meets.
 struct ShellContactPair {
   int partner = -1;             // b, whose patch a meets
-  double stiffness = 0.0;       // k (N/m)
-  double penetration = 0.0;     // δ (m)
-  Vector3 force = Vector3::Zero();        // on a; −force on b
-  Vector3 moment = Vector3::Zero();       // on a's rotation
-  Vector3 partner_moment = Vector3::Zero();  // on b's rotation
+  double stiffness = 0.0;       // w k, the share of a's spring this pair carries (N/m)
+  double penetration = 0.0;     // δ = (h_a + h_b)/2 − |g| (m), 0 where the patch only weighs
+  Vector3 force = Vector3::Zero();  // on a; −force on b
 };
 
 // What the last evaluation found.
@@ -132,7 +147,7 @@ class ShellContact {
       largest_thickness = std::max(largest_thickness, thickness[i]);
       largest_spacing = std::max(largest_spacing, spacing_[i]);
     }
-    reach_ = std::hypot(largest_thickness, options_.patch_spacings * largest_spacing);
+    reach_ = std::hypot(2.0 * largest_thickness, options_.patch_spacings * largest_spacing);
     find_material_neighbours(model);
   }
 
@@ -149,11 +164,12 @@ class ShellContact {
     if (count != reference_.size())
       sphshell::detail::invalid_parameter("shell contact particle count", count,
                                           "must equal the model's " + std::to_string(reference_.size()));
-    pairs_.assign(count, ShellContactPair{});
+    pairs_.assign(count * max_patches_per_particle, ShellContactPair{});
+    pair_count_.assign(count, 0);
     candidates_.assign(count, 0);
     const approx::CellList cells(particles.position, reach_);
     parallel::for_each_range(std::size_t{0}, count, [&](std::size_t first, std::size_t last) noexcept {
-      for (std::size_t a = first; a < last; ++a) pairs_[a] = find_pair(particles, cells, time_step, a);
+      for (std::size_t a = first; a < last; ++a) find_pairs(particles, cells, time_step, a);
     });
     loads.force.assign(count, Vector3::Zero());
     loads.moment.assign(count, Vector3::Zero());
@@ -161,17 +177,18 @@ class ShellContact {
     statistics_ = ShellContactStatistics{};
     for (std::size_t a = 0; a < count; ++a) {
       statistics_.candidate_pairs += candidates_[a];
-      const ShellContactPair& pair = pairs_[a];
-      if (pair.partner < 0) continue;
-      const auto b = static_cast<std::size_t>(pair.partner);
-      loads.force[a] += pair.force;
-      loads.force[b] -= pair.force;
-      loads.moment[a] += pair.moment;
-      loads.moment[b] += pair.partner_moment;
-      const double energy = 0.5 * pair.stiffness * pair.penetration * pair.penetration;
-      result.spring_energy += energy;
-      ++result.contacts;
-      statistics_.largest_penetration = std::max(statistics_.largest_penetration, pair.penetration);
+      bool touches = false;
+      for (std::size_t k = 0; k < pair_count_[a]; ++k) {
+        const ShellContactPair& pair = pairs_[a * max_patches_per_particle + k];
+        if (!(pair.penetration > 0.0)) continue;
+        const auto b = static_cast<std::size_t>(pair.partner);
+        loads.force[a] += pair.force;
+        loads.force[b] -= pair.force;
+        result.spring_energy += 0.5 * pair.stiffness * pair.penetration * pair.penetration;
+        statistics_.largest_penetration = std::max(statistics_.largest_penetration, pair.penetration);
+        touches = true;
+      }
+      if (touches) ++result.contacts;
     }
     statistics_.contacts = result.contacts;
     statistics_.spring_energy = result.spring_energy;
@@ -179,54 +196,60 @@ class ShellContact {
   }
 
   const ShellContactStatistics& statistics() const { return statistics_; }
-  // Each particle's pair of the last compute() (partner < 0: none).
-  const std::vector<ShellContactPair>& pairs() const { return pairs_; }
+  // Particle a's pairs of the last compute(): the patches it weighs (those
+  // with penetration 0 carry no force).
+  std::vector<ShellContactPair> pairs_of(std::size_t a) const {
+    const auto first = pairs_.begin() + static_cast<std::ptrdiff_t>(a * max_patches_per_particle);
+    return {first, first + static_cast<std::ptrdiff_t>(pair_count_.at(a))};
+  }
 
  private:
-  ShellContactPair find_pair(const ContactParticles& particles, const approx::CellList& cells, double time_step,
-                             std::size_t a) noexcept {
+  void find_pairs(const ContactParticles& particles, const approx::CellList& cells, double time_step,
+                  std::size_t a) noexcept {
     const Vector3& xa = particles.position[a];
     const double half_a = 0.5 * particles.thickness[a];
-    int best = -1;
-    double best_distance_squared = std::numeric_limits<double>::infinity();
-    double best_gap = 0.0;
-    std::size_t candidates = 0;
+    ShellContactPair* pairs = &pairs_[a * max_patches_per_particle];
+    double weights[max_patches_per_particle];
+    std::size_t found = 0, candidates = 0;
+    double weight_sum = 0.0;
     cells.for_each_within(xa, reach_, [&](int j, double distance_squared) {
       const auto b = static_cast<std::size_t>(j);
       if (b == a) return;
       ++candidates;
-      if (is_material_neighbour(a, j)) return;
-      const Vector3 r = xa - particles.position[b];
-      const double gap = r.dot(particles.director[b]);
+      if (found == max_patches_per_particle || is_material_neighbour(a, j)) return;
+      const Vector3& db = particles.director[b];
+      const double gap = (xa - particles.position[b]).dot(db);
       const double lateral_squared = std::max(0.0, distance_squared - gap * gap);
       const double patch = options_.patch_spacings * spacing_[b];
-      if (lateral_squared > patch * patch) return;
-      if (!(std::abs(gap) < half_a + 0.5 * particles.thickness[b])) return;
-      if (distance_squared < best_distance_squared || (distance_squared == best_distance_squared && j < best)) {
-        best = j;
-        best_distance_squared = distance_squared;
-        best_gap = gap;
+      if (!(lateral_squared < patch * patch)) return;
+      const double contact_distance = half_a + 0.5 * particles.thickness[b];
+      const double distance = std::abs(gap);
+      if (!(distance < 2.0 * contact_distance)) return;
+      const double sideways = 1.0 - lateral_squared / (patch * patch);
+      double along = 1.0;
+      if (distance > contact_distance) {
+        const double beyond = (distance - contact_distance) / contact_distance;
+        along = (1.0 - beyond * beyond) * (1.0 - beyond * beyond);
       }
+      const double weight = sideways * sideways * along;
+      ShellContactPair& pair = pairs[found];
+      pair.partner = j;
+      pair.penetration = std::max(0.0, contact_distance - distance);
+      const double mass_a = particles.mass[a], mass_b = particles.mass[b];
+      pair.stiffness = penalty_stiffness(mass_a * mass_b / (mass_a + mass_b), time_step, options_.stiffness_scale);
+      // The normal from b towards a.
+      pair.force = gap >= 0.0 ? Vector3(db) : Vector3(-db);
+      weights[found] = weight;
+      weight_sum += weight;
+      ++found;
     });
     candidates_[a] = candidates;
-    ShellContactPair pair;
-    if (best < 0) return pair;
-    const auto b = static_cast<std::size_t>(best);
-    const double half_b = 0.5 * particles.thickness[b];
-    const Vector3& db = particles.director[b];
-    const Vector3 n = best_gap >= 0.0 ? Vector3(db) : Vector3(-db);
-    const double mass_a = particles.mass[a], mass_b = particles.mass[b];
-    pair.partner = best;
-    pair.stiffness = penalty_stiffness(mass_a * mass_b / (mass_a + mass_b), time_step, options_.stiffness_scale);
-    pair.penetration = half_a + half_b - std::abs(best_gap);
-    pair.force = pair.stiffness * pair.penetration * n;
-    // a's face towards b lies along −n, b's towards a along +n.
-    const Vector3& da = particles.director[a];
-    const Vector3 arm_a = (da.dot(n) > 0.0 ? -half_a : half_a) * da;
-    const Vector3 arm_b = (db.dot(n) > 0.0 ? half_b : -half_b) * db;
-    pair.moment = arm_a.cross(pair.force);
-    pair.partner_moment = arm_b.cross(Vector3(-pair.force));
-    return pair;
+    pair_count_[a] = found;
+    for (std::size_t k = 0; k < found; ++k) {
+      ShellContactPair& pair = pairs[k];
+      pair.stiffness *= weight_sum > 0.0 ? weights[k] / weight_sum : 0.0;
+      pair.force *= pair.stiffness * pair.penetration;
+    }
   }
 
   // Whether a and b (a ≠ b) lie within the reference ball of either's reach.
@@ -293,7 +316,8 @@ class ShellContact {
   std::vector<int> neighbours_;
   std::vector<double> spacing_;
   double reach_ = 0.0;
-  std::vector<ShellContactPair> pairs_;
+  std::vector<ShellContactPair> pairs_;  // max_patches_per_particle slots per particle
+  std::vector<std::size_t> pair_count_;
   std::vector<std::size_t> candidates_;
   ShellContactStatistics statistics_;
 };
