@@ -31,13 +31,16 @@ constexpr double pi = 3.14159265358979323846;
 struct Arguments {
   double diameter = 0.05;
   double thickness = 2e-3;
-  double length = 0.1;
-  double spacing = 2.5e-3;
+  double length = 0.06;
+  double spacing = 3e-3;
   double speed = 10.0;
-  double crush = 0.04;
+  double crush = 0.03;
   double yield_stress = 200e6;
   double hardening = 500e6;
   double friction = 0.2;
+  double safety_factor = 0.8;
+  double exclusion_spacings = 1.5;
+  double contact_stiffness = contact::default_penalty_stiffness_scale;
   bool no_self_contact = false;
   std::string output = "tube_crush";
   bool frames = false;
@@ -61,6 +64,11 @@ std::optional<Arguments> parse(int argc, char** argv) {
   command_line.number("--yield-stress", a.yield_stress, "Pa", "initial yield stress σ0");
   command_line.number("--hardening", a.hardening, "Pa", "plastic modulus E Et / (E − Et)");
   command_line.number("--friction", a.friction, "", "Coulomb friction coefficient at the walls");
+  command_line.number("--safety-factor", a.safety_factor, "", "time step / stable bound, in (0, 1)");
+  command_line.number("--exclusion-spacings", a.exclusion_spacings, "",
+                      "self contact: material neighbours' reach in spacings (ShellContactOptions::exclusion_spacings)");
+  command_line.number("--contact-stiffness", a.contact_stiffness, "",
+                      "penalty stiffness scale s of walls and self contact (k = s m / dt^2), in (0, 4)");
   command_line.flag("--no-self-contact", a.no_self_contact, "leave the shell's self contact off (folds pass through each other)");
   command_line.output_folder(a.output);
   command_line.flag("--frames", a.frames,
@@ -78,6 +86,8 @@ std::optional<Arguments> parse(int argc, char** argv) {
     detail::require_positive(name, value);
   detail::require_nonnegative("--hardening", a.hardening);
   detail::require_nonnegative("--friction", a.friction);
+  if (!(a.safety_factor > 0.0 && a.safety_factor < 1.0))
+    detail::invalid_parameter("--safety-factor", a.safety_factor, "must lie in (0, 1)");
   if (!(a.thickness < 0.2 * a.diameter))
     detail::invalid_parameter("--thickness", a.thickness, "must be below a fifth of --diameter (a thin shell)");
   if (!(a.crush < 0.9 * a.length))
@@ -103,6 +113,7 @@ int run(const Arguments& a) {
   const int along = std::max(5, static_cast<int>(std::lround(a.length / a.spacing)) + 1);
   SolverOptions options;
   options.density = density;
+  options.safety_factor = a.safety_factor;
   options.output_directory = a.frames ? a.output : "";
   const double ramp_time = ramp_share * a.crush / a.speed;
   const double end_time = a.crush / a.speed + 0.5 * ramp_time;  // the ramp loses half its time's travel
@@ -111,7 +122,14 @@ int run(const Arguments& a) {
   TubeSolver solver(ShellModel::cylindrical_panel(radius, a.length, 2.0 * pi, around, along, a.thickness),
                     material::J2Plasticity::Parameters{youngs_modulus, poisson_ratio, a.yield_stress, a.hardening},
                     options);
-  if (!a.no_self_contact) solver.enable_shell_contact();
+  // The two halves of a fold lie about a fold length apart along the tube,
+  // ≈ 0.99 √(R t) each (Alexander's estimate, about 7 mm here): the self
+  // contact must spare fewer neighbours than that, or it lets the fold pass
+  // through itself at a coarse spacing.
+  contact::ShellContactOptions self_contact;
+  self_contact.exclusion_spacings = a.exclusion_spacings;
+  self_contact.stiffness_scale = a.contact_stiffness;
+  if (!a.no_self_contact) solver.enable_shell_contact(self_contact);
   // The ends stand square on the walls: their rotations are held (a platen
   // keeps the end ring from tilting), their translations are left to the
   // contact. An end particle touches a wall edge-on, its director along the
@@ -123,6 +141,7 @@ int run(const Arguments& a) {
 
   contact::PenaltyOptions wall_contact;
   wall_contact.friction_coefficient = a.friction;
+  wall_contact.stiffness_scale = a.contact_stiffness;
   using FixedWall = contact::RigidBody<contact::Plane, contact::Fixed>;
   solver.add_rigid_body(FixedWall(contact::Plane(Vector3::UnitZ()), contact::Fixed{}), wall_contact);
   const double speed = a.speed;

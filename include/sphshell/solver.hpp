@@ -213,7 +213,7 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
       latch_.check();
       if (steps_ != 0)
         detail::invalid_parameter("enable_shell_contact at step", steps_, "must come before the first step");
-      bodies_.enable_shell_contact(model_, contact_options);
+      bodies_.enable_shell_contact(model_, contact_options, options_.rotary_inertia_scale);
     }
   }
   // What the shell contact found in the last step, and its loads per particle.

@@ -269,10 +269,11 @@ class RigidBodySet {
   // The shell's contact with itself (shell_contact.hpp), stepped with the
   // bodies: its loads go to the particles in load_chunk(), its work and spring
   // energy into the same books. Once per run.
-  void enable_shell_contact(const ShellModel& model, const ShellContactOptions& options) {
+  void enable_shell_contact(const ShellModel& model, const ShellContactOptions& options,
+                            double rotary_inertia_scale = 1.0) {
     if (shell_contact_)
       sphshell::detail::invalid_parameter("enable_shell_contact", "a second call", "the shell contact is enabled once");
-    shell_contact_ = std::make_unique<ShellContact>(model, options);
+    shell_contact_ = std::make_unique<ShellContact>(model, options, rotary_inertia_scale);
     old_velocity_.resize(model.particle_count());
     old_angular_velocity_.resize(model.particle_count());
   }

@@ -43,19 +43,23 @@
 //
 // Forces. The pair's spring k = s m_ab / Δt² (penalty.hpp's rule, with the
 // reduced mass m_ab = m_a m_b / (m_a + m_b): the pair oscillates at ω Δt = √s)
-// and share w gives f = w k δ n on a and −f on b, exactly opposite, so the
-// pair's forces sum to zero in floating point (momentum is conserved to
-// round-off). They act on the translations only: at the faces (offset h/2
-// along ±d, as the rigid contact's) an inclined pair's forces would also turn
-// the particles, and a particle's small rotational inertia (m h²/12) on that
-// arm makes a spring 3 times as stiff as on its translation — in a fold,
-// where directors meet at an angle, it broke the step's stability. The
-// offsets are in the gap; momentum is conserved, angular momentum is not
-// exactly (the pair's forces are along n, not along x_a − x_b). A particle
-// carries the shares of its own spring (summing to 1) and of the springs of
-// the particles that meet its patch: with the default s = 0.1 a few leave
-// (ω Δt)² well below the 4 the central difference allows beside the shell's
-// 2.56 (penalty.hpp). No friction: the contact is frictionless.
+// and share w gives f = w k δ n on a, −f on b and, on b's rotation, the
+// moment M_b = (x_a − x_b) × (−f): the force on b acts where a meets b's
+// patch, not at x_b. That moment is what makes the pair's spring conservative:
+// δ depends on b's director through g = r · d_b, and turning d_b by θ changes
+// ½ k δ² by −θ · M_b (without it, the folds of a crushed tube gained energy
+// from the springs until the run blew up). The forces are exactly opposite,
+// so they sum to zero in floating point (momentum is conserved to
+// round-off), and with M_b the pair conserves angular momentum too. The
+// spring's mass is the pair's effective mass at the contact point,
+// 1/m_ab = 1/m_a + 1/m_b + ρ²/I_b (I_b = s_I m_b h_b²/12, the solver's rotary
+// inertia, docs/method.md §1; ρ the lateral offset, b's rotation moving the
+// patch under a by ρ θ), so the pair oscillates at ω Δt = √s whatever arm it
+// acts on. The thickness offsets are in the gap. A particle carries the
+// shares of its own spring (summing to 1) and of the springs of the particles
+// that meet its patch: with the default s = 0.1 a few leave (ω Δt)² well
+// below the 4 the central difference allows beside the shell's 2.56
+// (penalty.hpp). No friction: the contact is frictionless.
 //
 // Search: a cell list (approx/neighbour_search.hpp) rebuilt from the current
 // positions every step, with cells as wide as the farthest a patch can weigh
@@ -120,6 +124,7 @@ struct ShellContactPair {
   double stiffness = 0.0;       // w k, the share of a's spring this pair carries (N/m)
   double penetration = 0.0;     // δ = (h_a + h_b)/2 − |g| (m), 0 where the patch only weighs
   Vector3 force = Vector3::Zero();  // on a; −force on b
+  Vector3 partner_moment = Vector3::Zero();  // on b's rotation, (x_a − x_b) × (−force)
 };
 
 // What the last evaluation found.
@@ -134,8 +139,13 @@ class ShellContact {
  public:
   // The model's reference positions, local spacings and thicknesses; the
   // particles' current state comes with every compute().
-  ShellContact(const ShellModel& model, const ShellContactOptions& options) : options_(options) {
+  // rotary_inertia_scale: the solver's s_I (SolverOptions::rotary_inertia_scale).
+  ShellContact(const ShellModel& model, const ShellContactOptions& options, double rotary_inertia_scale = 1.0)
+      : options_(options), rotary_inertia_scale_(rotary_inertia_scale) {
     validate(options_);
+    if (!(rotary_inertia_scale >= 1.0) || !std::isfinite(rotary_inertia_scale))
+      sphshell::detail::invalid_parameter("shell contact rotary_inertia_scale", rotary_inertia_scale,
+                                          "must be finite and >= 1");
     reference_ = model.particle_position;
     spacing_ = solver::local_spacing(model).particle;
     const std::vector<double>& thickness = model.particle_thicknesses();
@@ -184,6 +194,7 @@ class ShellContact {
         const auto b = static_cast<std::size_t>(pair.partner);
         loads.force[a] += pair.force;
         loads.force[b] -= pair.force;
+        loads.moment[b] += pair.partner_moment;
         result.spring_energy += 0.5 * pair.stiffness * pair.penetration * pair.penetration;
         statistics_.largest_penetration = std::max(statistics_.largest_penetration, pair.penetration);
         touches = true;
@@ -235,10 +246,13 @@ class ShellContact {
       ShellContactPair& pair = pairs[found];
       pair.partner = j;
       pair.penetration = std::max(0.0, contact_distance - distance);
-      const double mass_a = particles.mass[a], mass_b = particles.mass[b];
-      pair.stiffness = penalty_stiffness(mass_a * mass_b / (mass_a + mass_b), time_step, options_.stiffness_scale);
-      // The normal from b towards a.
+      const double mass_b = particles.mass[b], thickness_b = particles.thickness[b];
+      const double rotary_inertia_b = rotary_inertia_scale_ * mass_b * thickness_b * thickness_b / 12.0;
+      const double compliance = 1.0 / particles.mass[a] + 1.0 / mass_b + lateral_squared / rotary_inertia_b;
+      pair.stiffness = penalty_stiffness(1.0 / compliance, time_step, options_.stiffness_scale);
+      // The normal from b towards a; the arm of b's moment, x_a − x_b.
       pair.force = gap >= 0.0 ? Vector3(db) : Vector3(-db);
+      pair.partner_moment = xa - particles.position[b];
       weights[found] = weight;
       weight_sum += weight;
       ++found;
@@ -249,6 +263,7 @@ class ShellContact {
       ShellContactPair& pair = pairs[k];
       pair.stiffness *= weight_sum > 0.0 ? weights[k] / weight_sum : 0.0;
       pair.force *= pair.stiffness * pair.penetration;
+      pair.partner_moment = pair.partner_moment.cross(Vector3(-pair.force));
     }
   }
 
@@ -311,6 +326,7 @@ class ShellContact {
   }
 
   ShellContactOptions options_;
+  double rotary_inertia_scale_ = 1.0;
   std::vector<Vector3> reference_;
   std::vector<std::size_t> neighbour_begin_;
   std::vector<int> neighbours_;
