@@ -409,3 +409,63 @@ TEST_CASE("shell contact: a particle beyond the other sheet's edge is not pushed
   for (const Vector3& m : loads.moment) moments += m.norm();
   CHECK(moments > 1e-3 * scale);  // not balanced by accident: the moments are there
 }
+
+TEST_CASE("tube crush: mean crush force within 15 % of Guillow, Lu & Grzebieta (2001)",
+          "[contact][shell_contact][validation]") {
+  // examples/tube_crush.cpp at its defaults: a 6060-like aluminium tube, D 50 mm,
+  // t 2 mm (D/t = 25), 60 mm long, 3 mm spacing (52 × 21 particles), J2 with
+  // σ0 200 MPa and a 500 MPa plastic modulus, crushed 30 mm at 10 m/s
+  // (reached over the first 0.6 mm) between rigid walls with μ = 0.2, ends'
+  // rotations held, self contact on (exclusion 1.5 spacings).
+  // Guillow et al., Int. J. Mech. Sci. 43 (2001) 2103–2123, their fit to
+  // quasi-static axial crushing of circular 6060-T5 tubes:
+  //   F_av / M_p = 72.3 (D/t)^0.32,  M_p = σ0 t² / 4.
+  using TubeSolver = Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<5>, material::J2Plasticity>;
+  const double diameter = 0.05, thickness = 2e-3, length = 0.06, speed = 10.0, crush = 0.03;
+  const double yield_stress = 200e6, hardening = 500e6;
+  SolverOptions options;
+  options.density = 2700.0;
+  TubeSolver solver(ShellModel::cylindrical_panel(0.5 * diameter, length, 2.0 * pi, 52, 21, thickness),
+                    material::J2Plasticity::Parameters{70e9, 0.3, yield_stress, hardening}, options);
+  contact::ShellContactOptions self_contact;
+  self_contact.exclusion_spacings = 1.5;
+  solver.enable_shell_contact(self_contact);
+  const ShellModel& model = solver.model();
+  for (const char* end : {"z_min", "z_max"})
+    for (const Vector3& axis : {Vector3::UnitX(), Vector3::UnitY(), Vector3::UnitZ()})
+      solver.fix_rotation(model.set(end), axis);
+  contact::PenaltyOptions walls;
+  walls.friction_coefficient = 0.2;
+  solver.add_rigid_body(contact::RigidBody<contact::Plane, contact::Fixed>(contact::Plane(Vector3::UnitZ()),
+                                                                           contact::Fixed{}),
+                        walls);
+  const double ramp_time = 0.02 * crush / speed;
+  contact::RigidKinematics top;
+  top.position = Vector3(0.0, 0.0, length);
+  const contact::RigidBodyId moving = solver.add_rigid_body(
+      contact::RigidBody(contact::Plane(-Vector3::UnitZ()), contact::prescribed([=](double t) {
+                           return Vector3(0.0, 0.0, -speed * std::min(1.0, t / ramp_time));
+                         }),
+                         top),
+      walls);
+  double absorbed = 0.0, last_crush = 0.0, last_force = 0.0;
+  std::size_t most_contacts = 0;
+  solver.run_until(crush / speed + 0.5 * ramp_time, [&](const TubeSolver& s) {
+    const contact::RigidBodyState wall = s.rigid_body(moving);
+    const double now_crush = length - wall.kinematics.position.z();
+    absorbed += 0.5 * (wall.contact_force.z() + last_force) * (now_crush - last_crush);
+    last_crush = now_crush;
+    last_force = wall.contact_force.z();
+    most_contacts = std::max(most_contacts, s.shell_contact_statistics().contacts);
+  });
+  const double mean_force = absorbed / last_crush;
+  const double guillow = 72.3 * std::pow(diameter / thickness, 0.32) * yield_stress * thickness * thickness / 4.0;
+  const EnergyReport energy = solver.energy();
+  INFO("crush " << last_crush << " m, mean force " << mean_force << " N, Guillow " << guillow << " N, ratio "
+                << mean_force / guillow << ", most self contacts " << most_contacts << ", balance "
+                << energy.balance() << " J of " << energy.internal << " J");
+  CHECK(last_crush == Approx(crush).epsilon(1e-3));
+  CHECK(most_contacts > 0);  // the folds touched
+  CHECK(std::abs(energy.balance()) < 0.01 * energy.internal);
+  CHECK(mean_force == Approx(guillow).epsilon(0.15));
+}
