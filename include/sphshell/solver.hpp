@@ -190,6 +190,29 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
       return bodies_.add(std::move(body), contact_options, contact_particles(), time_step_);
     }
   }
+  // The shell's penalty contact with itself (contact/shell_contact.hpp): far
+  // parts of the shell, or two shells of the model, pushed apart when their
+  // mid-surfaces come closer than the half thicknesses; material neighbours
+  // are left out. Off unless enabled; once, before the first step. One
+  // process only: a distributed run refuses.
+  void enable_shell_contact(const contact::ShellContactOptions& contact_options = {}) {
+    if constexpr (distributed) {
+      domain_.collectively([&] {
+        throw Error("sphshell: enable_shell_contact: a distributed run has no shell contact yet; run it on one "
+                    "process");
+      });
+    } else {
+      latch_.check();
+      if (steps_ != 0)
+        detail::invalid_parameter("enable_shell_contact at step", steps_, "must come before the first step");
+      bodies_.enable_shell_contact(model_, contact_options, options_.rotary_inertia_scale);
+    }
+  }
+  // What the shell contact found in the last step, and its loads per particle.
+  contact::ShellContactStatistics shell_contact_statistics() const {
+    return bodies_.shell_contact() ? bodies_.shell_contact()->statistics() : contact::ShellContactStatistics{};
+  }
+  const contact::ParticleContactLoads& shell_contact_loads() const { return bodies_.shell_contact_loads(); }
   std::size_t rigid_body_count() const { return bodies_.size(); }
   // A body's position, velocities and the contact load of the last step.
   contact::RigidBodyState rigid_body(contact::RigidBodyId id) const { return bodies_.state(id); }
@@ -334,7 +357,7 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
                    : 0.0;
       });
       EnergyReport report = ledger_->report(domain_, stored, fracture_.released_energy());
-      if (!bodies_.empty()) report.add_rigid_bodies(bodies_.energy());
+      if (bodies_.active()) report.add_rigid_bodies(bodies_.energy());
       return report;
     }
   }
@@ -461,13 +484,13 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
     if (!loads_in_pass) apply_loads(context.at, failure);
     stop_if_alone(failure);
     // The particle pass over the owned particles (solver/particle_pass.hpp).
-    if (!bodies_.empty())
+    if (bodies_.active())
       bodies_.prepare(contact_particles(), forces_.external, forces_.external_moment, time_step_,
                       ledger_->chunk_count(particles_));
     solver::ParticlePass<Ledger, Stepper> pass{
         loads_,   load_context_at(context.at.time), constraints_, reference_position_, time_step_, *ledger_,
         stepper_, particles_, inertia_, forces_, distributed ? nullptr : &*assembler_,
-        bodies_.empty() ? nullptr : &bodies_};
+        bodies_.active() ? &bodies_ : nullptr};
     const solver::ParticlePassFailures failed = pass.run(context, loads_in_pass);
     if (failed.load < domain_.owned_count()) keep_first(failure, non_finite_load(context.at, failed.load));
     if (failed.condition_error) {
@@ -481,7 +504,7 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
     }
     stop_if_alone(failure);
     ledger_->finish_step();  // a failed step's terms never reach the books
-    if (!bodies_.empty()) bodies_.finish_step(context.at, time_step_, context.velocity_step);
+    if (bodies_.active()) bodies_.finish_step(context.at, time_step_, context.velocity_step);
     ++steps_;
     time_ = start_time_ + static_cast<double>(steps_) * time_step_;  // t = t0 + n Δt, never summed
     bodies_.write_probes(time_);

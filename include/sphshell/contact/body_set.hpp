@@ -34,7 +34,8 @@
 // work. The whole system — shell, bodies and contact springs — balances
 //   shell balance + W_cs + K_b + E_spring + D_friction − W_b = 0,
 // K_b the bodies' kinetic energy, E_spring the energy the contact springs
-// hold, D_friction what slip dissipated, and W_b the work put into the bodies
+// hold (the shell's self contact's too, when enabled: shell_contact.hpp, whose
+// forces on the shell are part of W_cs and which puts no work into a body), D_friction what slip dissipated, and W_b the work put into the bodies
 // from outside the contact: their initial kinetic energy, gravity's work
 // (free bodies, m g · Δt_v v̄) and, for a fixed or prescribed body, the work
 // of what drives it (its kinetic energy change less the contact's work on it).
@@ -47,6 +48,7 @@
 #include <sphshell/contact/penalty.hpp>
 #include <sphshell/contact/plane.hpp>
 #include <sphshell/contact/rigid_body.hpp>
+#include <sphshell/contact/shell_contact.hpp>
 #include <sphshell/contact/sphere.hpp>
 #include <sphshell/contact/surface_mesh.hpp>
 #include <sphshell/contact/triangle_surface.hpp>
@@ -261,6 +263,24 @@ class RigidBodySet {
  public:
   bool empty() const { return bodies_.empty(); }
   std::size_t size() const { return bodies_.size(); }
+  // Whether a step has contact to evaluate: bodies, or the shell's self contact.
+  bool active() const { return !bodies_.empty() || shell_contact_ != nullptr; }
+
+  // The shell's contact with itself (shell_contact.hpp), stepped with the
+  // bodies: its loads go to the particles in load_chunk(), its work and spring
+  // energy into the same books. Once per run.
+  void enable_shell_contact(const ShellModel& model, const ShellContactOptions& options,
+                            double rotary_inertia_scale = 1.0) {
+    if (shell_contact_)
+      sphshell::detail::invalid_parameter("enable_shell_contact", "a second call", "the shell contact is enabled once");
+    shell_contact_ = std::make_unique<ShellContact>(model, options, rotary_inertia_scale);
+    old_velocity_.resize(model.particle_count());
+    old_angular_velocity_.resize(model.particle_count());
+  }
+  // Null unless enabled.
+  const ShellContact* shell_contact() const { return shell_contact_.get(); }
+  // The shell contact's loads of the last step, per particle.
+  const ParticleContactLoads& shell_contact_loads() const { return shell_loads_; }
 
   // A body in contact with the particles (the whole shell, one process).
   // Refuses a body whose surface lies deeper in the shell than a particle's
@@ -295,6 +315,7 @@ class RigidBodySet {
     external_moment_ = &external_moment;
     time_step_ = time_step;
     for (auto& body : bodies_) body->prepare(chunk_count);
+    if (shell_contact_) shell_result_ = shell_contact_->compute(particles, time_step, shell_loads_);
     shell_work_slots_.assign(chunk_count, HalfStepWork{});
   }
 
@@ -313,6 +334,11 @@ class RigidBodySet {
         (*external_moment_)[i] += loads.moment[i];
       }
     }
+    if (shell_contact_)
+      for (std::size_t i = first; i < last; ++i) {
+        (*external_force_)[i] += shell_loads_.force[i];
+        (*external_moment_)[i] += shell_loads_.moment[i];
+      }
   }
 
   // In the pass, after the velocities are final (kinematic conditions imposed):
@@ -320,8 +346,7 @@ class RigidBodySet {
   void book_chunk(std::size_t chunk, std::size_t first, std::size_t last, double velocity_step) noexcept {
     const ContactParticles& particles = *particles_;
     HalfStepWork work;
-    for (const auto& body : bodies_) {
-      const ParticleContactLoads& loads = body->loads();
+    const auto add_work = [&](const ParticleContactLoads& loads) {
       for (std::size_t i = first; i < last; ++i) {
         work.first_half += 0.5 * velocity_step *
                            (loads.force[i].dot(old_velocity_[i]) + loads.moment[i].dot(old_angular_velocity_[i]));
@@ -329,7 +354,9 @@ class RigidBodySet {
                             (loads.force[i].dot(particles.velocity[i]) +
                              loads.moment[i].dot(particles.angular_velocity[i]));
       }
-    }
+    };
+    for (const auto& body : bodies_) add_work(body->loads());
+    if (shell_contact_) add_work(shell_loads_);
     shell_work_slots_[chunk] = work;
   }
 
@@ -345,6 +372,7 @@ class RigidBodySet {
       energy_.body_work += body_work;
       kinetic += body->state().kinetic_energy;
     }
+    if (shell_contact_) spring += shell_result_.spring_energy;
     for (const HalfStepWork& work : shell_work_slots_) {
       energy_.shell_contact_work += work.first_half + work.second_half;
       second_half += work.second_half;
@@ -462,6 +490,9 @@ class RigidBodySet {
   }
 
   std::vector<std::unique_ptr<detail::BodyContact>> bodies_;
+  std::unique_ptr<ShellContact> shell_contact_;  // null: no self contact
+  ParticleContactLoads shell_loads_;
+  ContactStepResult shell_result_;
   std::unique_ptr<ContactParticles> particles_;  // the solver's arrays, this step
   std::vector<Vector3>* external_force_ = nullptr;
   std::vector<Vector3>* external_moment_ = nullptr;

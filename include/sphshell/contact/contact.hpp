@@ -12,7 +12,9 @@
 //       whether the shape is a finite solid (a plane is not: it has no finite
 //       rotational inertia, so a free plane only translates).
 // rigid_body.hpp places a shape in the world (position, orientation) and moves
-// it; penalty.hpp pushes shell particles out of it.
+// it; penalty.hpp pushes shell particles out of it. shell_contact.hpp is the
+// shell's penalty contact with itself (no rigid shape: the other side is the
+// shell), stepped with the bodies.
 
 #include <sphshell/core/types.hpp>
 
