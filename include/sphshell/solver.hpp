@@ -36,6 +36,7 @@
 #include <sphshell/approx/approx.hpp>
 #include <sphshell/approx/memory_estimate.hpp>
 #include <sphshell/contact/body_set.hpp>
+#include <sphshell/contact/solver_contact.hpp>
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/parallel.hpp>
 #include <sphshell/core/types.hpp>
@@ -86,7 +87,8 @@ template <class Approx, class Rule, class Material, class Crack = crack::None,
           class Stepper = stepper::CentralDifference, class Domain = domain::Serial>
 class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, Crack, Stepper, Domain>>,
                public solver::PointShare<Approx, Rule, Material, Domain>,
-               public solver::CheckpointIO<Solver<Approx, Rule, Material, Crack, Stepper, Domain>> {
+               public solver::CheckpointIO<Solver<Approx, Rule, Material, Crack, Stepper, Domain>>,
+               public contact::SolverContact<Solver<Approx, Rule, Material, Crack, Stepper, Domain>> {
   using Share = solver::PointShare<Approx, Rule, Material, Domain>;
   using Share::domain_, Share::particles_, Share::inertia_, Share::forces_, Share::reference_position_,
       Share::reference_normal_, Share::points_, Share::all_points_, Share::states_, Share::point_owned_,
@@ -170,55 +172,6 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
       this->check_stress_point(stress_point);
       output_->add_probe(csv_path, typename Output::StressProbe{stress_point}, *this);
     });
-  }
-  // A rigid body (contact/rigid_body.hpp) in penalty contact with the shell
-  // (contact/penalty.hpp: k = s m / Δt², offsets of half the thickness,
-  // Coulomb friction); a free body moves under the contact's reaction. The
-  // run's time step is kept. Returns the body's id for rigid_body() and
-  // add_rigid_body_probe(). One process only: a distributed run refuses.
-  template <class Shape, class Motion>
-  contact::RigidBodyId add_rigid_body(contact::RigidBody<Shape, Motion> body,
-                                      const contact::PenaltyOptions& contact_options = {}) {
-    if constexpr (distributed) {
-      domain_.collectively([&] {
-        throw Error("sphshell: add_rigid_body: a distributed run has no rigid bodies yet (the contact reactions "
-                    "are not summed over the processes); run the impact on one process");
-      });
-      return 0;
-    } else {
-      latch_.check();
-      return bodies_.add(std::move(body), contact_options, contact_particles(), time_step_);
-    }
-  }
-  // The shell's penalty contact with itself (contact/shell_contact.hpp): far
-  // parts of the shell, or two shells of the model, pushed apart when their
-  // mid-surfaces come closer than the half thicknesses; material neighbours
-  // are left out. Off unless enabled; once, before the first step. One
-  // process only: a distributed run refuses.
-  void enable_shell_contact(const contact::ShellContactOptions& contact_options = {}) {
-    if constexpr (distributed) {
-      domain_.collectively([&] {
-        throw Error("sphshell: enable_shell_contact: a distributed run has no shell contact yet; run it on one "
-                    "process");
-      });
-    } else {
-      latch_.check();
-      if (steps_ != 0)
-        detail::invalid_parameter("enable_shell_contact at step", steps_, "must come before the first step");
-      bodies_.enable_shell_contact(model_, contact_options, options_.rotary_inertia_scale);
-    }
-  }
-  // What the shell contact found in the last step, and its loads per particle.
-  contact::ShellContactStatistics shell_contact_statistics() const {
-    return bodies_.shell_contact() ? bodies_.shell_contact()->statistics() : contact::ShellContactStatistics{};
-  }
-  const contact::ParticleContactLoads& shell_contact_loads() const { return bodies_.shell_contact_loads(); }
-  std::size_t rigid_body_count() const { return bodies_.size(); }
-  // A body's position, velocities and the contact load of the last step.
-  contact::RigidBodyState rigid_body(contact::RigidBodyId id) const { return bodies_.state(id); }
-  // CSV time history of a body (contact/body_set.hpp): now and after every step.
-  void add_rigid_body_probe(const std::string& csv_path, contact::RigidBodyId id) {
-    bodies_.add_probe(csv_path, id, time_);
   }
   // Writes one ParaView frame now (particles, stress points and cracks),
   // whatever the output interval; requires output_directory. Collective.
@@ -370,6 +323,7 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
   friend class solver::CheckpointIO<Solver>;
   friend class solver::FramePiece<Solver>;
   friend class solver::StaticSolution<Solver>;
+  friend class contact::SolverContact<Solver>;
   StepTime now() const { return {steps_, time_}; }
   contact::ContactParticles contact_particles() {
     return {particles_.position, particles_.director, particles_.velocity, particles_.angular_velocity,
