@@ -212,7 +212,7 @@ class CommandLine {
       }
       option->set(value);
     }
-    std::cout << build_line() << '\n';
+    std::cout << build_line() << '\n' << std::flush;  // first, also when the streams go to one file
     return true;
   }
 
