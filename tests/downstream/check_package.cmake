@@ -68,8 +68,10 @@ elseif(PREFIX)
 endif()
 
 if(CONSUMER STREQUAL "find_package" OR CONSUMER STREQUAL "find_package-simd")
-  file(STRINGS ${WORK_DIR}/sphshell-build/CMakeCache.txt chosen REGEX "^SPHSHELL_SIMD_CHOSEN:")
-  string(REGEX REPLACE "^[^=]*=" "" chosen "${chosen}")
+  # The set the installed package records (its config file), whichever
+  # install (this check's own or the shared one) made it.
+  file(STRINGS ${moved_prefix}/share/sphshell/cmake/sphshellConfig.cmake chosen REGEX "^set\\(sphshell_SIMD ")
+  string(REGEX REPLACE "^set\\(sphshell_SIMD ([A-Z0-9_]*)\\).*" "\\1" chosen "${chosen}")
   if(chosen STREQUAL "" OR (CONSUMER STREQUAL "find_package-simd" AND NOT chosen STREQUAL "SSE2"))
     message(FATAL_ERROR "the package's SPHSHELL_SIMD resolved to '${chosen}'")
   endif()
