@@ -653,18 +653,19 @@ PathRun follow_arc_length(const ShellModel& model, double E, double nu, const So
                                          });
 }
 
-// The path's readings where its load factor first reaches `lambda` (what load
-// control would give: past a snap-through, the far branch), by quadratic
-// interpolation in the control displacement through the two points around
-// the crossing and the next (or the one before, at the end). Empty when the
-// path never reaches `lambda`.
-inline std::vector<double> readings_at_load_factor(const std::vector<PathPoint>& path, double lambda) {
-  std::size_t k = 1;
-  while (k < path.size() && path[k].load_factor < lambda) ++k;
-  if (k >= path.size()) return {};
-  const std::size_t first = k + 1 < path.size() ? k - 1 : (k >= 2 ? k - 2 : k - 1);
-  const std::size_t count = std::min<std::size_t>(3, path.size() - first);
-  auto lagrange = [&](double s, auto&& value_of) {
+// The path between its points k − 1 and k (k ≥ 1) as a function of the
+// control displacement s: the quadratic through those two points and the
+// next (the one before, at the path's end; a line on a two-point path),
+// evaluated for the quantity value_of(point).
+struct PathStep {
+  const std::vector<PathPoint>& path;
+  std::size_t first, count;
+  PathStep(const std::vector<PathPoint>& path_, std::size_t k)
+      : path(path_),
+        first(k + 1 < path_.size() ? k - 1 : (k >= 2 ? k - 2 : k - 1)),
+        count(std::min<std::size_t>(3, path_.size() - first)) {}
+  template <class ValueOf>
+  double operator()(double s, ValueOf&& value_of) const {
     double sum = 0.0;
     for (std::size_t i = first; i < first + count; ++i) {
       double basis = 1.0;
@@ -673,7 +674,18 @@ inline std::vector<double> readings_at_load_factor(const std::vector<PathPoint>&
       sum += basis * value_of(path[i]);
     }
     return sum;
-  };
+  }
+};
+
+// The path's readings where its load factor first reaches `lambda` (what load
+// control would give: past a snap-through, the far branch), by PathStep's
+// interpolation in the control displacement over the step of the crossing.
+// Empty when the path never reaches `lambda`.
+inline std::vector<double> readings_at_load_factor(const std::vector<PathPoint>& path, double lambda) {
+  std::size_t k = 1;
+  while (k < path.size() && path[k].load_factor < lambda) ++k;
+  if (k >= path.size()) return {};
+  const PathStep lagrange(path, k);
   const auto load_factor = [](const PathPoint& point) { return point.load_factor; };
   // λ(s) − lambda changes sign on [s_{k−1}, s_k] (the interpolant passes through both points).
   double low = path[k - 1].control, high = path[k].control;
@@ -775,26 +787,14 @@ inline double limit_load_factor(const std::vector<LoadDeflection>& table) {
 // (load factor / load_scale, reading `reading` / deflection_scale): a path
 // that turns back in both (a snap-back) has no single value at a load or a
 // deflection, so a point is compared with the nearest point of the curve.
-// Between steps the curve is the quadratic in the control through the step's
-// two ends and the next point (the one before, at the end), as in
+// Between steps the curve is PathStep's quadratic, as in
 // readings_at_load_factor, sampled finely.
 inline double distance_to_path(const std::vector<PathPoint>& path, std::size_t reading, const LoadDeflection& point,
                                double load_scale, double deflection_scale) {
   constexpr int samples = 128;
   double nearest = std::numeric_limits<double>::infinity();
   for (std::size_t k = 1; k < path.size(); ++k) {
-    const std::size_t first = k + 1 < path.size() ? k - 1 : (k >= 2 ? k - 2 : k - 1);
-    const std::size_t count = std::min<std::size_t>(3, path.size() - first);
-    auto lagrange = [&](double s, auto&& value_of) {
-      double sum = 0.0;
-      for (std::size_t i = first; i < first + count; ++i) {
-        double basis = 1.0;
-        for (std::size_t j = first; j < first + count; ++j)
-          if (j != i) basis *= (s - path[j].control) / (path[i].control - path[j].control);
-        sum += basis * value_of(path[i]);
-      }
-      return sum;
-    };
+    const PathStep lagrange(path, k);
     for (int m = 0; m <= samples; ++m) {
       const double s = path[k - 1].control + (path[k].control - path[k - 1].control) * m / samples;
       const double load = lagrange(s, [](const PathPoint& p) { return p.load_factor; });
