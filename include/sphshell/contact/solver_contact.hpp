@@ -3,16 +3,30 @@
 // bodies and the shell's contact with itself. The bodies and the shell
 // contact live in the solver's RigidBodySet (contact/body_set.hpp), which
 // the step calls before and after its particle pass; this part adds them,
-// queries them and writes their probes. The solver gives it its domain,
-// model, options, time, time step, step latch and contact particles.
+// queries them, writes their probes and ends their step. The solver gives it
+// its domain, model, options, time, time step, step latch and contact
+// particles.
+//
+// Distributed (mpi::Domain): every process holds every body, each evaluates
+// the contact of the particles it owns, and the step's sums (the reaction on
+// each body, the energy terms) are formed from every process's per-particle
+// terms in the order of a serial run's particle pass (RigidBodySet::
+// finish_step), so the bodies move alike on every process and by the bits of
+// the serial run. A body's probe is written by process 0. The shell's
+// contact with itself needs the particles near an owned one, which a
+// process's ghosts do not cover: a distributed run refuses it.
 
 #include <sphshell/contact/body_set.hpp>
 #include <sphshell/contact/shell_contact.hpp>
 #include <sphshell/core/error.hpp>
+#include <sphshell/domain/domain.hpp>
+#include <sphshell/solver/energy_ledger.hpp>
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace sphshell::contact {
 
@@ -23,14 +37,29 @@ class SolverContact {
   // (contact/penalty.hpp: k = s m / Δt², offsets of half the thickness,
   // Coulomb friction); a free body moves under the contact's reaction. The
   // run's time step is kept. Returns the body's id for rigid_body() and
-  // add_rigid_body_probe(). One process only: a distributed run refuses.
+  // add_rigid_body_probe(). A body that starts inside the shell beyond a
+  // particle's half thickness is refused, naming the particle of lowest
+  // global id (the same Error on every process). Distributed: collective,
+  // every process adds the same body.
   template <class Shape, class Motion>
   RigidBodyId add_rigid_body(RigidBody<Shape, Motion> body, const PenaltyOptions& contact_options = {}) {
     Solver& s = solver();
-    one_process("add_rigid_body: a distributed run has no rigid bodies yet (the contact reactions are not summed "
-                "over the processes); run the impact on one process");
     s.latch_.check();
-    return s.bodies_.add(std::move(body), contact_options, s.contact_particles(), s.time_step_);
+    s.domain_.collectively([&] { validate(contact_options); });
+    const ContactParticles particles = s.contact_particles();
+    std::optional<domain::Failure> failure;
+    if (const auto inside = RigidBodySet::start_inside(body, particles, s.domain_.owned_count(),
+                                                       [&](std::size_t i) { return s.domain_.global_of(i); })) {
+      try {
+        s.bodies_.refuse_start_inside(*inside);
+      } catch (...) {
+        failure = s.domain_.failure_of_current_exception(inside->particle);
+      }
+    }
+    s.domain_.agree(failure);
+    RigidBodyId id = 0;
+    s.domain_.collectively([&] { id = s.bodies_.add(std::move(body), contact_options, particles, s.time_step_); });
+    return id;
   }
   // The shell's penalty contact with itself (contact/shell_contact.hpp): far
   // parts of the shell, or two shells of the model, pushed apart when their
@@ -39,7 +68,9 @@ class SolverContact {
   // process only: a distributed run refuses.
   void enable_shell_contact(const ShellContactOptions& contact_options = {}) {
     Solver& s = solver();
-    one_process("enable_shell_contact: a distributed run has no shell contact yet; run it on one process");
+    one_process("enable_shell_contact: a distributed run has no shell contact (a process's ghosts do not hold "
+                "every particle near the ones it owns); run the self contact on one process, rigid bodies run "
+                "distributed");
     s.latch_.check();
     if (s.steps_ != 0)
       sphshell::detail::invalid_parameter("enable_shell_contact at step", s.steps_, "must come before the first step");
@@ -54,9 +85,47 @@ class SolverContact {
   std::size_t rigid_body_count() const { return solver().bodies_.size(); }
   // A body's position, velocities and the contact load of the last step.
   RigidBodyState rigid_body(RigidBodyId id) const { return solver().bodies_.state(id); }
-  // CSV time history of a body (contact/body_set.hpp): now and after every step.
+  // CSV time history of a body (contact/body_set.hpp): now and after every
+  // step. Distributed: collective, written by process 0 (an Error there, such
+  // as a path that cannot be written, is the Error of every process).
   void add_rigid_body_probe(const std::string& csv_path, RigidBodyId id) {
-    solver().bodies_.add_probe(csv_path, id, solver().time_);
+    Solver& s = solver();
+    s.domain_.collectively([&] {
+      s.bodies_.check(id);
+      if (s.domain_.is_root()) s.bodies_.add_probe(csv_path, id, s.time_);
+    });
+  }
+
+ protected:
+  // The particles' thicknesses in the local numbering (the model's serially).
+  const std::vector<double>& contact_thicknesses() const {
+    const Solver& s = solver();
+    if constexpr (!Solver::distributed) {
+      return s.model_.particle_thicknesses();
+    } else {
+      if (local_thickness_.size() != s.domain_.local_count()) {
+        local_thickness_.resize(s.domain_.local_count());
+        for (std::size_t i = 0; i < local_thickness_.size(); ++i)
+          local_thickness_[i] = s.model_.particle_thicknesses()[static_cast<std::size_t>(s.domain_.global_of(i))];
+      }
+      return local_thickness_;
+    }
+  }
+  // After the particle pass: the bodies move by the sums of every process's
+  // terms (RigidBodySet::finish_step; one all-gather of the terms of the
+  // particles near a body when distributed), and the books add the step.
+  void finish_contact_step(const StepTime& at, double velocity_step) {
+    Solver& s = solver();
+    const auto global_of = [&](std::size_t i) { return s.domain_.global_of(i); };
+    constexpr std::size_t chunk = solver::ParticleEnergyTerms::sum_chunk;
+    if constexpr (Solver::distributed) {
+      const typename Solver::domain_type::Timer timer(s.domain_);
+      s.bodies_.finish_step(at, s.time_step_, velocity_step, chunk, global_of,
+                            [&](std::vector<ContactTerm>&& mine) { return s.domain_.communicator().all_gather_v(mine); });
+    } else {
+      s.bodies_.finish_step(at, s.time_step_, velocity_step, chunk, global_of,
+                            [](std::vector<ContactTerm>&& mine) { return std::move(mine); });
+    }
   }
 
  private:
@@ -67,6 +136,7 @@ class SolverContact {
     if constexpr (Solver::distributed)
       solver().domain_.collectively([&] { throw Error(std::string("sphshell: ") + what); });
   }
+  mutable std::vector<double> local_thickness_;  // distributed: contact_thicknesses()
 };
 
 }  // namespace sphshell::contact
