@@ -440,9 +440,7 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
     if (!loads_in_pass) apply_loads(context.at, failure);
     stop_if_alone(failure);
     // The particle pass over the owned particles (solver/particle_pass.hpp).
-    if (bodies_.active())
-      bodies_.prepare(contact_particles(), forces_.external, forces_.external_moment, time_step_,
-                      ledger_->chunk_count(particles_));
+    if (bodies_.active()) this->prepare_contact_step(ledger_->chunk_count(particles_));
     solver::ParticlePass<Ledger, Stepper> pass{
         loads_,   load_context_at(context.at.time), constraints_, reference_position_, time_step_, *ledger_,
         stepper_, particles_, inertia_, forces_, distributed ? nullptr : &*assembler_,

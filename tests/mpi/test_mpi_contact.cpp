@@ -1,5 +1,5 @@
-// Rigid bodies in a distributed run (contact/solver_contact.hpp) against the
-// serial Solver: the same model run by sphshell::Solver in one process (on
+// Rigid bodies and the shell's contact with itself in a distributed run
+// (contact/solver_contact.hpp) against the serial Solver: the same model run by sphshell::Solver in one process (on
 // every rank, as the independent reference) and by the distributed Solver
 // over the ranks. The particles' positions, directors and velocities, the
 // bodies' state (position, velocities, contact force, moment, impulse,
@@ -82,6 +82,34 @@ auto pressing_wall(double gap, double speed, double ramp_time) {
   const Vector3 downward_normal = -Vector3(3e-4, 1e-4, 1.0).normalized();
   return contact::RigidBody(contact::Plane(downward_normal), contact::prescribed(WallVelocity{speed, ramp_time}),
                             corner);
+}
+
+// Two n × n square plates of side `side` in the planes z = 0 and z = gap,
+// directors +z, one model: the sets "upper", "lower" and "lower_edge".
+ShellModel two_plates(int n, double side, double gap, double thickness) {
+  std::vector<Vector3> positions, normals;
+  std::vector<Quad> quads;
+  const double spacing = side / (n - 1);
+  for (int sheet = 0; sheet < 2; ++sheet) {
+    const int base = sheet * n * n;
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        positions.emplace_back(i * spacing, j * spacing, sheet * gap);
+        normals.push_back(Vector3::UnitZ());
+      }
+    for (int i = 0; i + 1 < n; ++i)
+      for (int j = 0; j + 1 < n; ++j)
+        quads.push_back({base + i * n + j, base + (i + 1) * n + j, base + (i + 1) * n + j + 1, base + i * n + j + 1});
+  }
+  ShellModel model = ShellModel::from_quads(positions, normals, quads, thickness);
+  const double edge = 1e-3 * spacing;
+  model.define_set("upper", [gap](const Vector3& X) { return X.z() > 0.5 * gap; });
+  model.define_set("lower", [gap](const Vector3& X) { return X.z() < 0.5 * gap; });
+  model.define_set("lower_edge", [=](const Vector3& X) {
+    return X.z() < 0.5 * gap &&
+           (X.x() < edge || X.y() < edge || X.x() > side - edge || X.y() > side - edge);
+  });
+  return model;
 }
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof(double)) == 0; }
@@ -307,7 +335,65 @@ TEST_CASE("Distributed rigid bodies: refused input is the serial Error on every 
   const std::string bad_path = (fs::temp_directory_path() / "sphshell_no_such_directory" / "probe.csv").string();
   CHECK_THAT(message_of([&] { distributed.add_rigid_body_probe(bad_path, 0); }),
              Catch::Contains("rigid body probe path"));
-  // The shell's self contact stays one process's: refused, naming what runs distributed.
-  CHECK_THAT(message_of([&] { distributed.enable_shell_contact(); }),
-             Catch::Contains("a distributed run has no shell contact") && Catch::Contains("rigid bodies run distributed"));
+  // The shell contact enabled twice: the serial Error.
+  serial.enable_shell_contact();
+  distributed.enable_shell_contact();
+  const std::string serial_twice = message_of([&] { serial.enable_shell_contact(); });
+  CHECK_THAT(serial_twice, Catch::Contains("enable_shell_contact"));
+  CHECK(message_of([&] { distributed.enable_shell_contact(); }) == serial_twice);
+}
+
+TEST_CASE("Distributed shell contact: a plate driven onto another, bitwise serial", "[mpi][contact][shell_contact]") {
+  const mpi::Communicator comm;
+  // 0.1 m square steel plates, 2 mm thick, 11 × 11 particles (10 mm apart),
+  // 21 mm apart: beyond the 20 mm support radius, so they share no
+  // approximation rows; only the contact joins them.
+  const double side = 0.1, thickness = 2e-3, gap = 0.021;
+  const ShellModel model = two_plates(11, side, gap, thickness);
+  const material::Elastic::Parameters steel{steel_E, steel_nu};
+  Serial<material::Elastic> serial(model, steel, plate_options());
+  Distributed<material::Elastic> distributed(comm, model, steel, plate_options());
+  // The upper plate is driven down rigidly: fast over 200 steps until its
+  // lower face is 0.1 mm above the lower plate's upper face, then at 10 m/s
+  // into it; the lower plate is clamped at its edges.
+  const double dt = serial.time_step(), approach = gap - thickness - 1e-4, steps_to_close = 200;
+  const double fast = approach / (steps_to_close * dt), switch_time = steps_to_close * dt, slow = 10.0;
+  const auto driven = [=](const Vector3&, double t) { return Vector3(0.0, 0.0, t < switch_time ? -fast : -slow); };
+  const auto set_up = [&](auto& solver) {
+    solver.clamp("lower_edge");
+    solver.prescribe_velocity("upper", driven);
+    solver.enable_shell_contact();
+  };
+  set_up(serial);
+  set_up(distributed);
+  std::size_t most_contacts = 0;
+  long steps_in_contact = 0;
+  for (long n = 0; n < 400; ++n) {
+    serial.step();
+    distributed.step();
+    const contact::ShellContactStatistics s = serial.shell_contact_statistics(),
+                                          d = distributed.shell_contact_statistics();
+    CHECK(d.contacts == s.contacts);
+    CHECK(d.candidate_pairs == s.candidate_pairs);
+    CHECK(same_bits(d.largest_penetration, s.largest_penetration));
+    CHECK(same_bits(d.spring_energy, s.spring_energy));
+    most_contacts = std::max(most_contacts, s.contacts);
+    if (s.contacts > 0) ++steps_in_contact;
+  }
+  // The plates met over much of their area, for many steps.
+  CHECK(most_contacts > 50);
+  CHECK(steps_in_contact > 100);
+  compare_runs("plate driven onto a plate", serial, distributed, 0);
+  // The shell contact's loads on this rank's particles are the serial run's.
+  std::size_t differing = 0;
+  const contact::ParticleContactLoads& local = distributed.shell_contact_loads();
+  const contact::ParticleContactLoads& whole = serial.shell_contact_loads();
+  for (std::size_t i = 0; i < distributed.layout().owned_count(); ++i) {
+    const auto g = static_cast<std::size_t>(distributed.global_id(i));
+    if (!same_bits(local.force[i], whole.force[g]) || !same_bits(local.moment[i], whole.moment[g])) ++differing;
+  }
+  CHECK(differing == 0);
+  if (comm.is_root())
+    WARN("plate driven onto a plate on " << comm.size() << " ranks: bitwise over 400 steps, " << steps_in_contact
+                                         << " with shell contact, up to " << most_contacts << " particles");
 }

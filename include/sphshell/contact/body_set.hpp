@@ -278,8 +278,9 @@ class RigidBodySet {
   bool active() const { return !bodies_.empty() || shell_contact_ != nullptr; }
 
   // The shell's contact with itself (shell_contact.hpp), stepped with the
-  // bodies: its loads go to the particles in load_chunk(), its work and spring
-  // energy into the same books. Once per run.
+  // bodies: computed by compute_shell_contact() after prepare(), its loads go
+  // to the particles in load_chunk(), its work and spring energy into the
+  // same books. Once per run.
   void enable_shell_contact(const ShellModel& model, const ShellContactOptions& options,
                             double rotary_inertia_scale = 1.0) {
     if (shell_contact_)
@@ -287,11 +288,10 @@ class RigidBodySet {
     shell_contact_ = std::make_unique<ShellContact>(model, options, rotary_inertia_scale);
     old_velocity_.resize(model.particle_count());
     old_angular_velocity_.resize(model.particle_count());
-    shell_work_.resize(model.particle_count());
   }
   // Null unless enabled.
   const ShellContact* shell_contact() const { return shell_contact_.get(); }
-  // The shell contact's loads of the last step, per particle.
+  // The shell contact's loads of the last step, per particle (local numbering).
   const ParticleContactLoads& shell_contact_loads() const { return shell_loads_; }
 
   // Where a body would start inside the shell: the particle (its global id)
@@ -352,9 +352,29 @@ class RigidBodySet {
     external_force_ = &external_force;
     external_moment_ = &external_moment;
     time_step_ = time_step;
-    chunk_count_ = chunk_count;
     for (auto& body : bodies_) body->prepare(chunk_count);
-    if (shell_contact_) shell_result_ = shell_contact_->compute(particles, time_step, shell_loads_);
+    shell_chunk_terms_.resize(chunk_count);
+    for (std::vector<ContactTerm>& terms : shell_chunk_terms_) terms.clear();
+  }
+
+  // After prepare(), with the shell contact enabled: its loads at
+  // configuration n. `whole` is every particle of the model, numbered
+  // globally (one process's own arrays; a distributed run's gathered
+  // positions and directors: the contact reads positions, directors, masses
+  // and thicknesses, and a fold's far side is no ghost of a process), so
+  // every process computes what one process would; the loads of its `local`
+  // particles (global_of numbers them) are kept.
+  template <class GlobalOf>
+  void compute_shell_contact(const ContactParticles& whole, double time_step, std::size_t local,
+                             GlobalOf&& global_of) {
+    shell_result_ = shell_contact_->compute(whole, time_step, shell_whole_loads_);
+    shell_loads_.force.resize(local);
+    shell_loads_.moment.resize(local);
+    for (std::size_t i = 0; i < local; ++i) {
+      const auto g = static_cast<std::size_t>(global_of(i));
+      shell_loads_.force[i] = shell_whole_loads_.force[g];
+      shell_loads_.moment[i] = shell_whole_loads_.moment[g];
+    }
   }
 
   // In the pass, after the chunk's loads: the bodies' contact loads added to them.
@@ -399,7 +419,14 @@ class RigidBodySet {
         term.work_second_half = second_half(body->loads(), i);
       }
     if (shell_contact_)
-      for (std::size_t i = first; i < last; ++i) shell_work_[i] = {first_half(shell_loads_, i), second_half(shell_loads_, i)};
+      for (std::size_t i = first; i < last; ++i)
+        if ((shell_loads_.force[i].array() != 0.0).any() || (shell_loads_.moment[i].array() != 0.0).any()) {
+          ContactTerm term;
+          term.particle = static_cast<std::int64_t>(i);
+          term.work_first_half = first_half(shell_loads_, i);
+          term.work_second_half = second_half(shell_loads_, i);
+          shell_chunk_terms_[chunk].push_back(term);
+        }
   }
 
   // After the pass (which did not fail): the bodies move, the books add the
@@ -408,10 +435,12 @@ class RigidBodySet {
   // those of all processes; `global_of` numbers a local particle globally.
   // The sums are then formed from the terms in one fixed order, the order of
   // one process's particle pass: within the chunks of `particles_per_chunk`
-  // particles (ParticleEnergyTerms::sum_chunk) in index order, body by body,
-  // then chunk by chunk. So every process moves the bodies alike, by the
-  // same bits as one process would, whatever the split of the particles
-  // between processes and threads.
+  // particles (ParticleEnergyTerms::sum_chunk) in index order, body by body
+  // (the shell contact's work last, as if it were one more body), then chunk
+  // by chunk. So every process moves the bodies alike, by the same bits as
+  // one process would, whatever the split of the particles between
+  // processes and threads. A particle without a term adds ±0 to a sum that
+  // is never −0: nothing.
   template <class GlobalOf, class Gather>
   void finish_step(const StepTime& at, double time_step, double velocity_step, std::size_t particles_per_chunk,
                    GlobalOf&& global_of, Gather&& gather) {
@@ -423,6 +452,13 @@ class RigidBodySet {
           term.body = static_cast<std::int64_t>(b);
           mine.push_back(term);
         }
+    const auto shell = static_cast<std::int64_t>(bodies_.size());
+    for (const std::vector<ContactTerm>& chunk : shell_chunk_terms_)
+      for (ContactTerm term : chunk) {
+        term.particle = static_cast<std::int64_t>(global_of(static_cast<std::size_t>(term.particle)));
+        term.body = shell;
+        mine.push_back(term);
+      }
     std::vector<ContactTerm> terms = gather(std::move(mine));
     const auto chunk_of = [&](const ContactTerm& term) {
       return static_cast<std::size_t>(term.particle) / particles_per_chunk;
@@ -434,7 +470,7 @@ class RigidBodySet {
       return a.body != b.body ? a.body < b.body : a.particle < b.particle;
     });
     std::vector<ContactStepResult> totals(bodies_.size());
-    for (std::size_t k = 0; k < terms.size();) {
+    for (std::size_t k = 0; k < terms.size() && terms[k].body != shell;) {
       ContactStepResult chunk_sum;
       const std::int64_t body = terms[k].body;
       const std::size_t chunk = chunk_of(terms[k]);
@@ -455,27 +491,20 @@ class RigidBodySet {
     }
     if (shell_contact_) spring += shell_result_.spring_energy;
     // The contact forces' work on the particles: a sum per chunk (the bodies'
-    // terms in body and index order, then the shell contact's, of one process
-    // only), the chunks' sums in chunk order.
+    // terms in body and index order, then the shell contact's), the chunks'
+    // sums in chunk order.
     std::sort(terms.begin(), terms.end(), [&](const ContactTerm& a, const ContactTerm& b) {
       const std::size_t chunk_a = chunk_of(a), chunk_b = chunk_of(b);
       if (chunk_a != chunk_b) return chunk_a < chunk_b;
       return a.body != b.body ? a.body < b.body : a.particle < b.particle;
     });
-    const std::size_t chunks =
-        std::max(shell_contact_ ? chunk_count_ : 0, terms.empty() ? 0 : chunk_of(terms.back()) + 1);
-    for (std::size_t chunk = 0, k = 0; chunk < chunks; ++chunk) {
+    for (std::size_t k = 0; k < terms.size();) {
       HalfStepWork work;
+      const std::size_t chunk = chunk_of(terms[k]);
       for (; k < terms.size() && chunk_of(terms[k]) == chunk; ++k) {
         work.first_half += terms[k].work_first_half;
         work.second_half += terms[k].work_second_half;
       }
-      if (shell_contact_)
-        for (std::size_t i = chunk * particles_per_chunk;
-             i < std::min(shell_work_.size(), (chunk + 1) * particles_per_chunk); ++i) {
-          work.first_half += shell_work_[i].first_half;
-          work.second_half += shell_work_[i].second_half;
-        }
       energy_.shell_contact_work += work.first_half + work.second_half;
       second_half += work.second_half;
     }
@@ -596,7 +625,9 @@ class RigidBodySet {
 
   std::vector<std::unique_ptr<detail::BodyContact>> bodies_;
   std::unique_ptr<ShellContact> shell_contact_;  // null: no self contact
-  ParticleContactLoads shell_loads_;
+  ParticleContactLoads shell_loads_;        // local numbering
+  ParticleContactLoads shell_whole_loads_;  // every particle of the model
+  std::vector<std::vector<ContactTerm>> shell_chunk_terms_;  // its work, per chunk of the pass
   ContactStepResult shell_result_;
   std::unique_ptr<ContactParticles> particles_;  // the solver's arrays, this step
   std::vector<Vector3>* external_force_ = nullptr;
@@ -608,8 +639,7 @@ class RigidBodySet {
   struct HalfStepWork {
     double first_half = 0.0, second_half = 0.0;
   };
-  std::vector<HalfStepWork> shell_work_;  // the shell contact's, per particle
-  std::size_t chunk_count_ = 0;           // of this step's particle pass
+
   ContactEnergy energy_;
   std::vector<Probe> probes_;
 };

@@ -13,8 +13,12 @@
 // terms in the order of a serial run's particle pass (RigidBodySet::
 // finish_step), so the bodies move alike on every process and by the bits of
 // the serial run. A body's probe is written by process 0. The shell's
-// contact with itself needs the particles near an owned one, which a
-// process's ghosts do not cover: a distributed run refuses it.
+// contact with itself needs every particle that can touch an owned one, and
+// the far side of a fold is no ghost (the ghosts are material neighbours):
+// every process gathers all positions and directors each step and computes
+// the whole shell's contact, as one process would, keeping its own
+// particles' loads (O(N) per process and step: correct at any rank count,
+// not yet a distributed search).
 
 #include <sphshell/contact/body_set.hpp>
 #include <sphshell/contact/shell_contact.hpp>
@@ -64,17 +68,25 @@ class SolverContact {
   // The shell's penalty contact with itself (contact/shell_contact.hpp): far
   // parts of the shell, or two shells of the model, pushed apart when their
   // mid-surfaces come closer than the half thicknesses; material neighbours
-  // are left out. Off unless enabled; once, before the first step. One
-  // process only: a distributed run refuses.
+  // are left out. Off unless enabled; once, before the first step.
+  // Distributed: collective (see above).
   void enable_shell_contact(const ShellContactOptions& contact_options = {}) {
     Solver& s = solver();
-    one_process("enable_shell_contact: a distributed run has no shell contact (a process's ghosts do not hold "
-                "every particle near the ones it owns); run the self contact on one process, rigid bodies run "
-                "distributed");
     s.latch_.check();
-    if (s.steps_ != 0)
-      sphshell::detail::invalid_parameter("enable_shell_contact at step", s.steps_, "must come before the first step");
-    s.bodies_.enable_shell_contact(s.model_, contact_options, s.options_.rotary_inertia_scale);
+    s.domain_.collectively([&] {
+      if (s.steps_ != 0)
+        sphshell::detail::invalid_parameter("enable_shell_contact at step", s.steps_,
+                                            "must come before the first step");
+      s.bodies_.enable_shell_contact(s.model_, contact_options, s.options_.rotary_inertia_scale);
+    });
+    if constexpr (Solver::distributed) {
+      // Every particle's mass (fixed from the set-up on), from its owner.
+      std::vector<Vector3> mass(s.domain_.owned_count());
+      for (std::size_t i = 0; i < mass.size(); ++i) mass[i] = Vector3(s.inertia_.mass[i], 0.0, 0.0);
+      const std::vector<Vector3> whole = s.domain_.gathered(mass);
+      whole_mass_.resize(whole.size());
+      for (std::size_t g = 0; g < whole.size(); ++g) whole_mass_[g] = whole[g].x();
+    }
   }
   // What the shell contact found in the last step, and its loads per particle.
   ShellContactStatistics shell_contact_statistics() const {
@@ -111,6 +123,26 @@ class SolverContact {
       return local_thickness_;
     }
   }
+  // Before the particle pass: the bodies' and shell contact's step prepared,
+  // the shell contact computed (over the whole shell: see above).
+  void prepare_contact_step(std::size_t chunk_count) {
+    Solver& s = solver();
+    const ContactParticles particles = s.contact_particles();
+    s.bodies_.prepare(particles, s.forces_.external, s.forces_.external_moment, s.time_step_, chunk_count);
+    if (!s.bodies_.shell_contact()) return;
+    const auto global_of = [&](std::size_t i) { return s.domain_.global_of(i); };
+    if constexpr (Solver::distributed) {
+      const typename Solver::domain_type::Timer timer(s.domain_);
+      whole_position_ = s.domain_.gathered(s.particles_.position);
+      whole_director_ = s.domain_.gathered(s.particles_.director);
+      // The shell contact reads no velocities: none are gathered.
+      const ContactParticles whole{whole_position_, whole_director_, no_velocities_, no_velocities_,
+                                   whole_mass_,     s.model_.particle_thicknesses()};
+      s.bodies_.compute_shell_contact(whole, s.time_step_, s.domain_.local_count(), global_of);
+    } else {
+      s.bodies_.compute_shell_contact(particles, s.time_step_, s.domain_.local_count(), global_of);
+    }
+  }
   // After the particle pass: the bodies move by the sums of every process's
   // terms (RigidBodySet::finish_step; one all-gather of the terms of the
   // particles near a body when distributed), and the books add the step.
@@ -131,12 +163,11 @@ class SolverContact {
  private:
   Solver& solver() { return static_cast<Solver&>(*this); }
   const Solver& solver() const { return static_cast<const Solver&>(*this); }
-  // A distributed run refuses, with the same Error on every process.
-  void one_process(const char* what) {
-    if constexpr (Solver::distributed)
-      solver().domain_.collectively([&] { throw Error(std::string("sphshell: ") + what); });
-  }
   mutable std::vector<double> local_thickness_;  // distributed: contact_thicknesses()
+  // Distributed shell contact: every particle's state, gathered.
+  std::vector<Vector3> whole_position_, whole_director_;
+  std::vector<double> whole_mass_;
+  const std::vector<Vector3> no_velocities_;
 };
 
 }  // namespace sphshell::contact
