@@ -269,6 +269,10 @@ TEST_CASE("Distributed rigid bodies: a plate pressed by a moving wall onto a fix
   const ContactSeen seen = compare_runs("plate between walls", serial, distributed, steps);
   CHECK(seen.most_contacts > 20);
   CHECK(serial.rigid_body(1).contacts > 20);  // pressed onto the lower wall
+  if (comm.is_root())
+    WARN("plate between walls on " << comm.size() << " ranks: bitwise over " << steps << " steps, up to "
+                                   << seen.most_contacts << " particles on a wall, " << serial.rigid_body(1).contacts
+                                   << " on the lower one at the end");
   distributed.write_frame();
   serial.write_frame();
   comm.barrier();
