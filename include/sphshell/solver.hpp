@@ -301,7 +301,9 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
       for (std::size_t p = 0; p < states_->size(); ++p)
         if (point_owned_[p] && states_->active(p))
           elastic.add(states_->stored_energy(p, points_->membrane_bending_weight(p), points_->shear_weight(p)));
-      return ledger_->report(domain_, elastic, fracture_.released_energy());
+      EnergyReport report = ledger_->report(domain_, elastic, fracture_.released_energy());
+      if (bodies_.active()) report.add_rigid_bodies(bodies_.energy());  // the same on every process
+      return report;
     } else {
       // A point out of action holds 0, which adds nothing.
       const double stored = assembler_->sum_over_points(*points_, [&](std::size_t p) {
@@ -327,7 +329,7 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
   StepTime now() const { return {steps_, time_}; }
   contact::ContactParticles contact_particles() {
     return {particles_.position, particles_.director, particles_.velocity, particles_.angular_velocity,
-            inertia_.mass,       model_.particle_thicknesses()};
+            inertia_.mass,       this->contact_thicknesses()};
   }
 
   void set_up(const typename Domain::Weights& weights) try {
@@ -438,9 +440,7 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
     if (!loads_in_pass) apply_loads(context.at, failure);
     stop_if_alone(failure);
     // The particle pass over the owned particles (solver/particle_pass.hpp).
-    if (bodies_.active())
-      bodies_.prepare(contact_particles(), forces_.external, forces_.external_moment, time_step_,
-                      ledger_->chunk_count(particles_));
+    if (bodies_.active()) this->prepare_contact_step(ledger_->chunk_count(particles_));
     solver::ParticlePass<Ledger, Stepper> pass{
         loads_,   load_context_at(context.at.time), constraints_, reference_position_, time_step_, *ledger_,
         stepper_, particles_, inertia_, forces_, distributed ? nullptr : &*assembler_,
@@ -458,7 +458,7 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
     }
     stop_if_alone(failure);
     ledger_->finish_step();  // a failed step's terms never reach the books
-    if (bodies_.active()) bodies_.finish_step(context.at, time_step_, context.velocity_step);
+    if (bodies_.active()) this->finish_contact_step(context.at, context.velocity_step);
     ++steps_;
     time_ = start_time_ + static_cast<double>(steps_) * time_step_;  // t = t0 + n Δt, never summed
     bodies_.write_probes(time_);

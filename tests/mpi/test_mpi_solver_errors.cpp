@@ -3,7 +3,8 @@
 // message; periodic checkpoints are written by every rank and a restart from
 // them continues bitwise; a checkpoint of the other kind of run or of another
 // rank count, and a set name the model does not have, are each an Error
-// naming it on every rank; a rigid body (not distributed yet) is refused alike.
+// naming it on every rank; a rigid body that starts inside the shell is
+// refused alike (tests/mpi/test_mpi_contact.cpp runs bodies distributed).
 #include <sphshell/approx/mls.hpp>
 #include <sphshell/contact/sphere.hpp>
 #include <sphshell/kernel/cubic_spline.hpp>
@@ -254,16 +255,22 @@ TEST_CASE("Checkpoints of the other kind of run or another rank count, unknown s
   if (comm.is_root()) std::filesystem::remove_all(folder);
 }
 
-TEST_CASE("A rigid body in a distributed run: an Error naming the feature on every rank, the run usable",
+TEST_CASE("A rigid body starting inside the shell in a distributed run: an Error on every rank, the run usable",
           "[mpi][solver][contact][errors]") {
   const mpi::Communicator comm;
   Distributed distributed(comm, plate(), steel, steel_options());
   distributed.clamp("boundary");
-  contact::RigidKinematics above;
-  above.position = Vector3(0.25, 0.25, 0.1);
-  const contact::RigidBody<contact::Sphere, contact::Fixed> sphere(contact::Sphere(0.05), contact::Fixed{}, above);
+  contact::RigidKinematics sunk;
+  sunk.position = Vector3(0.25, 0.25, 0.0);  // the plate's mid-surface through its centre
+  const contact::RigidBody<contact::Sphere, contact::Fixed> sphere(contact::Sphere(0.05), contact::Fixed{}, sunk);
   CHECK_THROWS_WITH(distributed.add_rigid_body(sphere),
-                    Catch::Contains("add_rigid_body") && Catch::Contains("distributed run has no rigid bodies"));
+                    Catch::Contains("rigid body 0 initial gap at particle") &&
+                        Catch::Contains("the body starts inside the shell"));
   CHECK(distributed.rigid_body_count() == 0);
+  CHECK_NOTHROW(distributed.step());
+  sunk.position.z() = 0.1;  // clear of the plate: taken
+  CHECK_NOTHROW(distributed.add_rigid_body(
+      contact::RigidBody<contact::Sphere, contact::Fixed>(contact::Sphere(0.05), contact::Fixed{}, sunk)));
+  CHECK(distributed.rigid_body_count() == 1);
   CHECK_NOTHROW(distributed.step());
 }

@@ -14,16 +14,19 @@
 //   load_chunk()  in the pass, after the loads and before the stepper's
 //                 velocity update: every body's contact with the chunk's
 //                 particles, added to their external forces and moments,
-//                 and the chunk's sums (reaction on the body, spring energy,
-//                 friction dissipation) kept in that chunk's slot;
+//                 and each particle's share of the sums (reaction on the
+//                 body, spring energy, friction dissipation: a ContactTerm,
+//                 penalty.hpp) kept in the chunk's list;
 //   book_chunk()  in the pass, after the energy books' chunk: the work of the
 //                 contact forces on the chunk's particles over the step, as
 //                 the books count external work, f · Δt_v (v^{n−½} + v^{n+½})/2
-//                 (and the moments' with ω);
-//   finish_step() after the pass: the slots summed in chunk order (the same
-//                 bits for any thread count), the reaction put on each body,
-//                 the body advanced (RigidBody::advance) and the energy terms
-//                 booked.
+//                 (and the moments' with ω), per particle;
+//   finish_step() after the pass: the terms of every process (the particles
+//                 are split between them in a distributed run) summed in one
+//                 fixed order, that of one process's chunks (the same bits
+//                 for any thread and process count), the reaction put on
+//                 each body, the body advanced (RigidBody::advance) and the
+//                 energy terms booked.
 //
 // The spring energy is reported at n+½, where the books' kinetic energies
 // are: the springs' ½ k δ² at n less the contact's work over the step's second
@@ -56,6 +59,7 @@
 #include <sphshell/core/types.hpp>
 #include <sphshell/io/binary_stream.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -63,6 +67,7 @@
 #include <fstream>
 #include <iomanip>
 #include <memory>
+#include <optional>
 #include <string>
 #include <type_traits>
 #include <typeinfo>
@@ -136,14 +141,16 @@ class BodyContact {
  public:
   virtual ~BodyContact() = default;
   virtual void prepare(std::size_t chunk_count) = 0;
-  // Particles [first, last) of chunk `chunk`: their loads into loads(), the sums into the chunk's slot.
+  // Particles [first, last) of chunk `chunk`: their loads into loads(), their
+  // terms (penalty.hpp, ContactTerm) into the chunk's list.
   virtual void compute_range(const ContactParticles& particles, double time_step, std::size_t chunk,
                              std::size_t first, std::size_t last) = 0;
-  // The slots summed in chunk order, the body moved: returns the step's
-  // sums, the work put into the body from outside the contact and the
-  // contact's work on it over the step's second half.
-  virtual ContactStepResult finish_step(const StepTime& at, double time_step, double velocity_step,
-                                        double& body_work, double& contact_second_half) = 0;
+  // The body moved by the step's sums `total` (RigidBodySet::finish_step
+  // forms them from every process's terms): returns the work put into the
+  // body from outside the contact and the contact's work on it over the
+  // step's second half.
+  virtual void finish_step(const ContactStepResult& total, const StepTime& at, double time_step,
+                           double velocity_step, double& body_work, double& contact_second_half) = 0;
   virtual RigidBodyState state() const = 0;
   // The body's surface where it is now, for the frames (surface_mesh.hpp).
   virtual SurfaceMesh surface(const ModelExtent& model, const SurfaceMeshResolution& resolution) const = 0;
@@ -152,9 +159,13 @@ class BodyContact {
   virtual void save(io::BinaryWriter& out) const = 0;
   virtual void load(io::BinaryReader& in) = 0;
   const ParticleContactLoads& loads() const { return loads_; }
+  // The terms of chunk `chunk` of the last evaluation, in index order.
+  std::vector<ContactTerm>& terms(std::size_t chunk) { return chunk_terms_[chunk]; }
+  const std::vector<std::vector<ContactTerm>>& chunk_terms() const { return chunk_terms_; }
 
  protected:
   ParticleContactLoads loads_;
+  std::vector<std::vector<ContactTerm>> chunk_terms_;  // per chunk; cleared, not freed, each step
 };
 
 template <class Shape, class Motion>
@@ -166,17 +177,19 @@ class BodyContactOf final : public BodyContact {
     contact_.prepare(particles, time_step, loads_);
   }
 
-  void prepare(std::size_t chunk_count) override { slots_.assign(chunk_count, ContactStepResult{}); }
+  void prepare(std::size_t chunk_count) override {
+    chunk_terms_.resize(chunk_count);
+    for (std::vector<ContactTerm>& terms : chunk_terms_) terms.clear();
+  }
 
   void compute_range(const ContactParticles& particles, double time_step, std::size_t chunk, std::size_t first,
                      std::size_t last) override {
-    slots_[chunk] = contact_.compute_range(particles, body_, time_step, loads_, first, last);
+    chunk_terms_[chunk].clear();
+    contact_.compute_terms(particles, body_, time_step, loads_, first, last, chunk_terms_[chunk]);
   }
 
-  ContactStepResult finish_step(const StepTime& at, double time_step, double velocity_step, double& body_work,
-                                double& contact_second_half) override {
-    ContactStepResult total;
-    for (const ContactStepResult& slot : slots_) PenaltyContact::accumulate(total, slot);
+  void finish_step(const ContactStepResult& total, const StepTime& at, double time_step, double velocity_step,
+                   double& body_work, double& contact_second_half) override {
     const Vector3 old_velocity = body_.velocity();
     const Vector3 old_angular_velocity = body_.angular_velocity();
     const double old_kinetic = kinetic_energy();
@@ -196,7 +209,6 @@ class BodyContactOf final : public BodyContact {
     } else {
       body_work = kinetic_energy() - old_kinetic - contact_work;
     }
-    return total;
   }
 
   RigidBodyState state() const override {
@@ -220,7 +232,7 @@ class BodyContactOf final : public BodyContact {
     return description;
   }
   // The body's state, its contact history and the particles it touched in
-  // the last step; the chunk slots are rewritten by every step before use.
+  // the last step; the chunks' terms are rewritten by every step before use.
   void save(io::BinaryWriter& out) const override {
     body_.save(out);
     contact_.save(out);
@@ -253,7 +265,6 @@ class BodyContactOf final : public BodyContact {
  private:
   RigidBody<Shape, Motion> body_;
   PenaltyContact contact_;
-  std::vector<ContactStepResult> slots_;
   std::size_t contacts_ = 0;
 };
 
@@ -267,8 +278,9 @@ class RigidBodySet {
   bool active() const { return !bodies_.empty() || shell_contact_ != nullptr; }
 
   // The shell's contact with itself (shell_contact.hpp), stepped with the
-  // bodies: its loads go to the particles in load_chunk(), its work and spring
-  // energy into the same books. Once per run.
+  // bodies: computed by compute_shell_contact() after prepare(), its loads go
+  // to the particles in load_chunk(), its work and spring energy into the
+  // same books. Once per run.
   void enable_shell_contact(const ShellModel& model, const ShellContactOptions& options,
                             double rotary_inertia_scale = 1.0) {
     if (shell_contact_)
@@ -279,24 +291,50 @@ class RigidBodySet {
   }
   // Null unless enabled.
   const ShellContact* shell_contact() const { return shell_contact_.get(); }
-  // The shell contact's loads of the last step, per particle.
+  // The shell contact's loads of the last step, per particle (local numbering).
   const ParticleContactLoads& shell_contact_loads() const { return shell_loads_; }
 
-  // A body in contact with the particles (the whole shell, one process).
-  // Refuses a body whose surface lies deeper in the shell than a particle's
-  // half thickness (the contact would throw the particle out at once).
+  // Where a body would start inside the shell: the particle (its global id)
+  // and the body's signed distance there.
+  struct StartInside {
+    long particle = 0;
+    double gap = 0.0;
+    double half_thickness = 0.0;
+  };
+  // The particle of lowest global id among this process's [0, owned) where
+  // `body` lies deeper in the shell than the particle's half thickness (the
+  // contact would throw the particle out at once), if any.
+  template <class Shape, class Motion, class GlobalOf>
+  static std::optional<StartInside> start_inside(const RigidBody<Shape, Motion>& body,
+                                                 const ContactParticles& particles, std::size_t owned,
+                                                 GlobalOf&& global_of) {
+    std::optional<StartInside> found;
+    for (std::size_t i = 0; i < owned; ++i) {
+      const double gap = body.proximity(particles.position[i]).gap;
+      const double half_thickness = 0.5 * particles.thickness[i];
+      const long particle = static_cast<long>(global_of(i));
+      if (gap < -half_thickness && (!found || particle < found->particle))
+        found = StartInside{particle, gap, half_thickness};
+    }
+    return found;
+  }
+  // The Error of a body that starts inside the shell (the next body's id).
+  [[noreturn]] void refuse_start_inside(const StartInside& inside) const {
+    sphshell::detail::invalid_parameter("rigid body " + std::to_string(bodies_.size()) + " initial gap at particle " +
+                                            std::to_string(inside.particle),
+                                        inside.gap,
+                                        "must be at least minus half the thickness (" +
+                                            std::to_string(-inside.half_thickness) +
+                                            " m): the body starts inside the shell");
+  }
+
+  // A body in contact with the particles (local numbering: a process's owned
+  // particles, then its ghosts). The caller has refused a body that starts
+  // inside the shell (start_inside).
   template <class Shape, class Motion>
   RigidBodyId add(RigidBody<Shape, Motion> body, const PenaltyOptions& options, const ContactParticles& particles,
                   double time_step) {
     validate(options);
-    for (std::size_t i = 0; i < particles.position.size(); ++i) {
-      const double gap = body.proximity(particles.position[i]).gap;
-      if (gap < -0.5 * particles.thickness[i])
-        sphshell::detail::invalid_parameter(
-            "rigid body " + std::to_string(bodies_.size()) + " initial gap at particle " + std::to_string(i), gap,
-            "must be at least minus half the thickness (" + std::to_string(-0.5 * particles.thickness[i]) +
-                " m): the body starts inside the shell");
-    }
     auto pair = std::make_unique<detail::BodyContactOf<Shape, Motion>>(std::move(body), options, particles, time_step);
     energy_.body_work += pair->kinetic_energy();  // the initial kinetic energy is put in from outside
     energy_.body_kinetic += pair->kinetic_energy();
@@ -315,8 +353,28 @@ class RigidBodySet {
     external_moment_ = &external_moment;
     time_step_ = time_step;
     for (auto& body : bodies_) body->prepare(chunk_count);
-    if (shell_contact_) shell_result_ = shell_contact_->compute(particles, time_step, shell_loads_);
-    shell_work_slots_.assign(chunk_count, HalfStepWork{});
+    shell_chunk_terms_.resize(chunk_count);
+    for (std::vector<ContactTerm>& terms : shell_chunk_terms_) terms.clear();
+  }
+
+  // After prepare(), with the shell contact enabled: its loads at
+  // configuration n. `whole` is every particle of the model, numbered
+  // globally (one process's own arrays; a distributed run's gathered
+  // positions and directors: the contact reads positions, directors, masses
+  // and thicknesses, and a fold's far side is no ghost of a process), so
+  // every process computes what one process would; the loads of its `local`
+  // particles (global_of numbers them) are kept.
+  template <class GlobalOf>
+  void compute_shell_contact(const ContactParticles& whole, double time_step, std::size_t local,
+                             GlobalOf&& global_of) {
+    shell_result_ = shell_contact_->compute(whole, time_step, shell_whole_loads_);
+    shell_loads_.force.resize(local);
+    shell_loads_.moment.resize(local);
+    for (std::size_t i = 0; i < local; ++i) {
+      const auto g = static_cast<std::size_t>(global_of(i));
+      shell_loads_.force[i] = shell_whole_loads_.force[g];
+      shell_loads_.moment[i] = shell_whole_loads_.moment[g];
+    }
   }
 
   // In the pass, after the chunk's loads: the bodies' contact loads added to them.
@@ -342,38 +400,111 @@ class RigidBodySet {
   }
 
   // In the pass, after the velocities are final (kinematic conditions imposed):
-  // the contact forces' work on the chunk's particles over the step.
+  // the contact forces' work on the chunk's particles over the step, per
+  // particle (a particle without a body's term has no load from it).
   void book_chunk(std::size_t chunk, std::size_t first, std::size_t last, double velocity_step) noexcept {
     const ContactParticles& particles = *particles_;
-    HalfStepWork work;
-    const auto add_work = [&](const ParticleContactLoads& loads) {
-      for (std::size_t i = first; i < last; ++i) {
-        work.first_half += 0.5 * velocity_step *
-                           (loads.force[i].dot(old_velocity_[i]) + loads.moment[i].dot(old_angular_velocity_[i]));
-        work.second_half += 0.5 * velocity_step *
-                            (loads.force[i].dot(particles.velocity[i]) +
-                             loads.moment[i].dot(particles.angular_velocity[i]));
-      }
+    const auto first_half = [&](const ParticleContactLoads& loads, std::size_t i) {
+      return 0.5 * velocity_step *
+             (loads.force[i].dot(old_velocity_[i]) + loads.moment[i].dot(old_angular_velocity_[i]));
     };
-    for (const auto& body : bodies_) add_work(body->loads());
-    if (shell_contact_) add_work(shell_loads_);
-    shell_work_slots_[chunk] = work;
+    const auto second_half = [&](const ParticleContactLoads& loads, std::size_t i) {
+      return 0.5 * velocity_step *
+             (loads.force[i].dot(particles.velocity[i]) + loads.moment[i].dot(particles.angular_velocity[i]));
+    };
+    for (const auto& body : bodies_)
+      for (ContactTerm& term : body->terms(chunk)) {
+        const auto i = static_cast<std::size_t>(term.particle);
+        term.work_first_half = first_half(body->loads(), i);
+        term.work_second_half = second_half(body->loads(), i);
+      }
+    if (shell_contact_)
+      for (std::size_t i = first; i < last; ++i)
+        if ((shell_loads_.force[i].array() != 0.0).any() || (shell_loads_.moment[i].array() != 0.0).any()) {
+          ContactTerm term;
+          term.particle = static_cast<std::int64_t>(i);
+          term.work_first_half = first_half(shell_loads_, i);
+          term.work_second_half = second_half(shell_loads_, i);
+          shell_chunk_terms_[chunk].push_back(term);
+        }
   }
 
-  // After the pass (which did not fail): the bodies move, the books add the step.
-  void finish_step(const StepTime& at, double time_step, double velocity_step) {
+  // After the pass (which did not fail): the bodies move, the books add the
+  // step. Every process passes the terms of the particles it owns, and
+  // `gather` (std::vector<ContactTerm> → std::vector<ContactTerm>) returns
+  // those of all processes; `global_of` numbers a local particle globally.
+  // The sums are then formed from the terms in one fixed order, the order of
+  // one process's particle pass: within the chunks of `particles_per_chunk`
+  // particles (ParticleEnergyTerms::sum_chunk) in index order, body by body
+  // (the shell contact's work last, as if it were one more body), then chunk
+  // by chunk. So every process moves the bodies alike, by the same bits as
+  // one process would, whatever the split of the particles between
+  // processes and threads. A particle without a term adds ±0 to a sum that
+  // is never −0: nothing.
+  template <class GlobalOf, class Gather>
+  void finish_step(const StepTime& at, double time_step, double velocity_step, std::size_t particles_per_chunk,
+                   GlobalOf&& global_of, Gather&& gather) {
+    std::vector<ContactTerm> mine;
+    for (std::size_t b = 0; b < bodies_.size(); ++b)
+      for (const std::vector<ContactTerm>& chunk : bodies_[b]->chunk_terms())
+        for (ContactTerm term : chunk) {
+          term.particle = static_cast<std::int64_t>(global_of(static_cast<std::size_t>(term.particle)));
+          term.body = static_cast<std::int64_t>(b);
+          mine.push_back(term);
+        }
+    const auto shell = static_cast<std::int64_t>(bodies_.size());
+    for (const std::vector<ContactTerm>& chunk : shell_chunk_terms_)
+      for (ContactTerm term : chunk) {
+        term.particle = static_cast<std::int64_t>(global_of(static_cast<std::size_t>(term.particle)));
+        term.body = shell;
+        mine.push_back(term);
+      }
+    std::vector<ContactTerm> terms = gather(std::move(mine));
+    const auto chunk_of = [&](const ContactTerm& term) {
+      return static_cast<std::size_t>(term.particle) / particles_per_chunk;
+    };
+    // Each body's sums: a sum per chunk in index order, the chunks' sums in
+    // chunk order (PenaltyContact::accumulate). A chunk without terms adds
+    // nothing (its sums are +0, and none of these sums is −0).
+    std::sort(terms.begin(), terms.end(), [](const ContactTerm& a, const ContactTerm& b) {
+      return a.body != b.body ? a.body < b.body : a.particle < b.particle;
+    });
+    std::vector<ContactStepResult> totals(bodies_.size());
+    for (std::size_t k = 0; k < terms.size() && terms[k].body != shell;) {
+      ContactStepResult chunk_sum;
+      const std::int64_t body = terms[k].body;
+      const std::size_t chunk = chunk_of(terms[k]);
+      for (; k < terms.size() && terms[k].body == body && chunk_of(terms[k]) == chunk; ++k)
+        PenaltyContact::add(chunk_sum, terms[k]);
+      PenaltyContact::accumulate(totals[static_cast<std::size_t>(body)], chunk_sum);
+    }
     double spring = 0.0, kinetic = 0.0, second_half = 0.0;
-    for (auto& body : bodies_) {
+    for (std::size_t b = 0; b < bodies_.size(); ++b) {
       double body_work = 0.0, body_second_half = 0.0;
-      const ContactStepResult result = body->finish_step(at, time_step, velocity_step, body_work, body_second_half);
+      const ContactStepResult& result = totals[b];
+      bodies_[b]->finish_step(result, at, time_step, velocity_step, body_work, body_second_half);
       spring += result.spring_energy;
       second_half += body_second_half;
       energy_.friction_dissipation += result.friction_dissipation;
       energy_.body_work += body_work;
-      kinetic += body->state().kinetic_energy;
+      kinetic += bodies_[b]->state().kinetic_energy;
     }
     if (shell_contact_) spring += shell_result_.spring_energy;
-    for (const HalfStepWork& work : shell_work_slots_) {
+    // The contact forces' work on the particles: a sum per chunk (the bodies'
+    // terms in body and index order, then the shell contact's), the chunks'
+    // sums in chunk order.
+    std::sort(terms.begin(), terms.end(), [&](const ContactTerm& a, const ContactTerm& b) {
+      const std::size_t chunk_a = chunk_of(a), chunk_b = chunk_of(b);
+      if (chunk_a != chunk_b) return chunk_a < chunk_b;
+      return a.body != b.body ? a.body < b.body : a.particle < b.particle;
+    });
+    for (std::size_t k = 0; k < terms.size();) {
+      HalfStepWork work;
+      const std::size_t chunk = chunk_of(terms[k]);
+      for (; k < terms.size() && chunk_of(terms[k]) == chunk; ++k) {
+        work.first_half += terms[k].work_first_half;
+        work.second_half += terms[k].work_second_half;
+      }
       energy_.shell_contact_work += work.first_half + work.second_half;
       second_half += work.second_half;
     }
@@ -449,7 +580,16 @@ class RigidBodySet {
     return bodies_[id]->surface(model, resolution);
   }
 
-  // CSV time history of one body: written now and after every step.
+  // An Error unless `id` is a body of this run.
+  void check(RigidBodyId id) const {
+    if (id >= bodies_.size())
+      sphshell::detail::invalid_parameter("rigid body id", id,
+                                          "must be below the number of bodies added (" +
+                                              std::to_string(bodies_.size()) + ")");
+  }
+
+  // CSV time history of one body: written now and after every step (by the
+  // one process that adds it: every process holds the same bodies).
   void add_probe(const std::string& csv_path, RigidBodyId id, double time) {
     check(id);
     Probe probe{id, std::ofstream(csv_path)};
@@ -482,28 +622,24 @@ class RigidBodySet {
                << s.contacts << '\n';
     probe.file.flush();
   }
-  void check(RigidBodyId id) const {
-    if (id >= bodies_.size())
-      sphshell::detail::invalid_parameter("rigid body id", id,
-                                          "must be below the number of bodies added (" +
-                                              std::to_string(bodies_.size()) + ")");
-  }
 
   std::vector<std::unique_ptr<detail::BodyContact>> bodies_;
   std::unique_ptr<ShellContact> shell_contact_;  // null: no self contact
-  ParticleContactLoads shell_loads_;
+  ParticleContactLoads shell_loads_;        // local numbering
+  ParticleContactLoads shell_whole_loads_;  // every particle of the model
+  std::vector<std::vector<ContactTerm>> shell_chunk_terms_;  // its work, per chunk of the pass
   ContactStepResult shell_result_;
   std::unique_ptr<ContactParticles> particles_;  // the solver's arrays, this step
   std::vector<Vector3>* external_force_ = nullptr;
   std::vector<Vector3>* external_moment_ = nullptr;
   double time_step_ = 0.0;
   std::vector<Vector3> old_velocity_, old_angular_velocity_;
-  // The contact forces' work on a chunk's particles over the halves of the
-  // step, f^n · Δt_v v^{n−½}/2 and f^n · Δt_v v^{n+½}/2.
+  // The contact forces' work on particles over the halves of the step,
+  // f^n · Δt_v v^{n−½}/2 and f^n · Δt_v v^{n+½}/2.
   struct HalfStepWork {
     double first_half = 0.0, second_half = 0.0;
   };
-  std::vector<HalfStepWork> shell_work_slots_;
+
   ContactEnergy energy_;
   std::vector<Probe> probes_;
 };

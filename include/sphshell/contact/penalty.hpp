@@ -52,6 +52,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -107,6 +108,28 @@ struct ContactStepResult {
   double friction_dissipation = 0.0;  // dissipated by slip this step (J)
   double spring_energy = 0.0;         // held by the normal and tangential springs (J)
   std::size_t contacts = 0;           // particles in contact
+};
+
+// One particle's share of a ContactStepResult, as compute_range adds it:
+// what a contact evaluation sums over the particles, kept per particle so
+// that the sum can be formed in one fixed order wherever the particles are
+// (body_set.hpp: in index order within the chunks of
+// ParticleEnergyTerms::sum_chunk particles, then chunk by chunk, however the
+// particles are split between threads or processes). Only particles near
+// enough to touch have a term: the others add nothing. Plain data (no Eigen
+// members), so that terms can be gathered between processes as bytes.
+struct ContactTerm {
+  std::int64_t particle = 0;  // its index (the local one where computed; body_set.hpp renumbers)
+  std::int64_t body = 0;      // the body's id in its run (body_set.hpp)
+  double force[3] = {0.0, 0.0, 0.0};        // on the particle; the body takes −force
+  double body_moment[3] = {0.0, 0.0, 0.0};  // (c − x_body) × (−force)
+  double work = 0.0;                  // ½ (f^{n−1} + f^n) · Δu
+  double friction_dissipation = 0.0;  // μ |f_n| × slip, when it slipped
+  double spring_energy = 0.0;
+  // The contact force's work on the particle over the halves of the step
+  // (body_set.hpp, RigidBodySet::book_chunk), f^n · Δt_v v^{n∓½}/2.
+  double work_first_half = 0.0, work_second_half = 0.0;
+  std::int32_t in_contact = 0, slipped = 0;
 };
 
 class PenaltyContact {
@@ -169,6 +192,49 @@ class PenaltyContact {
                                   double time_step, ParticleContactLoads& loads, std::size_t first,
                                   std::size_t last) {
     ContactStepResult result;
+    for_each_term(particles, body, time_step, loads, first, last, [&](const ContactTerm& term) { add(result, term); });
+    return result;
+  }
+  // The same evaluation, its terms (in index order) appended to `terms`
+  // instead of summed, for a sum formed elsewhere in a fixed order.
+  template <class Shape, class Motion>
+  void compute_terms(const ContactParticles& particles, const RigidBody<Shape, Motion>& body, double time_step,
+                     ParticleContactLoads& loads, std::size_t first, std::size_t last,
+                     std::vector<ContactTerm>& terms) {
+    for_each_term(particles, body, time_step, loads, first, last,
+                  [&](const ContactTerm& term) { terms.push_back(term); });
+  }
+
+  // A particle's term added to a sum, as compute_range adds it.
+  static void add(ContactStepResult& result, const ContactTerm& term) {
+    if (term.in_contact) {
+      if (term.slipped) result.friction_dissipation += term.friction_dissipation;
+      result.body_force -= Vector3(term.force[0], term.force[1], term.force[2]);
+      result.body_moment += Vector3(term.body_moment[0], term.body_moment[1], term.body_moment[2]);
+      result.spring_energy += term.spring_energy;
+      ++result.contacts;
+    }
+    result.work += term.work;
+  }
+
+  static void accumulate(ContactStepResult& total, const ContactStepResult& part) {
+    total.body_force += part.body_force;
+    total.body_moment += part.body_moment;
+    total.work += part.work;
+    total.friction_dissipation += part.friction_dissipation;
+    total.spring_energy += part.spring_energy;
+    total.contacts += part.contacts;
+  }
+
+  // The tangential (friction) force each particle holds.
+  const std::vector<Vector3>& tangential_forces() const { return tangential_force_; }
+
+ private:
+  // The contact of particles [first, last): their loads and history written,
+  // each particle near enough to touch handed to `sink` as its term.
+  template <class Shape, class Motion, class Sink>
+  void for_each_term(const ContactParticles& particles, const RigidBody<Shape, Motion>& body, double time_step,
+                     ParticleContactLoads& loads, std::size_t first, std::size_t last, Sink&& sink) {
     const double body_mass = body.inertial_mass();
     for (std::size_t i = first; i < last; ++i) {
       loads.force[i].setZero();
@@ -182,6 +248,8 @@ class PenaltyContact {
         tangential_force_[i].setZero();
         continue;
       }
+      ContactTerm term;
+      term.particle = static_cast<std::int64_t>(i);
       const Vector3& d = particles.director[i];
       const double side = d.dot(at_mid.normal) > 0.0 ? -1.0 : 1.0;
       const Vector3 arm = side * half_thickness * d;
@@ -210,39 +278,30 @@ class PenaltyContact {
         const double trial = tangential.norm();
         if (trial > limit) {
           const double slip = (trial - limit) / tangential_stiffness;
-          result.friction_dissipation += limit * slip;
+          term.slipped = 1;
+          term.friction_dissipation = limit * slip;
           tangential *= trial > 0.0 ? limit / trial : 0.0;
         }
         tangential_force_[i] = tangential;
         force = normal_force * n + tangential;
         loads.force[i] = force;
         loads.moment[i] = arm.cross(force);
-        result.body_force -= force;
-        result.body_moment += (contact_point - body.position()).cross(-force);
-        result.spring_energy += 0.5 * normal_force * penetration + 0.5 * tangential.squaredNorm() / tangential_stiffness;
-        ++result.contacts;
+        const Vector3 moment = (contact_point - body.position()).cross(-force);
+        for (int k = 0; k < 3; ++k) {
+          term.force[k] = force[k];
+          term.body_moment[k] = moment[k];
+        }
+        term.spring_energy = 0.5 * normal_force * penetration + 0.5 * tangential.squaredNorm() / tangential_stiffness;
+        term.in_contact = 1;
       } else {
         tangential_force_[i].setZero();
       }
-      result.work += 0.5 * (previous_force_[i] + force).dot(displacement);
+      term.work = 0.5 * (previous_force_[i] + force).dot(displacement);
       previous_force_[i] = force;
+      sink(term);
     }
-    return result;
   }
 
-  static void accumulate(ContactStepResult& total, const ContactStepResult& part) {
-    total.body_force += part.body_force;
-    total.body_moment += part.body_moment;
-    total.work += part.work;
-    total.friction_dissipation += part.friction_dissipation;
-    total.spring_energy += part.spring_energy;
-    total.contacts += part.contacts;
-  }
-
-  // The tangential (friction) force each particle holds.
-  const std::vector<Vector3>& tangential_forces() const { return tangential_force_; }
-
- private:
   static void check_sizes(const ContactParticles& particles, std::size_t count) {
     const std::size_t sizes[] = {particles.director.size(), particles.velocity.size(),
                                  particles.angular_velocity.size(), particles.mass.size(),

@@ -206,7 +206,8 @@ class SolverOutput {
     if constexpr (Solver::crack_type::enabled)
       datasets.push_back({series_names[2], piece.crack_grid(), Drawn::whole});  // collective
     if (!solver.bodies_.empty())  // the rigid bodies' surfaces, listed in the particle series as its part 1
-      datasets.push_back({body_series, io::rigid_body_grid(solver.bodies_, solver.particles_.position, solver.time()),
+      // (a plane's patch is sized to the whole shell: all positions, gathered when distributed)
+      datasets.push_back({body_series, io::rigid_body_grid(solver.bodies_, solver.positions(), solver.time()),
                           Drawn::whole, series_names[0], 1});
     frames_.write(solver.domain_, solver.time(), datasets, {series_names.begin(), series_names.end()});
     last_frame_step_ = solver.steps();
