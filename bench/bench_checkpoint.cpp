@@ -5,7 +5,12 @@
 // for it), against one step. The counter `bytes` is the file's size. The file
 // goes to the system's temporary directory and is removed at the end.
 // Run single-threaded (OMP_NUM_THREADS=1) for per-step figures.
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/all.hpp>
+#include <sphshell/crack/all.hpp>
+#include <sphshell/kernel/all.hpp>
+#include <sphshell/material/all.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/all.hpp>
 
 #include <benchmark/benchmark.h>
 

@@ -12,7 +12,12 @@
 //  - rule_cost_ratio: Global against Gauss<5> on the same plate (51², J2,
 //    1 MPa) once it is plastic (from 1 ms on), alternating chunks of 10 steps;
 //    `ratio` is Global's time over Gauss<5>'s.
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/all.hpp>
+#include <sphshell/crack/all.hpp>
+#include <sphshell/kernel/all.hpp>
+#include <sphshell/material/all.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/all.hpp>
 
 #include <benchmark/benchmark.h>
 

@@ -15,8 +15,13 @@
 //    chunks of steps so that a change of machine load hits both alike (the
 //    counter `ratio` is LineSegments' time over None's).
 // Run single-threaded (OMP_NUM_THREADS=1) for per-step figures.
+#include <sphshell/approx/all.hpp>
 #include <sphshell/core/simd.hpp>
-#include <sphshell/sphshell.hpp>
+#include <sphshell/crack/all.hpp>
+#include <sphshell/kernel/all.hpp>
+#include <sphshell/material/all.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/all.hpp>
 
 #include <benchmark/benchmark.h>
 

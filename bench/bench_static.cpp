@@ -24,7 +24,12 @@
 //   --benchmark_enable_random_interleaving=true
 // (one command line) the repetitions of all of them interleave, so a change
 // of the machine's load hits both variants alike.
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/all.hpp>
+#include <sphshell/crack/all.hpp>
+#include <sphshell/kernel/all.hpp>
+#include <sphshell/material/all.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/all.hpp>
 
 #include <benchmark/benchmark.h>
 

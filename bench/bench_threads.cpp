@@ -29,7 +29,12 @@
 // of equal processors), `core_speed_ratio` (the slower pinned time over the
 // faster) and `cpuN_us_per_step` for each pinned processor N. They are left
 // out where the process may use fewer than two processors or pinning fails.
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/all.hpp>
+#include <sphshell/crack/all.hpp>
+#include <sphshell/kernel/all.hpp>
+#include <sphshell/material/all.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/all.hpp>
 
 #include <benchmark/benchmark.h>
 

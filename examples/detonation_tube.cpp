@@ -4,7 +4,14 @@
 // (Fig. 30) and crack tip speeds (Fig. 32).
 // `detonation_tube --help` lists the options, their defaults and the files written.
 
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/all.hpp>
+#include <sphshell/crack/all.hpp>
+#include <sphshell/io/csv_probe.hpp>
+#include <sphshell/io/svg_plot.hpp>
+#include <sphshell/kernel/all.hpp>
+#include <sphshell/material/all.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/all.hpp>
 
 #include "example_arguments.hpp"
 

@@ -12,7 +12,16 @@
 // (tests/support/shell_benchmarks.hpp, sphshell/statics/path_following.hpp).
 // `shell_benchmarks --help` lists the options and the files written.
 
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/all.hpp>
+#include <sphshell/crack/all.hpp>
+#include <sphshell/io/csv_probe.hpp>
+#include <sphshell/io/output_directory.hpp>
+#include <sphshell/io/svg_plot.hpp>
+#include <sphshell/kernel/all.hpp>
+#include <sphshell/material/all.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/statics/all.hpp>
+#include <sphshell/thickness/all.hpp>
 
 #include "example_arguments.hpp"
 #include "support/shell_benchmarks.hpp"

@@ -10,7 +10,15 @@
 // it does not reproduce the paper's ballistic limit.
 // `sphere_perforation --help` lists the options, their defaults and the files written.
 
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/all.hpp>
+#include <sphshell/contact/all.hpp>
+#include <sphshell/crack/all.hpp>
+#include <sphshell/io/csv_probe.hpp>
+#include <sphshell/io/svg_plot.hpp>
+#include <sphshell/kernel/all.hpp>
+#include <sphshell/material/all.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/all.hpp>
 
 #include "example_arguments.hpp"
 

@@ -6,7 +6,15 @@
 // reference the validation test test_validation_spherical_cap checks against).
 // `spherical_cap --help` lists the options, their defaults and the files written.
 
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/all.hpp>
+#include <sphshell/crack/all.hpp>
+#include <sphshell/io/csv_probe.hpp>
+#include <sphshell/io/svg_plot.hpp>
+#include <sphshell/kernel/all.hpp>
+#include <sphshell/material/all.hpp>
+#include <sphshell/shell/spherical_cap_ogrid.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/all.hpp>
 
 #include "example_arguments.hpp"
 #include "support/spherical_cap_case.hpp"

@@ -3,7 +3,14 @@
 // with --case fracture, the edge cracks of §3.2.4 (Figs 20-22).
 // `square_plate --help` lists the options, their defaults and the files written.
 
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/all.hpp>
+#include <sphshell/crack/all.hpp>
+#include <sphshell/io/csv_probe.hpp>
+#include <sphshell/io/svg_plot.hpp>
+#include <sphshell/kernel/all.hpp>
+#include <sphshell/material/all.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/all.hpp>
 
 #include "example_arguments.hpp"
 

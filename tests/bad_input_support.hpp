@@ -2,7 +2,13 @@
 // Shared by the bad-input tests: a small plate in each builder's form, and a
 // check that an expression throws sphshell::Error whose message holds every
 // expected piece.
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/all.hpp>
+#include <sphshell/crack/all.hpp>
+#include <sphshell/kernel/all.hpp>
+#include <sphshell/material/all.hpp>
+#include <sphshell/shell/spherical_cap_ogrid.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/all.hpp>
 
 #include <catch2/catch.hpp>
 

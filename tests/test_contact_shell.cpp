@@ -5,7 +5,13 @@
 // folded strip whose far part touches itself while its material neighbours
 // push nothing, the thickness offsets of both sides, the search's candidate
 // pairs per particle at growing size, and refused input.
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/all.hpp>
+#include <sphshell/contact/all.hpp>
+#include <sphshell/crack/all.hpp>
+#include <sphshell/kernel/all.hpp>
+#include <sphshell/material/all.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/all.hpp>
 
 #include <catch2/catch.hpp>
 

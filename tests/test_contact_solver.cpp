@@ -3,7 +3,14 @@
 // gravity, momentum exchanged with a free plate, the run's time step, thread
 // counts and refused input. The checks are conservation laws and statics,
 // computed here from what the solver reports.
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/all.hpp>
+#include <sphshell/contact/all.hpp>
+#include <sphshell/crack/all.hpp>
+#include <sphshell/io/vtu_format.hpp>
+#include <sphshell/kernel/all.hpp>
+#include <sphshell/material/all.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/all.hpp>
 
 #include "support/mesh_files.hpp"
 #include "support/vtu_reader.hpp"

@@ -3,7 +3,12 @@
 // over), probe, frame, collection and checkpoint paths that coincide are
 // refused before the first step, and a restart keeps and names stray files
 // in the output folder instead of failing part-way. Public API only.
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/all.hpp>
+#include <sphshell/crack/all.hpp>
+#include <sphshell/kernel/all.hpp>
+#include <sphshell/material/all.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/all.hpp>
 
 #include "support/mesh_files.hpp"
 

@@ -2,7 +2,14 @@
 // sphshell::Error naming the path and the system's reason; the three ParaView
 // collections agree however a run is killed; a reused output directory holds
 // only the new run's frames. Uses the Solver's public API only.
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/all.hpp>
+#include <sphshell/crack/all.hpp>
+#include <sphshell/io/pvd_collection.hpp>
+#include <sphshell/io/vtu_writer.hpp>
+#include <sphshell/kernel/all.hpp>
+#include <sphshell/material/all.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/all.hpp>
 
 #include "support/mesh_files.hpp"
 #include "support/vtu_reader.hpp"

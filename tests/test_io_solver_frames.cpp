@@ -3,7 +3,14 @@
 // convention, through-thickness points named by position, the encodings.
 // Read back with the tests' own reader (tests/support/vtu_reader.hpp) and
 // compared with the Solver's accessors.
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/all.hpp>
+#include <sphshell/crack/all.hpp>
+#include <sphshell/io/vtu_format.hpp>
+#include <sphshell/io/vtu_writer.hpp>
+#include <sphshell/kernel/all.hpp>
+#include <sphshell/material/all.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/all.hpp>
 
 #include "support/mesh_files.hpp"
 #include "support/vtu_reader.hpp"

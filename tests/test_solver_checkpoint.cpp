@@ -6,7 +6,13 @@
 // truncated, corrupted or foreign file is refused with an Error naming the file
 // and the problem. The reference is always a second, uninterrupted run of the
 // same program, never a stored output.
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/all.hpp>
+#include <sphshell/crack/all.hpp>
+#include <sphshell/io/directory_lock.hpp>
+#include <sphshell/kernel/all.hpp>
+#include <sphshell/material/all.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/all.hpp>
 
 #include "support/mesh_files.hpp"
 

@@ -1,7 +1,12 @@
 // Kinematic conditions: symmetry planes reproduce the full model, fixed
 // rotations stay fixed under large rotation, prescribed motions are imposed
 // exactly, and energy stays balanced when a pre-crack is cut mid-run.
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/all.hpp>
+#include <sphshell/crack/all.hpp>
+#include <sphshell/kernel/all.hpp>
+#include <sphshell/material/all.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/all.hpp>
 
 #include <catch2/catch.hpp>
 

@@ -2,7 +2,12 @@
 // points form cracks where the paper's plate tears first (the clamped
 // mid-edges), fragments keep their mass, and the topology does not depend on
 // the thread count.
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/all.hpp>
+#include <sphshell/crack/all.hpp>
+#include <sphshell/kernel/all.hpp>
+#include <sphshell/material/all.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/all.hpp>
 
 #include <catch2/catch.hpp>
 

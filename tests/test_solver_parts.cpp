@@ -2,7 +2,13 @@
 // load context's mass and moment channels (gravity, applied moments) against
 // closed forms, the parallel loop's deterministic error rule, and the grouped
 // options.
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/all.hpp>
+#include <sphshell/crack/all.hpp>
+#include <sphshell/kernel/all.hpp>
+#include <sphshell/material/all.hpp>
+#include <sphshell/shell/spherical_cap_ogrid.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/all.hpp>
 
 #include <catch2/catch.hpp>
 

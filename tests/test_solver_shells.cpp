@@ -1,7 +1,13 @@
 // Shell-level checks against closed forms and published references:
 // geometric nonlinearity (the elastica), the spherical-cap benchmark, energy
 // conservation, and the solver's errors on bad input and instability.
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/all.hpp>
+#include <sphshell/crack/all.hpp>
+#include <sphshell/kernel/all.hpp>
+#include <sphshell/material/all.hpp>
+#include <sphshell/shell/spherical_cap_ogrid.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/all.hpp>
 
 #include <catch2/catch.hpp>
 

@@ -3,10 +3,17 @@
 // against the independent axisymmetric reference of
 // tests/support/axisymmetric_shell.hpp (trusted by
 // test_axisymmetric_reference): linear, nonlinear elastic and elastoplastic
-// (σs0 = 165.5 MPa, Et = 1.448 GPa) apex histories over 0–1 ms. The first
-// apex peak and its time must change by ≤ 1 % between the two resolutions
-// and agree with the reference within 3 %.
-#include <sphshell/sphshell.hpp>
+// (σs0 = 165.5 MPa, Et = 1.448 GPa) apex histories over 0–1 ms, each SPH run
+// stopped once its first peak is behind it. The first apex peak and its time
+// must change by ≤ 1 % between the two resolutions and agree with the
+// reference within 3 %.
+#include <sphshell/approx/all.hpp>
+#include <sphshell/crack/all.hpp>
+#include <sphshell/kernel/all.hpp>
+#include <sphshell/material/all.hpp>
+#include <sphshell/shell/spherical_cap_ogrid.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/all.hpp>
 
 #include "support/ogrid_cap.hpp"
 #include "support/spherical_cap_case.hpp"
@@ -59,10 +66,16 @@ LibraryRun run_library(int m, const typename Material::Parameters& parameters, b
   LibraryRun run;
   run.history.time.push_back(0.0);
   run.history.apex.push_back(0.0);
-  solver.run_until(cap::end_time, [&](const auto& s) {
-    run.history.time.push_back(s.time());
-    run.history.apex.push_back(-s.displacement(apex).dot(model.particle_normal[apex]));
-  });
+  // The steps of run_until(cap::end_time), stopped once the history holds its
+  // first peak and the fall after it (cap::first_peak_behind): the checks read
+  // the history only up to that fall, so the steps after it could not change
+  // them (the runs stop near 0.2 ms, the elastoplastic ones near 0.3 ms).
+  while (solver.time() < cap::end_time - 0.5 * solver.time_step()) {
+    solver.step();
+    run.history.time.push_back(solver.time());
+    run.history.apex.push_back(-solver.displacement(apex).dot(model.particle_normal[apex]));
+    if (cap::first_peak_behind(run.history)) break;
+  }
   run.particles = model.particle_count();
   run.time_step = solver.time_step();
   run.cpu_seconds = double(std::clock() - start) / CLOCKS_PER_SEC;
@@ -83,7 +96,7 @@ LibraryRun run_library(cap::Case c, int m) {
 double relative(double value, double reference) { return std::abs(value - reference) / std::abs(reference); }
 
 void check_case(cap::Case c) {
-  const cap::History reference = cap::reference_history(c, reference_elements);
+  const cap::History reference = cap::reference_history(c, reference_elements, cap::Span::to_first_peak);
   const cap::Peak reference_peak = cap::first_peak(reference);
   REQUIRE(reference_peak.found);
   const LibraryRun coarse = run_library(c, coarse_m), fine = run_library(c, fine_m);
@@ -94,8 +107,8 @@ void check_case(cap::Case c) {
   for (const auto& [m, run, peak] : {std::tuple{coarse_m, &coarse, coarse_peak}, std::tuple{fine_m, &fine, fine_peak}})
     report << "; m = " << m << " (" << run->particles << " particles, dt " << run->time_step * 1e6 << " µs, "
            << run->cpu_seconds << " s CPU): " << peak.value * 1e3 << " mm at " << peak.time * 1e6
-           << " µs, history within " << 100 * cap::largest_difference(run->history, reference)
-           << " % of the reference's largest |u|";
+           << " µs, history to " << run->history.time.back() * 1e6 << " µs within "
+           << 100 * cap::largest_difference(run->history, reference) << " % of the reference's largest |u|";
   WARN(report.str());
   REQUIRE(coarse_peak.found);
   REQUIRE(fine_peak.found);

@@ -1,6 +1,10 @@
 // Must not compile: checkpointing a solver whose material law's State does not
 // list its fields (material/material.hpp, "Checkpoints").
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/mls.hpp>
+#include <sphshell/kernel/cubic_spline.hpp>
+#include <sphshell/material/elastic.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/gauss.hpp>
 
 // Elastic, but with a State of its own that has no for_each_field.
 struct SilentElastic : sphshell::material::Elastic {

@@ -1,6 +1,11 @@
 // Must not compile: an enabled crack policy whose visibility test lacks the
 // tangent frame the solver passes.
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/mls.hpp>
+#include <sphshell/crack/line_segments.hpp>
+#include <sphshell/kernel/cubic_spline.hpp>
+#include <sphshell/material/elastic.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/gauss.hpp>
 
 struct CrackWithoutFrame : sphshell::crack::LineSegments {
   static constexpr const char* name = "crack without frame";

@@ -1,5 +1,9 @@
 // Must not compile: a pre-crack on a solver whose crack policy is crack::None.
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/mls.hpp>
+#include <sphshell/kernel/cubic_spline.hpp>
+#include <sphshell/material/elastic.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/gauss.hpp>
 
 int main() {
   using namespace sphshell;

@@ -1,5 +1,9 @@
 // Must not compile: a stepper without advance_configuration as the fifth parameter.
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/mls.hpp>
+#include <sphshell/kernel/cubic_spline.hpp>
+#include <sphshell/material/elastic.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/gauss.hpp>
 
 struct HalfAStepper {
   double velocity_step(long, double time_step) const { return time_step; }

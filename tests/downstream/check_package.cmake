@@ -10,6 +10,14 @@
 #                   MPI were absent (CMAKE_DISABLE_FIND_PACKAGE_MPI), must still build
 #   install         only install into a scratch prefix and move it to WORK_DIR/moved-prefix,
 #                   for the consumers given it as PREFIX (one install shared by several checks)
+# What the consumer compiles: find_package-simd and include-only include the
+# whole library (the umbrella header), which shows that every installed header
+# compiles for a user (for SSE2 alone, a set the rest of the suite may not
+# compile for), and every header of a source tree without the generated version
+# header; the other checks show how the package is found and what its target or
+# .pc file passes (include directories, Eigen, definitions, flags, MPI), which
+# the core headers show as well (main.cpp, SPHSHELL_DOWNSTREAM_CORE_ONLY), at a
+# fraction of the compile time.
 # PREFIX: an installed and moved prefix (made by CONSUMER=install) that the
 # find_package* (but find_package-simd) and pkg-config consumers use instead of
 # installing one of their own.
@@ -76,10 +84,14 @@ if(CONSUMER STREQUAL "find_package" OR CONSUMER STREQUAL "find_package-simd")
     message(FATAL_ERROR "the package's SPHSHELL_SIMD resolved to '${chosen}'")
   endif()
   set(expected_simd -DEXPECTED_SIMD=${chosen})
+  set(core_only ON)
+  if(CONSUMER STREQUAL "find_package-simd")
+    set(core_only OFF)
+  endif()
   run_step(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/downstream -B ${WORK_DIR}/downstream-build
            -G ${GENERATOR} -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
            -DCMAKE_PREFIX_PATH=${moved_prefix} -DEXPECTED_VERSION=${EXPECTED_VERSION}
-           ${expected_simd})
+           ${expected_simd} -DCORE_ONLY=${core_only})
   run_step(${CMAKE_COMMAND} --build ${WORK_DIR}/downstream-build)
   run_step(${WORK_DIR}/downstream-build/downstream)
 elseif(CONSUMER STREQUAL "find_package-mpi")
@@ -94,7 +106,7 @@ elseif(CONSUMER STREQUAL "find_package-without-mpi")
   endif()
   run_step(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/downstream -B ${WORK_DIR}/downstream-build
            -G ${GENERATOR} -DCMAKE_CXX_COMPILER=${CXX_COMPILER} -DCMAKE_DISABLE_FIND_PACKAGE_MPI=ON
-           -DCMAKE_PREFIX_PATH=${moved_prefix} -DEXPECTED_VERSION=${EXPECTED_VERSION})
+           -DCMAKE_PREFIX_PATH=${moved_prefix} -DEXPECTED_VERSION=${EXPECTED_VERSION} -DCORE_ONLY=ON)
   run_step(${CMAKE_COMMAND} --build ${WORK_DIR}/downstream-build)
   run_step(${WORK_DIR}/downstream-build/downstream)
 elseif(CONSUMER STREQUAL "pkg-config")
@@ -129,7 +141,7 @@ elseif(CONSUMER STREQUAL "pkg-config")
     message(FATAL_ERROR "pkg-config --cflags sphshell ('${cflags}') does not name ${moved_include}")
   endif()
   run_step(${CXX_COMPILER} -std=c++17 ${compiler_flags} ${cflag_list}
-           "-DSPHSHELL_EXPECTED_VERSION=\"${EXPECTED_VERSION}\""
+           "-DSPHSHELL_EXPECTED_VERSION=\"${EXPECTED_VERSION}\"" -DSPHSHELL_DOWNSTREAM_CORE_ONLY
            ${SOURCE_DIR}/tests/downstream/main.cpp -o ${WORK_DIR}/downstream)
   run_step(${WORK_DIR}/downstream)
 elseif(CONSUMER STREQUAL "add_subdirectory")

@@ -20,7 +20,12 @@
 //  2. A 7 × 7 clamped plate under a pressure that yields it near the clamp, a
 //     few nonlinear explicit steps: the state stays finite and moves.
 
-#include <sphshell/sphshell.hpp>
+#include <sphshell/approx/all.hpp>
+#include <sphshell/crack/all.hpp>
+#include <sphshell/kernel/all.hpp>
+#include <sphshell/material/all.hpp>
+#include <sphshell/solver.hpp>
+#include <sphshell/thickness/all.hpp>
 
 #include <catch2/catch.hpp>
 

@@ -1,5 +1,12 @@
 // A consumer of sphshell::mpi: the exact sum of the ranks' numbers and the Error rule.
-#include <sphshell/mpi/all.hpp>
+// It includes the headers it uses (the MPI layer's communicator, reductions and
+// error agreement), not the distributed solver: what it checks is that the
+// component brings MPI and the target; that the headers compile for a consumer
+// is the umbrella header's check (tests/downstream/main.cpp).
+#include <sphshell/mpi/communicator.hpp>
+#include <sphshell/mpi/error_agreement.hpp>
+#include <sphshell/mpi/exact_sum.hpp>
+#include <sphshell/mpi/reductions.hpp>
 
 #include <iostream>
 
