@@ -13,6 +13,7 @@
 // response is credited to the nearest perturbed particle.
 
 #include <sphshell/core/types.hpp>
+#include <sphshell/statics/coupling.hpp>
 
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
@@ -26,12 +27,20 @@
 
 namespace sphshell::test_support {
 
+// Which particles are perturbed together.
+enum class PerturbationGroups {
+  grid_stride,      // every stride-th particle along x and y (PlateGrid::stride)
+  coupling_colours  // the colours of the solver's own coupling graph (statics/coupling.hpp)
+};
+
 struct PlateGrid {
   int nx, ny;  // particles along x and y (index j * nx + i)
   // Grid steps between particles perturbed together; 0 takes it from the
   // support on a uniform grid. A graded grid, whose supports span more steps
-  // where the steps are small, passes its own (max(nx, ny): one at a time).
+  // where the steps are small, passes its own (max(nx, ny): one at a time)
+  // or colours by the coupling graph, which follows each row's own support.
   int stride = 0;
+  PerturbationGroups groups = PerturbationGroups::grid_stride;
 };
 
 // Per-particle bending dofs: w (m), then rotations (rad) about x and y.
@@ -55,6 +64,35 @@ Eigen::VectorXd bending_forces(const Solver& solver) {
 template <class Solver>
 Eigen::SparseMatrix<double> assemble_bending_stiffness(Solver& solver, const PlateGrid& grid, double h) {
   const std::vector<Vector3> x0 = solver.positions(), d0 = solver.directors();
+  if (grid.groups == PerturbationGroups::coupling_colours) {
+    // The static family's coloured central differences over the solver's own
+    // rows: w, then the rotations about x and y, per particle.
+    using Approx = typename Solver::approximation_type;
+    const SolverOptions& options = solver.options();
+    const solver::IntegrationPoints<Approx> points(solver.model(), options.physics(), options.particle_integration(),
+                                                   solver.material().shear_modulus(),
+                                                   solver.material().poisson_ratio());
+    const std::size_t count = solver.particle_count();
+    std::vector<int> first(count + 1);
+    for (std::size_t i = 0; i <= count; ++i) first[i] = bending_dofs * static_cast<int>(i);
+    const Eigen::SparseMatrix<double> stiffness = statics::difference_tangent(
+        statics::coloured_coupling(points, count), first, [h](int, int) { return h; },
+        [&](const std::vector<statics::Perturbation>& perturbations) {
+          std::vector<Vector3> x = x0, d = d0;
+          for (const statics::Perturbation& m : perturbations) {
+            if (m.local == 0)
+              x[m.particle].z() += m.amount;
+            else
+              d[m.particle] =
+                  Eigen::AngleAxisd(m.amount, m.local == 1 ? Vector3::UnitX() : Vector3::UnitY()) * d0[m.particle];
+          }
+          solver.set_configuration(x, d);
+          return bending_forces(solver);
+        });
+    solver.set_configuration(x0, d0);
+    Eigen::SparseMatrix<double> transposed = stiffness.transpose();
+    return 0.5 * (stiffness + transposed);
+  }
   const double spacing = solver.model().maximum_spacing();
   const double reach = 2.0 * solver.options().support_radius_factor * spacing;
   const int stride = grid.stride > 0 ? grid.stride : static_cast<int>(std::ceil(2.0 * reach / spacing)) + 1;

@@ -5,9 +5,12 @@
 //
 // - linear_solve: one Newton step from the reference state, K u = λ f, the
 //   linear theory's answer (the whole solution of a linear solver).
-// - solve_to (load control): load steps, a full Newton iteration per step (the
-//   tangent re-assembled at every iteration), a step halved when its
-//   iteration diverges.
+// - solve_to (load control): load steps, a Newton iteration per step, a step
+//   halved when its iteration diverges. The tangent is assembled and
+//   factorised afresh at each iteration until the residual is small; from
+//   there one factorisation serves while the residual keeps falling fast
+//   (NewtonOptions::tangent_reuse_contraction; the factorisation dominates
+//   the cost of an iteration on the validation shells).
 // - solve_to_displacement (displacement control, Batoz & Dhatt, IJNME 14
 //   (1979) 1262–1267): one displacement Σ w_j u_j · e is prescribed step by
 //   step and λ is an unknown of each Newton iteration, so the path is followed
@@ -44,13 +47,22 @@ struct NewtonOptions {
   int max_iterations = 25;  // per load step, before the step is halved
   int max_halvings = 12;    // per load step
   TangentSteps steps;       // the tangent's finite-difference steps
+  // Modified Newton near the solution: once the relative residual is below
+  // detail::largest_reused_residual, the factorised tangent of an earlier
+  // iteration of the same step serves the next one as long as the relative
+  // residual fell at least by this factor over the last iteration; a slower
+  // fall assembles and factorises a fresh tangent. The convergence test is
+  // the same either way. In [0, 1); 0: a fresh tangent at every iteration
+  // (Newton's method itself).
+  double tangent_reuse_contraction = 0.3;
   // Displacement control: at most this many attempted sub-steps (halved
   // increments and failed tries included) per solve_to_displacement call, so
   // a path creeping in tiny steps (where the control cannot pass) stops with
   // an Error.
   int max_substeps = 64;
-  // Print every displacement-control iteration (load factor, relative
-  // residual, control gap) to standard error.
+  // Print every iteration (load factor, relative residual, for
+  // displacement control the control gap; whether the tangent was fresh) to
+  // standard error.
   bool trace = false;
 };
 
@@ -66,6 +78,12 @@ inline constexpr double load_divergence = 1e8;
 inline constexpr double target_reached = 1e-12;
 // The growth of a step after one taken whole.
 inline constexpr double step_growth = 1.5;
+// A kept factorisation serves only below this relative residual: further
+// from the solution the full Newton steps of the Sze cylinders overshoot
+// (relative residuals 1 → 8 → 1 → 5 in a step's first iterations), and a
+// tangent of an earlier iterate would compound that; the first iteration of
+// a step (residual of the predictor near 1 or above) always takes a fresh one.
+inline constexpr double largest_reused_residual = 1e-2;
 // A rotation angle below this (rad) has no axis to extrapolate along.
 inline constexpr double smallest_extrapolated_rotation = 1e-14;
 
@@ -77,6 +95,9 @@ inline void check(const NewtonOptions& options) {
     sphshell::detail::invalid_parameter("NewtonOptions::max_halvings", options.max_halvings, "must be >= 0");
   if (options.max_substeps < 1)
     sphshell::detail::invalid_parameter("NewtonOptions::max_substeps", options.max_substeps, "must be >= 1");
+  if (!(options.tangent_reuse_contraction >= 0.0 && options.tangent_reuse_contraction < 1.0))
+    sphshell::detail::invalid_parameter("NewtonOptions::tangent_reuse_contraction", options.tangent_reuse_contraction,
+                                        "must lie in [0, 1) (0: a fresh tangent at every iteration)");
 }
 
 }  // namespace detail
@@ -296,6 +317,8 @@ class PathFollower {
   template <class Control>
   bool converge_displacement(const Control& control, double target) {
     double smallest = std::numeric_limits<double>::infinity();
+    last_relative_ = std::numeric_limits<double>::infinity();
+    assembly_.discard_kept_factorisation();  // a step starts on a fresh tangent
     for (int iteration = 0; iteration < options_.max_iterations; ++iteration) {
       const DegreesOfFreedom dofs = assembly_.degrees_of_freedom();
       const Eigen::VectorXd f = assembly_.external_load(dofs);
@@ -314,22 +337,47 @@ class PathFollower {
         smallest = std::min(smallest, relative);
         if (relative <= options_.tolerance && std::abs(gap) <= options_.tolerance * std::abs(target)) return true;
       }
+      // The kept factorisation's degrees of freedom (they follow the
+      // directors, so they may lag the current ones by its age).
+      const DegreesOfFreedom& basis = tangent_for(dofs, reference > 0.0 ? r.norm() / reference : 0.0);
       Eigen::MatrixXd rhs(r.size(), 2);
-      rhs.col(0) = r;
-      rhs.col(1) = f;
-      const Eigen::MatrixXd solution = assembly_.solve(dofs, rhs, Factorisation::general, "on the path");
-      const Eigen::VectorXd g = control_gradient(dofs, control);
+      rhs.col(0) = &basis == &dofs ? r : assembly_.residual(basis, lambda_);
+      rhs.col(1) = &basis == &dofs ? f : assembly_.external_load(basis);
+      const Eigen::MatrixXd solution = assembly_.solve_kept(rhs);
+      const Eigen::VectorXd g = control_gradient(basis, control);
       const double along_load = g.dot(solution.col(1));
       if (!(std::abs(along_load) > 0.0)) return false;
       const double d_lambda = (gap - g.dot(solution.col(0))) / along_load;
       lambda_ += d_lambda;
-      assembly_.apply_update(dofs, solution.col(0) + d_lambda * solution.col(1));
+      assembly_.apply_update(basis, solution.col(0) + d_lambda * solution.col(1));
     }
     return false;
   }
 
+  // Modified Newton (NewtonOptions::tangent_reuse_contraction): keeps the
+  // factorisation of an earlier iteration of the step while the relative
+  // residual is small and falls fast enough, else factorises the tangent in
+  // `dofs`. `relative` is the
+  // current relative residual (0 when there is no load to measure it
+  // against: a fresh tangent). Returns the degrees of freedom of the
+  // factorisation to use: `dofs` itself when it is fresh.
+  const DegreesOfFreedom& tangent_for(const DegreesOfFreedom& dofs, double relative) {
+    const double contraction = options_.tangent_reuse_contraction;
+    const bool keep = contraction > 0.0 && relative > 0.0 && relative <= detail::largest_reused_residual &&
+                      assembly_.has_kept_factorisation() &&
+                      assembly_.kept_degrees_of_freedom().count() == dofs.count() &&
+                      !(relative > contraction * last_relative_);
+    last_relative_ = relative;
+    if (keep) return assembly_.kept_degrees_of_freedom();
+    if (options_.trace) std::fprintf(stderr, "  (a fresh tangent)\n");
+    assembly_.factorise(dofs, "on the path");
+    return dofs;
+  }
+
   // Load control's Newton iteration at λ.
   bool converge(double lambda) {
+    last_relative_ = std::numeric_limits<double>::infinity();
+    assembly_.discard_kept_factorisation();  // a step starts on a fresh tangent
     for (int iteration = 0; iteration < options_.max_iterations; ++iteration) {
       const DegreesOfFreedom dofs = assembly_.degrees_of_freedom();
       const Eigen::VectorXd r = assembly_.residual(dofs, lambda);
@@ -337,8 +385,12 @@ class PathFollower {
       const double relative = r.norm() / reference;
       if (!std::isfinite(relative)) return false;
       if (relative <= options_.tolerance) return true;
+      if (options_.trace)
+        std::fprintf(stderr, "  iteration %d: load factor %.8g, relative residual %.3e\n", iteration, lambda, relative);
       if (relative > detail::load_divergence) return false;
-      assembly_.apply_update(dofs, assembly_.solve(dofs, r, Factorisation::general, "on the path").col(0));
+      const DegreesOfFreedom& basis = tangent_for(dofs, relative);
+      const Eigen::VectorXd rhs = &basis == &dofs ? r : assembly_.residual(basis, lambda);
+      assembly_.apply_update(basis, assembly_.solve_kept(rhs).col(0));
     }
     return false;
   }
@@ -406,6 +458,8 @@ class PathFollower {
       }
       assembly_.set_configuration(x0, d0);
       lambda_ = lambda0;
+      // The halved step starts on a fresh tangent.
+      assembly_.discard_kept_factorisation();
       if (halvings + 1 > options_.max_halvings)
         throw Error("sphshell: " + failure(increment) + " after NewtonOptions::max_halvings = " +
                     std::to_string(options_.max_halvings) + " halvings (relative tolerance " +
@@ -419,6 +473,8 @@ class PathFollower {
   NewtonOptions options_;
   double lambda_ = 0.0;
   bool start_checked_ = false;
+  // The relative residual of the iteration before (tangent_for).
+  double last_relative_ = std::numeric_limits<double>::infinity();
   struct Converged {
     std::vector<Vector3> x, d;
     double lambda = 0.0;

@@ -26,6 +26,7 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -262,22 +263,54 @@ class TangentAssembly {
   // `where` names the state in an Error.
   // `check`: whether a pivot zero to rounding is refused as a mechanism (at
   // the unloaded start of a solve only, see factorise_checked).
+  // Factorisation::general goes through factorise (below), which keeps its
+  // factorisation for solve_kept.
   Eigen::MatrixXd solve(const DegreesOfFreedom& dofs, const Eigen::MatrixXd& rhs, Factorisation factorisation,
                         const std::string& where, MechanismCheck check = MechanismCheck::none) {
-    const SparseMatrix k = tangent(dofs);
     if (factorisation == Factorisation::symmetric) {
       Eigen::SimplicialLDLT<SparseMatrix> ldlt;
-      factorise_checked(ldlt, symmetrised(k), where, check);
+      factorise_checked(ldlt, symmetrised(tangent(dofs)), where, check);
       return ldlt.solve(rhs);
     }
-    Eigen::SparseLU<SparseMatrix> lu;
-    lu.compute(k);
-    if (lu.info() != Eigen::Success)
-      sphshell::detail::invalid_parameter("conditions (tangent stiffness " + where + ")", lu.lastErrorMessage(),
+    factorise(dofs, where);
+    return solve_kept(rhs);
+  }
+
+  // Assembles the tangent in `dofs` and factorises it by LU, kept (with the
+  // degrees of freedom it is written in) until the next factorise or discard.
+  // The fill-reducing ordering and the symbolic analysis depend on the
+  // pattern alone, so they are redone only when the pattern changes (the
+  // numbers are the same as a fresh analysis: the row pivoting is numeric).
+  void factorise(const DegreesOfFreedom& dofs, const std::string& where) {
+    const SparseMatrix k = tangent(dofs);
+    kept_.valid = false;
+    if (!kept_.lu) kept_.lu = std::make_unique<Eigen::SparseLU<SparseMatrix>>();
+    const bool same_pattern =
+        kept_.analysed && kept_.outer.size() == static_cast<std::size_t>(k.outerSize() + 1) &&
+        kept_.inner.size() == static_cast<std::size_t>(k.nonZeros()) &&
+        std::equal(kept_.outer.begin(), kept_.outer.end(), k.outerIndexPtr()) &&
+        std::equal(kept_.inner.begin(), kept_.inner.end(), k.innerIndexPtr());
+    if (!same_pattern) {
+      kept_.lu->analyzePattern(k);
+      kept_.outer.assign(k.outerIndexPtr(), k.outerIndexPtr() + k.outerSize() + 1);
+      kept_.inner.assign(k.innerIndexPtr(), k.innerIndexPtr() + k.nonZeros());
+      kept_.analysed = true;
+    }
+    kept_.lu->factorize(k);
+    if (kept_.lu->info() != Eigen::Success)
+      sphshell::detail::invalid_parameter("conditions (tangent stiffness " + where + ")", kept_.lu->lastErrorMessage(),
                                           "the LU factorisation met a zero pivot: a mechanism or a singular point "
                                           "of the path");
-    return lu.solve(rhs);
+    kept_.dofs = dofs;
+    kept_.valid = true;
   }
+
+  // Whether a factorisation is kept, the degrees of freedom it is written
+  // in, its solutions, and forgetting it.
+  bool has_kept_factorisation() const { return kept_.valid; }
+  const DegreesOfFreedom& kept_degrees_of_freedom() const { return kept_.dofs; }
+  Eigen::MatrixXd solve_kept(const Eigen::MatrixXd& rhs) const { return kept_.lu->solve(rhs); }
+  void discard_kept_factorisation() { kept_.valid = false; }
 
   // Moves the particles by an update in the degrees of freedom (translations
   // added, directors turned by the rotation vector of their degrees of freedom).
@@ -349,6 +382,15 @@ class TangentAssembly {
   double translation_step_ = 0.0;
   Coupling coupling_;
   NewtonReport report_;
+  // The last LU factorisation of the tangent (see factorise); the solver is
+  // held by pointer, as Eigen's solvers cannot be copied or moved.
+  struct KeptFactorisation {
+    std::unique_ptr<Eigen::SparseLU<SparseMatrix>> lu;
+    DegreesOfFreedom dofs;
+    std::vector<SparseMatrix::StorageIndex> outer, inner;  // the pattern analysed
+    bool analysed = false;
+    bool valid = false;
+  } kept_;
 };
 
 }  // namespace sphshell::statics
