@@ -343,7 +343,10 @@ void check_rigid_body_modes(const std::vector<std::vector<int>>& parts, const Pa
         for (int r = 0; r < basis.rotations[k]; ++r)
           fixed_w -= basis.rotation[k][static_cast<std::size_t>(r)].dot(w_normal) *
                      basis.rotation[k][static_cast<std::size_t>(r)];
-        columns.col(a) << fixed_u, size * fixed_w;
+        // Two segment writes, not a comma initializer: GCC 12 with AVX reads the
+        // 3-vector as a 4-wide load there and warns (-Warray-bounds).
+        columns.col(a).template head<3>() = fixed_u;
+        columns.col(a).template tail<3>() = size * fixed_w;
       }
       gram += columns.transpose() * columns;
     }
