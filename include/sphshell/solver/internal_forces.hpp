@@ -3,7 +3,11 @@
 // integration point: gather a1, a2, n, n1, n2 from its neighbours → strains
 // (Green or linear, shell/kinematics.hpp) → material update through the
 // thickness (Section) → resultants → the point's five conjugate forces (and
-// the corner forces of its edge-tied shear) kept per point; then each particle
+// the corner forces of its edge-tied shear) kept per point. The points go
+// through this in groups of points_per_group (SectionGroup,
+// section_group.hpp): the material update of a group's points runs side by
+// side, a vector lane a pair of point and integral point; a point alone is
+// the group of one. Then each particle
 // sums, over the shape-function slots that refer to it and in a fixed order
 // (IntegrationPoints::force_entries), the slot's share of its point's forces
 // (the deterministic sum: no atomic additions, identical results for any thread
