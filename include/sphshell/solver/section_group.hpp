@@ -21,9 +21,10 @@
 // so results agree with the point-by-point path to round-off, and bitwise
 // where the compiler contracts no multiply-adds. When the law has no batched
 // kernel, is rate-dependent (it needs the step's context at every integral
-// point), or the section is not a stack of integral points (the resultant
-// model thickness::Global), every point goes through its Section's own update,
-// exactly as one point alone would.
+// point), the section is not a stack of integral points (the resultant model
+// thickness::Global), or SPHSHELL_BATCHED_SECTIONS is 0 (the default below
+// AVX-512), every point goes through its Section's own update, exactly as one
+// point alone would.
 
 #include <sphshell/core/types.hpp>
 #include <sphshell/material/lanes.hpp>
@@ -39,8 +40,7 @@ namespace sphshell::solver {
 
 // Integration points the assembler integrates side by side. Eight points fill
 // an AVX-512 register per integral point of the rule (and two AVX2 or four
-// SSE2 registers); docs/performance-history.md records the measurement that
-// chose it.
+// SSE2 registers); other sizes are yet to be measured against it.
 inline constexpr int points_per_group = 8;
 
 // Whether thickness::Section<Rule, Law> is the primary template (a stack of
@@ -61,9 +61,15 @@ class SectionGroup {
 
   // Whether the group runs its points' integral points through the law's
   // batched kernel together; otherwise point by point through Section::update.
+  // SPHSHELL_BATCHED_SECTIONS (thickness/section.hpp) decides as it does for
+  // one point: moving the states, stored point by point, into lanes and back
+  // costs what the kernel saves unless the vector units are wide (with AVX2
+  // the group's lanes measured slower than its points one by one;
+  // docs/performance-history.md).
   static constexpr bool across_points = [] {
     if constexpr (layered_section_v<Rule, Law>)
-      return !material::is_rate_dependent_v<Law> && material::has_update_lanes_v<Law, G * Section::num_points>;
+      return SPHSHELL_BATCHED_SECTIONS != 0 && !material::is_rate_dependent_v<Law> &&
+             material::has_update_lanes_v<Law, G * Section::num_points>;
     else
       return false;
   }();
