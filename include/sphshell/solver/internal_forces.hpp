@@ -3,7 +3,11 @@
 // integration point: gather a1, a2, n, n1, n2 from its neighbours → strains
 // (Green or linear, shell/kinematics.hpp) → material update through the
 // thickness (Section) → resultants → the point's five conjugate forces (and
-// the corner forces of its edge-tied shear) kept per point; then each particle
+// the corner forces of its edge-tied shear) kept per point. The points go
+// through this in groups of points_per_group (SectionGroup,
+// section_group.hpp): the material update of a group's points runs side by
+// side, a vector lane a pair of point and integral point; a point alone is
+// the group of one. Then each particle
 // sums, over the shape-function slots that refer to it and in a fixed order
 // (IntegrationPoints::force_entries), the slot's share of its point's forces
 // (the deterministic sum: no atomic additions, identical results for any thread
@@ -31,9 +35,11 @@
 #include <sphshell/solver/assembly_schedule.hpp>
 #include <sphshell/solver/integration_points.hpp>
 #include <sphshell/solver/particles.hpp>
+#include <sphshell/solver/section_group.hpp>
 #include <sphshell/solver/section_states.hpp>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -95,13 +101,7 @@ class InternalForceAssembler {
       PointFailure& failure = failures_[segment];
       for (std::size_t run = schedule_.first_run(segment); run < schedule_.end_run(segment); ++run) {
         const AssemblySchedule::Run& rows = schedule_.run(run);
-        for (std::size_t row = rows.first_row; row < rows.end_row; ++row) {
-          try {
-            integrate_point(rows.group, row, points, states);
-          } catch (...) {
-            failure.keep_lowest(rows.group, row, std::current_exception());
-          }
-        }
+        integrate_rows(rows.group, rows.first_row, rows.end_row, points, states, failure);
         sum_run_chunks(points, chunks, rows, work_of, work_chunk_sums_.data());
         for (const std::uint32_t i : schedule_.completed_by(run)) sum(i, forces);
         for (const std::uint32_t band : schedule_.bands_after(run))
@@ -333,45 +333,90 @@ class InternalForceAssembler {
     }
   }
 
+  // What a point of a group keeps between its gather and its update.
+  struct GroupMember {
+    std::size_t row;
+    shell::SurfaceGradients current;
+    shell::Strains strains;
+    StrainVoigt d_membrane, d_curvature;
+    Vector2 d_shear;
+  };
+
+  // Integrates the rows [first_row, end_row) of a group of points, a
+  // SectionGroup of points_per_group active points at a time: each point's
+  // gather and strains, then the group's material update through the
+  // thickness (section_group.hpp), then each point's resultants, work,
+  // conjugate forces and tied shear. A failing point is kept in `failure`
+  // (the lowest row) and leaves the others of its group unaffected.
   template <class Approx, class Rule, class Law>
-  void integrate_point(PointGroup group, std::size_t row, const IntegrationPoints<Approx>& points,
-                       SectionStates<Rule, Law>& states) {
-    const std::size_t p = points.point(group, row);
-    if (!states.active(p)) {
-      work_increment_[p] = 0.0;
-      return;
+  void integrate_rows(PointGroup group, std::size_t first_row, std::size_t end_row,
+                      const IntegrationPoints<Approx>& points, SectionStates<Rule, Law>& states,
+                      PointFailure& failure) {
+    SectionGroup<Rule, Law> section_group;
+    std::array<GroupMember, std::size_t(points_per_group)> members;
+    for (std::size_t row = first_row; row < end_row;) {
+      section_group.clear();
+      for (; row < end_row && !section_group.full(); ++row) {
+        const std::size_t p = points.point(group, row);
+        if (!states.active(p)) {
+          work_increment_[p] = 0.0;
+          continue;
+        }
+        try {
+          GroupMember& member = members[std::size_t(section_group.size())];
+          member.row = row;
+          member.current = points.gather(group, row, packed_);
+          member.strains = strains_of(member.current, points, p);
+          member.d_membrane = member.strains.membrane - states.membrane_strain(p);
+          member.d_curvature = member.strains.curvature - states.curvature(p);
+          member.d_shear = member.strains.shear - states.shear_strain(p);
+          section_group.add(states.section(p), states.state(p), member.d_membrane, member.d_curvature);
+        } catch (...) {
+          failure.keep_lowest(group, row, std::current_exception());
+        }
+      }
+      // A rate-dependent law's sections get the step's context; every other
+      // section is called as it always was (a Section of the user's own need
+      // not take the context).
+      section_group.update(update_context_);
+      for (int g = 0; g < section_group.size(); ++g) {
+        const GroupMember& member = members[std::size_t(g)];
+        if (section_group.failure(g)) {
+          failure.keep_lowest(group, member.row, section_group.failure(g));
+          continue;
+        }
+        try {
+          finish_point(group, member, section_group.resultants(g), points, states);
+        } catch (...) {
+          failure.keep_lowest(group, member.row, std::current_exception());
+        }
+      }
     }
-    const shell::SurfaceGradients current = points.gather(group, row, packed_);
-    const shell::Strains strains = strains_of(current, points, p);
-    const StrainVoigt d_membrane = strains.membrane - states.membrane_strain(p);
-    const StrainVoigt d_curvature = strains.curvature - states.curvature(p);
-    const Vector2 d_shear = strains.shear - states.shear_strain(p);
-    // A rate-dependent law's section gets the step's time step; every other
-    // section is called as it always was (a Section of the user's own need
-    // not take the context).
-    const thickness::Resultants resultants = [&] {
-      if constexpr (material::is_rate_dependent_v<Law>)
-        return states.section(p).update(states.state(p), d_membrane, d_curvature, update_context_);
-      else
-        return states.section(p).update(states.state(p), d_membrane, d_curvature);
-    }();
+  }
+
+  // A point's bookkeeping after its material update: the new resultants and
+  // strains kept, the work over the step, its conjugate forces and tied shear.
+  template <class Approx, class Rule, class Law>
+  void finish_point(PointGroup group, const GroupMember& member, const thickness::Resultants& resultants,
+                    const IntegrationPoints<Approx>& points, SectionStates<Rule, Law>& states) {
+    const std::size_t p = points.point(group, member.row);
     // The elastic transverse shear force (weighted: the shear weight holds
     // κs G d A) is updated incrementally like the other resultants, so a
     // change of shape functions (after a crack) leaves it continuous.
-    const Vector2 shear_force = states.shear_force(p) + points.shear_weight(p) * d_shear;
+    const Vector2 shear_force = states.shear_force(p) + points.shear_weight(p) * member.d_shear;
     const double w = points.membrane_bending_weight(p);
     // Trapezoidal work of the generalized stresses over the strain increment.
-    work_increment_[p] = w * (0.5 * (states.membrane_force(p) + resultants.membrane).dot(d_membrane) +
-                              0.5 * (states.bending_moment(p) + resultants.moment).dot(d_curvature)) +
-                         0.5 * (states.shear_force(p) + shear_force).dot(d_shear);
-    states.restart_strains(p, strains);
+    work_increment_[p] = w * (0.5 * (states.membrane_force(p) + resultants.membrane).dot(member.d_membrane) +
+                              0.5 * (states.bending_moment(p) + resultants.moment).dot(member.d_curvature)) +
+                         0.5 * (states.shear_force(p) + shear_force).dot(member.d_shear);
+    states.restart_strains(p, member.strains);
     states.membrane_force(p) = resultants.membrane;
     states.bending_moment(p) = resultants.moment;
     states.shear_force(p) = shear_force;
     // The tied shear reads the corners from this step's packed kinematics
     // (the same numbers as the particle state's).
     const double tied_energy =
-        scatter(group, row, current, points, states,
+        scatter(group, member.row, member.current, points, states,
                 [&](int j) -> const Vector3& { return packed_[std::size_t(j)].position; },
                 [&](int j) -> const Vector3& { return packed_[std::size_t(j)].director; });
     // The tied shear is elastic and quadratic: its work over the step is
