@@ -144,8 +144,8 @@ int run(const Arguments& a) {
   // wall: a free rotation would swing its contact point between its faces.
   const ShellModel& model = solver.model();
   for (const char* end : {"z_min", "z_max"})
-    for (const Vector3& axis : {Vector3::UnitX(), Vector3::UnitY(), Vector3::UnitZ()})
-      solver.fix_rotation(model.set(end), axis);
+    for (int axis = 0; axis < 3; ++axis)
+      solver.fix_rotation(model.set(end), Vector3::Unit(axis));
 
   contact::PenaltyOptions wall_contact;
   wall_contact.friction_coefficient = a.friction;

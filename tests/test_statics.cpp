@@ -224,8 +224,8 @@ TEST_CASE("Statics: linear buckling of an axially compressed cylinder against th
   const double R = 1.0, t = R / 50.0, L = R, E = 1e9, nu = 0.3;
   const ShellModel model = ShellModel::cylindrical_panel(R, L, 2.0 * pi, 72, 19, t);
   statics::Conditions conditions(model.particle_count());
-  for (const Vector3& axis : {Vector3::UnitX(), Vector3::UnitY(), Vector3::UnitZ()})
-    conditions.hold_translation(model.set("z_min"), axis);
+  for (int axis = 0; axis < 3; ++axis)
+    conditions.hold_translation(model.set("z_min"), Vector3::Unit(axis));
   const ParticleSet top = model.set("z_max");
   const double classical = E * t / (R * std::sqrt(3.0 * (1.0 - nu * nu)));
   for (int i : top) {
