@@ -466,7 +466,12 @@ class RigidBodySet {
     // Each body's sums: a sum per chunk in index order, the chunks' sums in
     // chunk order (PenaltyContact::accumulate). A chunk without terms adds
     // nothing (its sums are +0, and none of these sums is −0).
-    std::sort(terms.begin(), terms.end(), [](const ContactTerm& a, const ContactTerm& b) {
+    // (body, particle) is unique, so a sort gives the one order whatever the
+    // input's; one process's terms arrive in it already, and the check alone runs.
+    const auto sorted_by = [&terms](auto&& before) {
+      if (!std::is_sorted(terms.begin(), terms.end(), before)) std::sort(terms.begin(), terms.end(), before);
+    };
+    sorted_by([](const ContactTerm& a, const ContactTerm& b) {
       return a.body != b.body ? a.body < b.body : a.particle < b.particle;
     });
     std::vector<ContactStepResult> totals(bodies_.size());
@@ -493,7 +498,7 @@ class RigidBodySet {
     // The contact forces' work on the particles: a sum per chunk (the bodies'
     // terms in body and index order, then the shell contact's), the chunks'
     // sums in chunk order.
-    std::sort(terms.begin(), terms.end(), [&](const ContactTerm& a, const ContactTerm& b) {
+    sorted_by([&](const ContactTerm& a, const ContactTerm& b) {
       const std::size_t chunk_a = chunk_of(a), chunk_b = chunk_of(b);
       if (chunk_a != chunk_b) return chunk_a < chunk_b;
       return a.body != b.body ? a.body < b.body : a.particle < b.particle;
