@@ -156,32 +156,74 @@ ShellModel touching_plates(int n) {
   return ShellModel::from_quads(positions, normals, quads, thickness);
 }
 
-void shell_contact_search(benchmark::State& state) {
-  constexpr double steel_density = 7850.0, time_step = 1e-7;
-  const ShellModel model = touching_plates(int(state.range(0)));
-  const std::size_t count = model.particle_count();
-  const std::vector<Vector3>& position = model.particle_position;
-  const std::vector<Vector3>& director = model.particle_normal;
-  const std::vector<Vector3> velocity(count, Vector3::Zero()), angular_velocity(count, Vector3::Zero());
-  const std::vector<double> thickness = model.particle_thicknesses();
-  std::vector<double> mass(count);
-  for (std::size_t i = 0; i < count; ++i) mass[i] = steel_density * model.particle_area[i] * thickness[i];
-  const contact::ContactParticles particles{position, director, velocity, angular_velocity, mass, thickness};
-  contact::ShellContact contact(model, {});
+// One size's contact: the model, the particles at rest in it, the contact.
+struct TouchingPlates {
+  static constexpr double steel_density = 7850.0, time_step = 1e-7;
+  ShellModel model;
+  std::vector<Vector3> velocity, angular_velocity;
+  std::vector<double> mass, thickness;
+  contact::ShellContact contact;
   contact::ParticleContactLoads loads;
-  // Untimed first call: it sizes the pair slots and loads (first touch of
-  // their pages), which a run's later steps reuse.
-  contact.compute(particles, time_step, loads);
-  for (auto _ : state) {
+
+  explicit TouchingPlates(int n)
+      : model(touching_plates(n)),
+        velocity(model.particle_count(), Vector3::Zero()),
+        angular_velocity(model.particle_count(), Vector3::Zero()),
+        thickness(model.particle_thicknesses()),
+        contact(model, {}) {
+    for (std::size_t i = 0; i < model.particle_count(); ++i)
+      mass.push_back(steel_density * model.particle_area[i] * thickness[i]);
+    // Untimed first call: it sizes the pair slots and loads (first touch of
+    // their pages), which a run's later steps reuse.
+    compute();
+  }
+  std::size_t size() const { return model.particle_count(); }
+  void compute() {
+    const contact::ContactParticles particles{model.particle_position, model.particle_normal, velocity,
+                                              angular_velocity, mass, thickness};
     contact.compute(particles, time_step, loads);
     benchmark::DoNotOptimize(loads.force.data());
   }
-  state.counters["ns_per_particle"] =
-      benchmark::Counter(double(count) * 1e-9, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
-  state.counters["particles"] = double(count);
-  state.counters["pairs_per_particle"] = double(contact.statistics().candidate_pairs) / double(count);
+};
+
+void shell_contact_search(benchmark::State& state) {
+  TouchingPlates plates(int(state.range(0)));
+  for (auto _ : state) plates.compute();
+  state.counters["ns_per_particle"] = benchmark::Counter(
+      double(plates.size()) * 1e-9, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.counters["particles"] = double(plates.size());
+  state.counters["pairs_per_particle"] =
+      double(plates.contact.statistics().candidate_pairs) / double(plates.size());
 }
 BENCHMARK(shell_contact_search)->Arg(71)->Arg(224)->Arg(708)->Unit(benchmark::kMillisecond);
+
+// The growth of the cost per particle from 2 × 71² to 2 × 708² particles,
+// both sizes advanced in alternating rounds (100 evaluations of the small,
+// one of the large: about the same time each) so that a change of machine
+// load hits both alike. `growth` is the large size's time per particle over
+// the small size's.
+void shell_contact_scaling(benchmark::State& state) {
+  constexpr int rounds = 20, small_per_round = 100;
+  TouchingPlates small(71), large(708);
+  for (auto _ : state) {
+    double small_seconds = 0.0, large_seconds = 0.0;
+    for (int round = 0; round < rounds; ++round) {
+      auto start = std::chrono::steady_clock::now();
+      for (int k = 0; k < small_per_round; ++k) small.compute();
+      small_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      start = std::chrono::steady_clock::now();
+      large.compute();
+      large_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
+    const double small_per_particle = small_seconds / (rounds * small_per_round) / double(small.size());
+    const double large_per_particle = large_seconds / rounds / double(large.size());
+    state.SetIterationTime(large_seconds / rounds);
+    state.counters["growth"] = large_per_particle / small_per_particle;
+    state.counters["small_ns_per_particle"] = 1e9 * small_per_particle;
+    state.counters["large_ns_per_particle"] = 1e9 * large_per_particle;
+  }
+}
+BENCHMARK(shell_contact_scaling)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(1)->Repetitions(3);
 
 }  // namespace
 
