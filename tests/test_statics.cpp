@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -86,6 +87,18 @@ TEST_CASE("Statics: bad input is an Error naming it, and the solver is left as i
       options.tangent_reuse_contraction = contraction;
       CHECK_THROWS_WITH(statics::PathFollower<NonlinearSolver>(solver, strip.conditions, options),
                         Catch::Contains("NewtonOptions::tangent_reuse_contraction") && Catch::Contains("[0, 1)"));
+    }
+  }
+  SECTION("GMRES options outside their ranges") {
+    statics::NewtonOptions options;
+    options.krylov_iterations = -1;
+    CHECK_THROWS_WITH(statics::PathFollower<NonlinearSolver>(solver, strip.conditions, options),
+                      Catch::Contains("NewtonOptions::krylov_iterations = -1") && Catch::Contains(">= 0"));
+    for (const double tolerance : {0.0, 1.0, -0.5, std::numeric_limits<double>::quiet_NaN()}) {
+      options.krylov_iterations = 10;
+      options.krylov_tolerance = tolerance;
+      CHECK_THROWS_WITH(statics::PathFollower<NonlinearSolver>(solver, strip.conditions, options),
+                        Catch::Contains("NewtonOptions::krylov_tolerance = ") && Catch::Contains("(0, 1)"));
     }
   }
   SECTION("a buckling reference load of zero") {
@@ -338,25 +351,144 @@ TEST_CASE("Statics: the kept factorisation (modified Newton) reaches the equilib
   // The strip bent by a tip force to a deflection of about a third of its
   // length, in two load steps: with a fresh tangent at every iteration and
   // with one kept while the residual falls by 0.9 per iteration (which keeps
-  // it as long as possible). Both stop below the relative residual 1e-8, so
-  // their tip deflections agree to about that.
-  auto tip_deflection = [](double contraction, int& iterations) {
+  // it as long as possible), and by GMRES on the kept factorisation
+  // (NewtonOptions::krylov_iterations). All stop below the relative residual
+  // 1e-8, so their tip deflections agree to about that.
+  auto tip_deflection = [](statics::NewtonOptions options, statics::NewtonReport& report) {
     Strip strip(11, 3);
     strip.conditions.add_force(strip.model.set("x_max"), Vector3(0.0, 0.0, 1.0 / 3.0));
     NonlinearSolver solver(strip.model, {Strip::E, 0.0});
-    statics::NewtonOptions options;
     options.tolerance = 1e-8;
-    options.tangent_reuse_contraction = contraction;
     statics::PathFollower<NonlinearSolver> path(solver, strip.conditions, options);
     path.solve_to(1.0, 0.5);
-    iterations = path.report().iterations;
+    report = path.report();
     return path.displacement(strip.model.set("x_max")[1]).z();
   };
-  int newton_iterations = 0, modified_iterations = 0;
-  const double newton = tip_deflection(0.0, newton_iterations);
-  const double modified = tip_deflection(0.9, modified_iterations);
-  std::printf("Strip tip deflection: full Newton %.10f (%d iterations), kept factorisation %.10f (%d iterations)\n",
-              newton, newton_iterations, modified, modified_iterations);
+  statics::NewtonReport newton_report, modified_report, krylov_report;
+  statics::NewtonOptions full, kept, krylov_steps;
+  full.tangent_reuse_contraction = 0.0;
+  kept.tangent_reuse_contraction = 0.9;
+  krylov_steps.krylov_iterations = 20;
+  const double newton = tip_deflection(full, newton_report);
+  const double modified = tip_deflection(kept, modified_report);
+  const double krylov = tip_deflection(krylov_steps, krylov_report);
+  std::printf("Strip tip deflection: full Newton %.10f (%d iterations, %d factorisations), kept factorisation %.10f "
+              "(%d iterations, %d factorisations), GMRES %.10f (%d iterations, %d factorisations, %ld products)\n",
+              newton, newton_report.iterations, newton_report.factorisations, modified, modified_report.iterations,
+              modified_report.factorisations, krylov, krylov_report.iterations, krylov_report.factorisations,
+              krylov_report.krylov_iterations);
   CHECK(newton > 0.2 * Strip::L);
   CHECK(modified == Approx(newton).epsilon(1e-6));
+  CHECK(krylov == Approx(newton).epsilon(1e-6));
+  // Full Newton factorises at every iteration; GMRES keeps a factorisation
+  // as its preconditioner across iterations and the two load steps.
+  CHECK(newton_report.factorisations == newton_report.iterations);
+  CHECK(krylov_report.krylov_iterations > 0);
+  CHECK(krylov_report.factorisations < newton_report.factorisations);
+}
+
+TEST_CASE("Statics: GMRES solves a nonsymmetric system to the tolerance asked, with and without a preconditioner",
+          "[statics]") {
+  // A convection–diffusion matrix (tridiagonal: a diagonal growing from 4
+  // to 7, −1.3 below and −0.7 above): the solution checked against Eigen's
+  // dense LU, the residual against the tolerance; an inexact preconditioner
+  // (the diagonal) needs more products than the exact one (the LU itself,
+  // one product).
+  const int n = 60;
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n);
+  for (int i = 0; i < n; ++i) {
+    a(i, i) = 4.0 + 3.0 * i / n;
+    if (i > 0) a(i, i - 1) = -1.3;
+    if (i + 1 < n) a(i, i + 1) = -0.7;
+  }
+  Eigen::VectorXd b(n);
+  for (int i = 0; i < n; ++i) b[i] = std::sin(1.0 + 0.75 * i);
+  const Eigen::VectorXd exact = a.partialPivLu().solve(b);
+  const auto apply = [&](const Eigen::VectorXd& v) { return Eigen::VectorXd(a * v); };
+  Eigen::VectorXd x;
+  const statics::KrylovSolve plain =
+      statics::gmres(apply, [](const Eigen::VectorXd& v) { return v; }, b, 1e-10, n, x);
+  CHECK(plain.converged);
+  CHECK(plain.iterations <= n);  // in exact arithmetic at most n: the Krylov space is then the whole space
+  CHECK((b - a * x).norm() <= 1.01e-10 * b.norm());
+  CHECK((x - exact).norm() <= 1e-8 * exact.norm());
+  CHECK(plain.relative_residual == Approx((b - a * x).norm() / b.norm()).epsilon(1e-3).margin(1e-14));
+  const Eigen::PartialPivLU<Eigen::MatrixXd> lu(a);
+  const statics::KrylovSolve exact_preconditioner =
+      statics::gmres(apply, [&](const Eigen::VectorXd& v) { return Eigen::VectorXd(lu.solve(v)); }, b, 1e-10, n, x);
+  CHECK(exact_preconditioner.iterations == 1);
+  CHECK((x - exact).norm() <= 1e-10 * exact.norm());
+  const statics::KrylovSolve jacobi =
+      statics::gmres(apply, [&](const Eigen::VectorXd& v) { return Eigen::VectorXd(v.cwiseQuotient(a.diagonal())); }, b,
+                     1e-10, n, x);
+  CHECK(jacobi.converged);
+  CHECK(jacobi.iterations > exact_preconditioner.iterations);
+  CHECK((x - exact).norm() <= 1e-8 * exact.norm());
+  // A budget too small: not converged, the best iterate still lowers the residual.
+  const statics::KrylovSolve short_budget =
+      statics::gmres(apply, [](const Eigen::VectorXd& v) { return v; }, b, 1e-10, 3, x);
+  CHECK_FALSE(short_budget.converged);
+  CHECK(short_budget.iterations == 3);
+  CHECK((b - a * x).norm() < b.norm());
+  CHECK(short_budget.relative_residual == Approx((b - a * x).norm() / b.norm()).epsilon(1e-6));
+  // The identity plus a rank-3 nonsymmetric part: its minimal polynomial has
+  // degree at most 4, so GMRES ends in at most 4 products (to rounding), at
+  // Eigen's direct solution.
+  Eigen::MatrixXd u(n, 3), w(n, 3);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < 3; ++j) {
+      u(i, j) = std::cos(0.3 * (i + 1) * (j + 1));
+      w(i, j) = std::sin(0.17 * (i + 2) + j);
+    }
+  const Eigen::MatrixXd low_rank = Eigen::MatrixXd::Identity(n, n) + 0.1 * u * w.transpose();
+  const Eigen::VectorXd low_rank_exact = low_rank.partialPivLu().solve(b);
+  const statics::KrylovSolve four = statics::gmres(
+      [&](const Eigen::VectorXd& v) { return Eigen::VectorXd(low_rank * v); },
+      [](const Eigen::VectorXd& v) { return v; }, b, 1e-12, n, x);
+  std::printf("GMRES: %d products on the 60 x 60 tridiagonal, %d with its diagonal as preconditioner, %d on the "
+              "identity plus rank 3\n",
+              plain.iterations, jacobi.iterations, four.iterations);
+  CHECK(four.converged);
+  CHECK(four.iterations <= 4);
+  CHECK((x - low_rank_exact).norm() <= 1e-11 * low_rank_exact.norm());
+}
+
+TEST_CASE("Statics: the tangent's product by differences equals the assembled tangent times the vector",
+          "[statics]") {
+  // The strip bent by a tip force (off the reference state, so geometric
+  // terms are in), then K v by tangent_product against the assembled tangent
+  // applied to the same v, and along single degrees of freedom against the
+  // tangent's columns. Both are central differences of the same Jacobian
+  // with steps of 1e-7 (of the spacing, or rad): their truncation error is
+  // of order 1e-14 and their round-off about 1e-16 / 1e-7 = 1e-9 of the
+  // forces' scale, so they agree to far better than the 1e-6 asked.
+  Strip strip(11, 3);
+  strip.conditions.add_force(strip.model.set("x_max"), Vector3(0.0, 0.0, 0.2));
+  NonlinearSolver solver(strip.model, {Strip::E, 0.0});
+  statics::PathFollower<NonlinearSolver> path(solver, strip.conditions);
+  path.solve_to(1.0, 0.5);
+  statics::TangentAssembly<NonlinearSolver>& assembly = path.assembly();
+  const statics::DegreesOfFreedom dofs = assembly.degrees_of_freedom();
+  const std::vector<Vector3> x0 = solver.positions(), d0 = solver.directors();
+  const statics::SparseMatrix k = assembly.tangent(dofs);
+  Eigen::VectorXd v(dofs.count());
+  for (int i = 0; i < dofs.count(); ++i) v[i] = std::sin(1.0 + 0.7548776662 * i) * (dofs.is_rotation[i] ? 0.1 : 1.0);
+  const Eigen::VectorXd assembled = k * v;
+  const Eigen::VectorXd product = assembly.tangent_product(dofs, x0, d0, v);
+  std::printf("Tangent product by differences against the assembled tangent: relative difference %.3e\n",
+              (product - assembled).norm() / assembled.norm());
+  CHECK((product - assembled).norm() <= 1e-6 * assembled.norm());
+  int translation = -1, rotation = -1;
+  for (int i = 0; i < dofs.count(); ++i) {
+    if (dofs.is_rotation[i] && rotation < 0 && i > dofs.count() / 2) rotation = i;
+    if (!dofs.is_rotation[i] && translation < 0 && i > dofs.count() / 2) translation = i;
+  }
+  REQUIRE(translation >= 0);
+  REQUIRE(rotation >= 0);
+  for (const int column : {translation, rotation}) {
+    const Eigen::VectorXd unit = Eigen::VectorXd::Unit(dofs.count(), column);
+    const Eigen::VectorXd expected = k * unit;
+    const Eigen::VectorXd along = assembly.tangent_product(dofs, x0, d0, unit);
+    CHECK((along - expected).norm() <= 1e-6 * expected.norm());
+  }
 }

@@ -27,6 +27,7 @@
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/statics/conditions.hpp>
+#include <sphshell/statics/krylov.hpp>
 #include <sphshell/statics/stability.hpp>
 #include <sphshell/statics/tangent.hpp>
 
@@ -42,6 +43,12 @@
 
 namespace sphshell::statics {
 
+// Where load control's Newton iteration starts a load step.
+enum class LoadPredictor {
+  extrapolated,  // the last two converged states extrapolated linearly in the load factor
+  last_state     // the last converged state (where a strongly nonlinear path makes the extrapolation overshoot)
+};
+
 struct NewtonOptions {
   double tolerance = 1e-6;  // ‖residual‖ ≤ tolerance · ‖λ f_ext‖, in (0, 1) (thin shells floor near 1e-7)
   int max_iterations = 25;  // per load step, before the step is halved
@@ -55,6 +62,16 @@ struct NewtonOptions {
   // the same either way. In [0, 1); 0: a fresh tangent at every iteration
   // (Newton's method itself).
   double tangent_reuse_contraction = 0.3;
+  // Load control's Newton steps by GMRES (statics/krylov.hpp): K δ = r
+  // solved to ‖r − K δ‖ ≤ krylov_tolerance ‖r‖ with the current tangent K
+  // applied by differences of the forces (two evaluations a product) and the
+  // kept factorisation of an earlier tangent, from this or an earlier step,
+  // as the preconditioner; a solve that needs more than krylov_iterations
+  // products assembles and factorises a fresh tangent and solves with it.
+  // 0: off (the kept factorisation used as it is, tangent_reuse_contraction).
+  int krylov_iterations = 0;
+  double krylov_tolerance = 1e-2;  // in (0, 1)
+  LoadPredictor predictor = LoadPredictor::extrapolated;
   // Displacement control: at most this many attempted sub-steps (halved
   // increments and failed tries included) per solve_to_displacement call, so
   // a path creeping in tiny steps (where the control cannot pass) stops with
@@ -95,6 +112,10 @@ inline void check(const NewtonOptions& options) {
     sphshell::detail::invalid_parameter("NewtonOptions::max_halvings", options.max_halvings, "must be >= 0");
   if (options.max_substeps < 1)
     sphshell::detail::invalid_parameter("NewtonOptions::max_substeps", options.max_substeps, "must be >= 1");
+  if (options.krylov_iterations < 0)
+    sphshell::detail::invalid_parameter("NewtonOptions::krylov_iterations", options.krylov_iterations,
+                                        "must be >= 0 (0: no GMRES)");
+  sphshell::detail::require_open_interval("NewtonOptions::krylov_tolerance", options.krylov_tolerance, 0.0, 1.0);
   if (!(options.tangent_reuse_contraction >= 0.0 && options.tangent_reuse_contraction < 1.0))
     sphshell::detail::invalid_parameter("NewtonOptions::tangent_reuse_contraction", options.tangent_reuse_contraction,
                                         "must lie in [0, 1) (0: a fresh tangent at every iteration)");
@@ -377,7 +398,8 @@ class PathFollower {
   // Load control's Newton iteration at λ.
   bool converge(double lambda) {
     last_relative_ = std::numeric_limits<double>::infinity();
-    assembly_.discard_kept_factorisation();  // a step starts on a fresh tangent
+    // A step starts on a fresh tangent, or with GMRES on the kept one as the preconditioner.
+    if (options_.krylov_iterations == 0) assembly_.discard_kept_factorisation();
     for (int iteration = 0; iteration < options_.max_iterations; ++iteration) {
       const DegreesOfFreedom dofs = assembly_.degrees_of_freedom();
       const Eigen::VectorXd r = assembly_.residual(dofs, lambda);
@@ -388,11 +410,43 @@ class PathFollower {
       if (options_.trace)
         std::fprintf(stderr, "  iteration %d: load factor %.8g, relative residual %.3e\n", iteration, lambda, relative);
       if (relative > detail::load_divergence) return false;
+      if (options_.krylov_iterations > 0) {
+        krylov_update(dofs, r);
+        continue;
+      }
       const DegreesOfFreedom& basis = tangent_for(dofs, relative);
       const Eigen::VectorXd rhs = &basis == &dofs ? r : assembly_.residual(basis, lambda);
       assembly_.apply_update(basis, assembly_.solve_kept(rhs).col(0));
     }
     return false;
+  }
+
+  // One Newton update K δ = r by GMRES on the current tangent, the kept
+  // factorisation its preconditioner (NewtonOptions::krylov_iterations);
+  // without one, or when GMRES needs more products than allowed, a fresh
+  // tangent is factorised at the current state and solved with directly.
+  void krylov_update(const DegreesOfFreedom& dofs, const Eigen::VectorXd& r) {
+    Solver& solver = assembly_.solver();
+    const std::vector<Vector3> x0 = solver.positions(), d0 = solver.directors();
+    if (assembly_.has_kept_factorisation() && assembly_.kept_degrees_of_freedom().count() == dofs.count()) {
+      Eigen::VectorXd update;
+      const KrylovSolve krylov = gmres(
+          [&](const Eigen::VectorXd& v) { return assembly_.tangent_product(dofs, x0, d0, v); },
+          [&](const Eigen::VectorXd& v) { return Eigen::VectorXd(assembly_.solve_kept(v).col(0)); }, r,
+          options_.krylov_tolerance, options_.krylov_iterations, update);
+      assembly_.report().krylov_iterations += krylov.iterations;
+      if (options_.trace)
+        std::fprintf(stderr, "  (GMRES: %d products, relative residual %.3e)\n", krylov.iterations,
+                     krylov.relative_residual);
+      if (krylov.converged) {
+        assembly_.apply_update(dofs, x0, d0, update);
+        return;
+      }
+      assembly_.set_configuration(x0, d0);
+    }
+    if (options_.trace) std::fprintf(stderr, "  (a fresh tangent)\n");
+    assembly_.factorise(dofs, "on the path");
+    assembly_.apply_update(dofs, assembly_.solve_kept(r).col(0));
   }
 
   // The start of a displacement step: the last two converged states (and
@@ -407,9 +461,10 @@ class PathFollower {
   }
 
   // The start of a load step: the last two converged states extrapolated
-  // linearly in the load factor, else the current state.
+  // linearly in the load factor, else (or with LoadPredictor::last_state)
+  // the current state.
   void predict(double target) {
-    if (previous_.x.empty()) return;
+    if (previous_.x.empty() || options_.predictor == LoadPredictor::last_state) return;
     const double span = lambda_ - previous_.lambda;
     if (!(span > 0.0)) return;
     extrapolate((target - lambda_) / span);

@@ -39,6 +39,8 @@ struct NewtonReport {
   int load_steps = 0;          // converged steps, halved ones included
   int iterations = 0;          // Newton updates in all
   long force_evaluations = 0;  // internal-force computations in all
+  int factorisations = 0;      // tangents assembled and factorised for Newton steps
+  long krylov_iterations = 0;  // tangent products of the GMRES Newton steps (NewtonOptions::krylov_iterations)
 };
 
 // The finite-difference steps of the tangent.
@@ -303,6 +305,7 @@ class TangentAssembly {
                                           "of the path");
     kept_.dofs = dofs;
     kept_.valid = true;
+    ++report_.factorisations;
   }
 
   // Whether a factorisation is kept, the degrees of freedom it is written
@@ -315,22 +318,40 @@ class TangentAssembly {
   // Moves the particles by an update in the degrees of freedom (translations
   // added, directors turned by the rotation vector of their degrees of freedom).
   void apply_update(const DegreesOfFreedom& dofs, const Eigen::VectorXd& update) {
-    std::vector<Vector3> x = solver_.positions(), d = solver_.directors();
-    const int n = static_cast<int>(x.size());
-    for (int i = 0; i < n; ++i) {
-      Vector3 rotation = Vector3::Zero();
-      for (int k = dofs.first[i]; k < dofs.first[i + 1]; ++k) {
-        if (dofs.is_rotation[k])
-          rotation += update[k] * dofs.direction[k];
-        else
-          x[i] += update[k] * dofs.direction[k];
-      }
-      const double angle = rotation.norm();
-      if (angle > 0.0) d[i] = Eigen::AngleAxisd(angle, rotation / angle) * d[i];
-    }
-    solver_.set_configuration(std::move(x), std::move(d));
+    apply_update(dofs, solver_.positions(), solver_.directors(), update);
+  }
+  // The same from the configuration (x0, d0) instead of the current one.
+  void apply_update(const DegreesOfFreedom& dofs, std::vector<Vector3> x0, std::vector<Vector3> d0,
+                    const Eigen::VectorXd& update) {
+    moved(dofs, update, x0, d0);
+    solver_.set_configuration(std::move(x0), std::move(d0));
     ++report_.force_evaluations;
     ++report_.iterations;
+  }
+
+  // The tangent stiffness at the configuration (x0, d0) applied to v, K v
+  // with K = −∂r/∂q in `dofs`, by a central difference of the forces along v
+  // (two force evaluations): the configuration moved by ±h v as apply_update
+  // moves it, h taking the largest translation of v to the tangent's
+  // translation step and its largest rotation to the rotation step, the
+  // steps whose round-off and truncation the assembled tangent balances.
+  // The solver is left in a moved configuration: the caller sets the one it
+  // wants afterwards.
+  Eigen::VectorXd tangent_product(const DegreesOfFreedom& dofs, const std::vector<Vector3>& x0,
+                                  const std::vector<Vector3>& d0, const Eigen::VectorXd& v) {
+    double h = std::numeric_limits<double>::infinity();
+    for (Eigen::Index k = 0; k < v.size(); ++k)
+      if (v[k] != 0.0) h = std::min(h, step_of(dofs, static_cast<int>(k)) / std::abs(v[k]));
+    if (!std::isfinite(h)) return Eigen::VectorXd::Zero(v.size());
+    Eigen::VectorXd response[2];
+    for (int side = 0; side < 2; ++side) {
+      std::vector<Vector3> x = x0, d = d0;
+      moved(dofs, (side == 0 ? h : -h) * v, x, d);
+      solver_.set_configuration(std::move(x), std::move(d));
+      ++report_.force_evaluations;
+      response[side] = residual(dofs, 0.0);
+    }
+    return (response[1] - response[0]) / (2.0 * h);
   }
 
   // Each particle's translation and director rotation in a vector of the
@@ -353,6 +374,23 @@ class TangentAssembly {
  private:
   double step_of(const DegreesOfFreedom& dofs, int k) const {
     return dofs.is_rotation[k] ? steps_.rotation : translation_step_;
+  }
+
+  // x and d moved by an update in the degrees of freedom (see apply_update).
+  static void moved(const DegreesOfFreedom& dofs, const Eigen::VectorXd& update, std::vector<Vector3>& x,
+                    std::vector<Vector3>& d) {
+    const int n = static_cast<int>(x.size());
+    for (int i = 0; i < n; ++i) {
+      Vector3 rotation = Vector3::Zero();
+      for (int k = dofs.first[i]; k < dofs.first[i + 1]; ++k) {
+        if (dofs.is_rotation[k])
+          rotation += update[k] * dofs.direction[k];
+        else
+          x[i] += update[k] * dofs.direction[k];
+      }
+      const double angle = rotation.norm();
+      if (angle > 0.0) d[i] = Eigen::AngleAxisd(angle, rotation / angle) * d[i];
+    }
   }
 
   // Moves particle i by degree of freedom k's amount `amount`.
