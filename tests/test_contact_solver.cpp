@@ -23,6 +23,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <sstream>
 #include <string>
 #include <vector>
 #ifdef _OPENMP
@@ -230,15 +232,38 @@ TEST_CASE("rigid bodies: refused input and the probe", "[contact]") {
   CHECK(solver.rigid_body_count() == 0);
   CHECK_THROWS_WITH(solver.rigid_body(0), Catch::Contains("rigid body id"));
   // A wall below the plate, and a probe of it.
+  const test_support::ScratchDirectory directory("contact_probe");
   const contact::RigidBodyId wall = solver.add_rigid_body(contact::fixed_wall({0.0, 0.0, -0.01}, Vector3::UnitZ()));
-  const std::string probe = "test_contact_solver_wall.csv";
+  CHECK_THROWS_WITH(solver.add_rigid_body_probe((directory / "none.csv").string(), wall + 1),
+                    Catch::Contains("rigid body id"));
+  // A probe file whose folder is a file, and a file another probe has.
+  std::ofstream((directory / "not_a_folder").string()) << "x";
+  const std::string unwritable = (directory / "not_a_folder" / "wall.csv").string();
+  CHECK_THROWS_WITH(solver.add_rigid_body_probe(unwritable, wall), Catch::Contains(unwritable));
+  const std::string taken = (directory / "particle.csv").string();
+  solver.add_particle_probe(taken, 0);
+  CHECK_THROWS_WITH(solver.add_rigid_body_probe(taken, wall),
+                    Catch::Contains(taken) && Catch::Contains("already the file of another probe"));
+  const std::string probe = (directory / "wall.csv").string();
   solver.add_rigid_body_probe(probe, wall);
   for (int k = 0; k < 3; ++k) solver.step();
   std::ifstream in(probe);
-  std::string line;
-  int lines = 0;
-  while (std::getline(in, line)) ++lines;
-  CHECK(lines == 2 + 1 + 3);  // comment, header, the start and three steps
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  REQUIRE(lines.size() == 1 + 1 + 3);  // header, the start and three steps
+  CHECK(lines.front() ==
+        "t [s],x [m],y [m],z [m],vx at t-dt/2 [m/s],vy at t-dt/2 [m/s],vz at t-dt/2 [m/s],fx [N],fy [N],fz [N],"
+        "impulse_x [N s],impulse_y [N s],impulse_z [N s],contacts");
+  // The last row: the time of the third step and the wall where it was put, untouched.
+  std::vector<double> row;
+  std::istringstream fields(lines.back());
+  for (std::string field; std::getline(fields, field, ',');) row.push_back(std::stod(field));
+  REQUIRE(row.size() == 14);
+  CHECK(row[0] == solver.time());
+  CHECK(row[0] == 3.0 * solver.time_step());
+  CHECK(row[1] == 0.0);
+  CHECK(row[3] == -0.01);
+  CHECK(row[13] == 0.0);
 }
 
 namespace {
@@ -328,6 +353,142 @@ TEST_CASE("a plate struck by a free sphere, checkpointed mid-impact and restarte
   CHECK(same_bits(e.contact_work_on_shell, f.contact_work_on_shell));
   CHECK(same_bits(e.rigid_body_work, f.rigid_body_work));
   CHECK(same_bits(e.balance(), f.balance()));
+}
+
+namespace {
+
+std::string file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+void write_bytes(const std::string& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+}  // namespace
+
+TEST_CASE("a body probe continues across a restart: its file is byte for byte the uninterrupted run's",
+          "[contact][checkpoint][probe]") {
+  const test_support::ScratchDirectory directory("contact_probe_restart");
+  const ShellModel plate = ShellModel::rectangular_plate(plate_side, plate_side, plate_particles, plate_particles,
+                                                         plate_thickness);
+  const Vector3 strike(0.3 * impact_speed, 0.0, -impact_speed);
+  const auto set_up = [&](PlateSolver& solver) {
+    solver.clamp(plate.set("boundary"));
+    solver.add_rigid_body(sphere_above_plate(impact_gap, strike), rough_contact());
+  };
+  const std::string reference_probe = (directory / "reference.csv").string();
+  const std::string probe = (directory / "restarted.csv").string();
+  const std::string checkpoint = (directory / "run.ckpt").string();
+  // The sphere strikes after 50 µs; the checkpoint is taken at the first
+  // step after 150 µs that ends in contact, and the first run goes on past
+  // it (its rows after the checkpoint are cut off on restart).
+  constexpr double checkpoint_after = 1.5e-4, killed_at = 2.2e-4, end_time = 3e-4;
+  PlateSolver reference(plate, steel, plate_options());
+  set_up(reference);
+  reference.add_rigid_body_probe(reference_probe, 0);
+  reference.run_until(end_time);
+  {
+    PlateSolver first(plate, steel, plate_options());
+    set_up(first);
+    first.add_rigid_body_probe(probe, 0);
+    first.run_until(checkpoint_after);
+    while (first.rigid_body(0).contacts == 0 && first.time() < killed_at) first.step();
+    REQUIRE(first.rigid_body(0).contacts > 0);
+    first.save_checkpoint(checkpoint);
+    first.run_until(killed_at);
+  }
+  PlateSolver restarted(plate, steel, plate_options());
+  set_up(restarted);
+  restarted.load_checkpoint(checkpoint);
+  restarted.add_rigid_body_probe(probe, 0);
+  restarted.run_until(end_time);
+  REQUIRE(restarted.steps() == reference.steps());
+  const std::string expected = file_bytes(reference_probe);
+  CHECK(std::count(expected.begin(), expected.end(), '\n') == 1 + 1 + reference.steps());  // header, start, steps
+  CHECK(file_bytes(probe) == expected);
+}
+
+TEST_CASE("a body probe's file is not continued when it was rewritten or is another probe's",
+          "[contact][checkpoint][probe][errors]") {
+  const test_support::ScratchDirectory directory("contact_probe_refused");
+  const ShellModel plate = ShellModel::rectangular_plate(plate_side, plate_side, plate_particles, plate_particles,
+                                                         plate_thickness);
+  const auto set_up = [&](PlateSolver& solver) {
+    solver.add_rigid_body(sphere_above_plate(impact_gap, {0.0, 0.0, -impact_speed}));
+    solver.add_rigid_body(contact::fixed_wall({0.0, 0.0, -0.01}, Vector3::UnitZ()));
+  };
+  const std::string probe = (directory / "sphere.csv").string();
+  const std::string checkpoint = (directory / "run.ckpt").string();
+  const std::string without_probe = (directory / "no_probe.ckpt").string();
+  std::string at_checkpoint, killed;
+  {
+    PlateSolver run(plate, steel, plate_options());
+    set_up(run);
+    for (int n = 0; n < 5; ++n) run.step();
+    run.save_checkpoint(without_probe);  // as a checkpoint from before body probes were recorded
+    run.add_rigid_body_probe(probe, 0);
+    for (int n = 0; n < 5; ++n) run.step();
+    run.save_checkpoint(checkpoint);
+    at_checkpoint = file_bytes(probe);
+    for (int n = 0; n < 5; ++n) run.step();
+    killed = file_bytes(probe);
+  }
+  REQUIRE(killed.size() > at_checkpoint.size());
+  const auto loaded = [&](const std::string& path) {
+    PlateSolver solver(plate, steel, plate_options());
+    set_up(solver);
+    solver.load_checkpoint(path);
+    return solver;
+  };
+  // Another body's probe, or a particle's, on the recorded file.
+  {
+    PlateSolver solver = loaded(checkpoint);
+    CHECK_THROWS_WITH(solver.add_rigid_body_probe(probe, 1),
+                      Catch::Contains("'" + probe + "'") &&
+                          Catch::Contains("rigid body probe of rigid body 0, not of rigid body 1"));
+    CHECK_THROWS_WITH(solver.add_particle_probe(probe, 60),
+                      Catch::Contains("rigid body probe of rigid body 0, not of particle 60"));
+    CHECK(file_bytes(probe) == killed);  // refused before the file was touched
+  }
+  // A row edited since the checkpoint (one digit of the first row), and the file cut short.
+  std::string edited = at_checkpoint;
+  const std::size_t first_row = edited.find('\n') + 1;
+  const std::size_t digit = edited.find_first_of("123456789", first_row);
+  REQUIRE(digit < at_checkpoint.size());
+  edited[digit] = edited[digit] == '9' ? '8' : static_cast<char>(edited[digit] + 1);
+  write_bytes(probe, edited);
+  CHECK_THROWS_WITH(loaded(checkpoint).add_rigid_body_probe(probe, 0),
+                    Catch::Contains("CSV probe '" + probe + "'") && Catch::Contains("no longer holds the rows"));
+  write_bytes(probe, at_checkpoint.substr(0, at_checkpoint.size() - 1));
+  CHECK_THROWS_WITH(loaded(checkpoint).add_rigid_body_probe(probe, 0),
+                    Catch::Contains("CSV probe '" + probe + "'") && Catch::Contains("fewer than the"));
+  // Added before loading: the file starts anew, so its rows are gone.
+  write_bytes(probe, killed);
+  {
+    PlateSolver solver(plate, steel, plate_options());
+    set_up(solver);
+    solver.add_rigid_body_probe(probe, 0);
+    CHECK_THROWS_WITH(solver.load_checkpoint(checkpoint),
+                      Catch::Contains("CSV probe '" + probe + "'") && Catch::Contains("add probes after restoring"));
+  }
+  // The file as the killed run left it: continued, its rows past the checkpoint cut off.
+  write_bytes(probe, killed);
+  {
+    PlateSolver solver = loaded(checkpoint);
+    solver.add_rigid_body_probe(probe, 0);
+    CHECK(file_bytes(probe) == at_checkpoint);
+  }
+  // A checkpoint that records no body probe: the probe starts its file (header and the row of now).
+  {
+    PlateSolver solver = loaded(without_probe);
+    solver.add_rigid_body_probe(probe, 0);
+    const std::string restarted = file_bytes(probe);
+    CHECK(std::count(restarted.begin(), restarted.end(), '\n') == 2);
+    CHECK(restarted.rfind("t [s],", 0) == 0);
+    CHECK(std::stod(restarted.substr(restarted.find('\n') + 1)) == solver.time());  // the row of the loaded time
+    CHECK(solver.time() == 5.0 * solver.time_step());
+  }
 }
 
 TEST_CASE("a checkpoint whose rigid bodies are not the solver's is refused, naming what differs",

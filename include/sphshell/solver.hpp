@@ -461,7 +461,6 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
     if (bodies_.active()) this->finish_contact_step(context.at, context.velocity_step);
     ++steps_;
     time_ = start_time_ + static_cast<double>(steps_) * time_step_;  // t = t0 + n Δt, never summed
-    bodies_.write_probes(time_);
     forces_current_ = false;
     if (failed.state < domain_.owned_count()) keep_first(failure, this->non_finite_state(now(), failed.state));
     domain_.agree(failure);

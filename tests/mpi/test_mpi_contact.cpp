@@ -6,7 +6,8 @@
 // contact count) and the contact's energy terms must be bitwise the serial
 // ones; the shell's energies within 1e-12 relative (exact sums over the
 // ranks against the serial loop's, solver/energy_ledger.hpp). A body's probe
-// and frames are written once, by rank 0, and are the serial run's bytes.
+// and frames are written once, by rank 0, and are the serial run's bytes; a
+// restart continues the probe's file.
 // Refused input is the serial Error on every rank, with nothing written.
 #include <sphshell/approx/mls.hpp>
 #include <sphshell/contact/all.hpp>
@@ -277,11 +278,11 @@ TEST_CASE("Distributed rigid bodies: a plate pressed by a moving wall onto a fix
   serial.write_frame();
   comm.barrier();
   if (comm.is_root()) {
-    // One probe, written by rank 0: the serial run's bytes (two header lines,
+    // One probe, written by rank 0: the serial run's bytes (a header line,
     // the start and a row per step).
     const std::string probe = file_text(distributed_dir / "wall.csv");
     CHECK(probe == file_text(serial_dir / "wall.csv"));
-    CHECK(std::count(probe.begin(), probe.end(), '\n') == steps + 3);
+    CHECK(std::count(probe.begin(), probe.end(), '\n') == steps + 2);
     // The bodies' frames (a plane drawn over the whole shell): the serial run's bytes.
     int frames = 0;
     for (const fs::directory_entry& entry : fs::directory_iterator(serial_dir / "frames")) {
@@ -336,9 +337,16 @@ TEST_CASE("Distributed rigid bodies: refused input is the serial Error on every 
         message_of([&] { serial.add_rigid_body_probe("unused.csv", 0); }));
   CHECK_FALSE(fs::exists("unused.csv"));
   distributed.add_rigid_body(clear);
-  const std::string bad_path = (fs::temp_directory_path() / "sphshell_no_such_directory" / "probe.csv").string();
-  CHECK_THAT(message_of([&] { distributed.add_rigid_body_probe(bad_path, 0); }),
-             Catch::Contains("rigid body probe path"));
+  serial.add_rigid_body(clear);
+  const fs::path not_a_folder = fs::temp_directory_path() / ("sphshell_mpi_probe_folder_np" + std::to_string(comm.size()));
+  if (comm.is_root()) std::ofstream(not_a_folder.string()) << "a file";
+  comm.barrier();
+  const std::string bad_path = (not_a_folder / "probe.csv").string();
+  const std::string serial_bad_path = message_of([&] { serial.add_rigid_body_probe(bad_path, 0); });
+  CHECK_THAT(serial_bad_path, Catch::Contains(bad_path));
+  CHECK(message_of([&] { distributed.add_rigid_body_probe(bad_path, 0); }) == serial_bad_path);
+  comm.barrier();
+  if (comm.is_root()) fs::remove(not_a_folder);
   // The shell contact enabled twice: the serial Error.
   serial.enable_shell_contact();
   distributed.enable_shell_contact();
@@ -420,8 +428,11 @@ TEST_CASE("Distributed rigid body: a restart from a checkpoint taken in contact 
     solver.clamp("boundary");
     solver.add_rigid_body(sphere, rough);
   };
+  // The sphere's probe, written by rank 0: the restarted run continues the file.
+  const std::string probe = (folder / "sphere.csv").string();
   Distributed<material::Elastic> original(comm, model, steel, plate_options());
   set_up(original);
+  original.add_rigid_body_probe(probe, 0);
   // Saved at the first step in contact (every rank holds the same body: the
   // loop ends alike on all of them).
   for (int n = 0; n < 200 && original.rigid_body(0).contacts == 0; ++n) original.step();
@@ -431,10 +442,17 @@ TEST_CASE("Distributed rigid body: a restart from a checkpoint taken in contact 
   CHECK(std::abs(original.rigid_body(0).contact_force.x()) > 1e-3 * std::abs(original.rigid_body(0).contact_force.z()));
   original.save_checkpoint(path);
   for (int n = 0; n < 30; ++n) original.step();
+  const std::string whole_probe = comm.is_root() ? file_text(probe) : std::string();
   Distributed<material::Elastic> restarted(comm, model, steel, plate_options());
   set_up(restarted);
   restarted.load_checkpoint(path);
+  restarted.add_rigid_body_probe(probe, 0);
   for (int n = 0; n < 30; ++n) restarted.step();
+  if (comm.is_root()) {
+    // The uninterrupted run's bytes: its rows after the checkpoint cut off and written again.
+    CHECK(std::count(whole_probe.begin(), whole_probe.end(), '\n') == 1 + 1 + original.steps());
+    CHECK(file_text(probe) == whole_probe);
+  }
   check_bodies(original, restarted, "30 steps after the restart");
   CHECK(mpi_test::differing_components(restarted.positions(), original.positions()) == 0);
   CHECK(mpi_test::differing_components(restarted.velocities(), original.velocities()) == 0);

@@ -64,8 +64,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
-#include <fstream>
-#include <iomanip>
 #include <memory>
 #include <optional>
 #include <string>
@@ -593,41 +591,7 @@ class RigidBodySet {
                                               std::to_string(bodies_.size()) + ")");
   }
 
-  // CSV time history of one body: written now and after every step (by the
-  // one process that adds it: every process holds the same bodies).
-  void add_probe(const std::string& csv_path, RigidBodyId id, double time) {
-    check(id);
-    Probe probe{id, std::ofstream(csv_path)};
-    if (!probe.file)
-      sphshell::detail::invalid_parameter("rigid body probe path", csv_path, "must be a file that can be written");
-    probe.file << "# rigid body " << id
-               << ": t (s); centre x, y, z at t (m); velocity at t - dt/2 (m/s); contact force and impulse "
-                  "received (N, N s); particles in contact\n"
-               << "t,x,y,z,vx,vy,vz,fx,fy,fz,impulse_x,impulse_y,impulse_z,contacts\n"
-               << std::setprecision(17);
-    probes_.push_back(std::move(probe));
-    write_probe(probes_.back(), time);
-  }
-  void write_probes(double time) {
-    for (Probe& probe : probes_) write_probe(probe, time);
-  }
-
  private:
-  struct Probe {
-    RigidBodyId id;
-    std::ofstream file;
-  };
-  void write_probe(Probe& probe, double time) const {
-    const RigidBodyState s = bodies_[probe.id]->state();
-    const Vector3& x = s.kinematics.position;
-    const Vector3& v = s.kinematics.velocity;
-    probe.file << time << ',' << x.x() << ',' << x.y() << ',' << x.z() << ',' << v.x() << ',' << v.y() << ','
-               << v.z() << ',' << s.contact_force.x() << ',' << s.contact_force.y() << ',' << s.contact_force.z()
-               << ',' << s.contact_impulse.x() << ',' << s.contact_impulse.y() << ',' << s.contact_impulse.z() << ','
-               << s.contacts << '\n';
-    probe.file.flush();
-  }
-
   std::vector<std::unique_ptr<detail::BodyContact>> bodies_;
   std::unique_ptr<ShellContact> shell_contact_;  // null: no self contact
   ParticleContactLoads shell_loads_;        // local numbering
@@ -646,7 +610,6 @@ class RigidBodySet {
   };
 
   ContactEnergy energy_;
-  std::vector<Probe> probes_;
 };
 
 }  // namespace sphshell::contact

@@ -3,9 +3,9 @@
 // bodies and the shell's contact with itself. The bodies and the shell
 // contact live in the solver's RigidBodySet (contact/body_set.hpp), which
 // the step calls before and after its particle pass; this part adds them,
-// queries them, writes their probes and ends their step. The solver gives it
-// its domain, model, options, time, time step, step latch and contact
-// particles.
+// queries them, adds their probes (to the solver's CSV probes,
+// solver/output_probes.hpp) and ends their step. The solver gives it its
+// domain, model, options, time, time step, step latch and contact particles.
 //
 // Distributed (mpi::Domain): every process holds every body, each evaluates
 // the contact of the particles it owns, and the step's sums (the reaction on
@@ -25,6 +25,7 @@
 #include <sphshell/core/error.hpp>
 #include <sphshell/domain/domain.hpp>
 #include <sphshell/solver/energy_ledger.hpp>
+#include <sphshell/solver/output_probes.hpp>
 
 #include <cstddef>
 #include <optional>
@@ -97,14 +98,18 @@ class SolverContact {
   std::size_t rigid_body_count() const { return solver().bodies_.size(); }
   // A body's position, velocities and the contact load of the last step.
   RigidBodyState rigid_body(RigidBodyId id) const { return solver().bodies_.state(id); }
-  // CSV time history of a body (contact/body_set.hpp): now and after every
-  // step. Distributed: collective, written by process 0 (an Error there, such
-  // as a path that cannot be written, is the Error of every process).
+  // CSV time history of a body (solver/output_probes.hpp, RigidBodyProbe: t,
+  // centre, velocity, contact force and impulse, contacts): a CSV probe like
+  // the particle probes, a row now and every probe_interval (0: every step),
+  // its file refused when another use has it, and continued after a
+  // checkpoint that recorded it. Distributed: collective, written by process
+  // 0 (an Error there, such as a path that cannot be written, is the Error of
+  // every process).
   void add_rigid_body_probe(const std::string& csv_path, RigidBodyId id) {
     Solver& s = solver();
     s.domain_.collectively([&] {
       s.bodies_.check(id);
-      if (s.domain_.is_root()) s.bodies_.add_probe(csv_path, id, s.time_);
+      s.output_->add_probe(csv_path, sphshell::solver::RigidBodyProbe{id}, s);
     });
   }
 

@@ -23,7 +23,10 @@
 //            FRAC crack topology, fragments, fracture counters,
 //            ENRG energy ledger, BODY the rigid bodies' state and contact
 //                 history, their energy terms, STEP the stepper's own state (if any),
-//            OUTP output and probe schedules, frame series, probe files.
+//            OUTP output and probe schedules, frame series, probe files
+//                 (particle, stress-point and rigid-body probes: a record's
+//                 kind 0, 1, 2; a file without kind 2 loads, its body
+//                 probes starting new files).
 // Each part of the solver (include/sphshell/solver/) writes and reads its own
 // section through save(Writer&) const / load(Reader&) members, so the parts
 // keep owning their state.
@@ -70,7 +73,10 @@ inline constexpr char magic[8] = {'S', 'P', 'H', 'S', 'H', 'C', 'K', 'P'};
 // of another version is refused (no silent reinterpretation). Version 2: the
 // identity lists transverse_shear and director_hourglass among the options
 // that change results (version 1 did not, so a restart with either changed
-// went on with other physics). Version 3: the rigid bodies (BDID, BODY).
+// went on with other physics). Version 3: the rigid bodies (BDID, BODY);
+// the rigid-body probe records (OUTP, kind 2) only extend it: a version-3
+// file without them loads (its body probes start new files), and a library
+// from before them refuses one with them ("a probe of unknown kind 2").
 inline constexpr std::uint32_t format_version = 3;
 
 inline std::string library_version() {

@@ -84,9 +84,9 @@ class CheckpointIO {
   // checkpoint's rows; probes added later do too, when their file is one the
   // checkpoint recorded. Rigid bodies are added again, as the saving run had
   // them, before loading (the checkpoint holds their state, not their shape
-  // or motion; an Error names a body count, kind or mass that differs); a
-  // body probe starts a file of its own. An Error after the file was accepted leaves the
-  // solver stopped (step() refuses).
+  // or motion; an Error names a body count, kind or mass that differs); their
+  // probes continue as the others do. An Error after the file was accepted
+  // leaves the solver stopped (step() refuses).
   void load_checkpoint(const std::string& path) {
     Solver& s = self();
     const std::string file_path = checkpoint_file(path);

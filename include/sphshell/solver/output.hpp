@@ -114,6 +114,8 @@ class SolverOutput {
       probe.point_names = thickness_point_names<typename Solver::rule_type>();
       const long row = domain.owned_stress_row(static_cast<std::size_t>(probe.stress_point));
       if (row >= 0) local_point = solver.points_->point(PointGroup::stress_points, static_cast<std::size_t>(row));
+    } else if constexpr (std::is_same_v<Probe, RigidBodyProbe>) {
+      if (domain.is_root()) local_point = 0;  // every process holds the body; the first writes
     } else if (domain.owns(probe.particle)) {
       local_point = 0;
     }
@@ -232,8 +234,8 @@ class SolverOutput {
 
   bool writes_frames() const { return !options_.output_directory.empty() && options_.output_interval > 0.0; }
 
-  // What ParticleProbe and StressPointProbe read, of what this process owns
-  // (particles by their global number; the probed stress point's local point).
+  // What the probes read, of what this process owns (particles by their
+  // global number; the probed stress point's local point; every rigid body).
   template <class Solver>
   struct OwnedView {
     const Solver& solver;
@@ -257,6 +259,7 @@ class SolverOutput {
     double integral_point_quantity(IntegralPointQuantity quantity, int, int k) const {
       return solver.states_->quantity(quantity, local_point, k);
     }
+    auto rigid_body(std::size_t id) const { return solver.rigid_body(id); }
   };
   template <class Solver>
   static auto owned_view(const Solver& solver) {

@@ -3,7 +3,8 @@
 // probe files of a run with their schedule, their identity (a probe file is
 // one file, by its absolute normalized path) and their continuation after a
 // checkpoint. A probe's file is written by the process that owns what it
-// probes; every process registers every probe.
+// probes (a rigid body's by the first process: every process holds every
+// body); every process registers every probe.
 //
 // A probe is a type whose column names and row values sit together:
 //   std::vector<std::string> columns() const;
@@ -16,9 +17,11 @@
 #include <sphshell/solver/section_states.hpp>
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <iterator>
 #include <optional>
 #include <string>
 #include <utility>
@@ -99,19 +102,52 @@ struct StressPointProbe {
   }
 };
 
+// One rigid body's history (Solver::add_rigid_body_probe): t, the body's
+// centre at t, its velocity at t − Δt/2 (the central difference's half step,
+// contact/rigid_body.hpp), the contact force it received in the last step and
+// the impulse received so far, and the particles in contact in the last step.
+struct RigidBodyProbe {
+  std::size_t body;
+  std::vector<std::string> columns() const {
+    return {"t [s]",
+            "x [m]",
+            "y [m]",
+            "z [m]",
+            "vx at t-dt/2 [m/s]",
+            "vy at t-dt/2 [m/s]",
+            "vz at t-dt/2 [m/s]",
+            "fx [N]",
+            "fy [N]",
+            "fz [N]",
+            "impulse_x [N s]",
+            "impulse_y [N s]",
+            "impulse_z [N s]",
+            "contacts"};
+  }
+  template <class Solver>
+  std::vector<double> row(const Solver& solver) const {
+    const auto state = solver.rigid_body(body);
+    const Vector3 &x = state.kinematics.position, &v = state.kinematics.velocity, &f = state.contact_force,
+                  &impulse = state.contact_impulse;
+    return {solver.time(), x.x(), x.y(), x.z(),       v.x(),       v.y(),       v.z(),
+            f.x(),         f.y(), f.z(), impulse.x(), impulse.y(), impulse.z(), static_cast<double>(state.contacts)};
+  }
+};
 
 // The probe files of a run. Rows are read through a view of what this
 // process owns: make_view(local_point) gives an object with the Solver
 // members the probes read (time, velocities, displacement, rotation,
-// integral_point_quantity of the probed stress point's local point).
+// integral_point_quantity of the probed stress point's local point,
+// rigid_body).
 template <int OutputPoints>
 class ProbeFiles {
  public:
   using StressProbe = StressPointProbe<OutputPoints>;
-  using Probe = std::variant<ParticleProbe, StressProbe>;
+  using Probe = std::variant<ParticleProbe, StressProbe, RigidBodyProbe>;
 
   // A probe file as a checkpoint records it: kind 0 a particle probe, 1 a
-  // stress-point probe, of particle or stress point `index`.
+  // stress-point probe, 2 a rigid-body probe (the variant's index), of
+  // particle, stress point or body `index`.
   struct Record {
     std::string key;
     std::uint32_t kind = 0;
@@ -186,7 +222,7 @@ class ProbeFiles {
     std::vector<Record> records;
     in(records);
     for (const Record& record : records)
-      if (record.kind > 1) in.fail("a probe of unknown kind " + std::to_string(record.kind));
+      if (record.kind >= std::variant_size_v<Probe>) in.fail("a probe of unknown kind " + std::to_string(record.kind));
     return records;
   }
   // Probes already added continue their files (or restart them, if the
@@ -233,10 +269,12 @@ class ProbeFiles {
   }
   static std::int64_t probed_index(const Probe& probe) {
     if (const auto* particle = std::get_if<ParticleProbe>(&probe)) return particle->particle;
+    if (const auto* body = std::get_if<RigidBodyProbe>(&probe)) return static_cast<std::int64_t>(body->body);
     return std::get<StressProbe>(probe).stress_point;
   }
   static void check_same_probe(const Record& record, const Probe& probe, const std::string& path) {
-    static const char* const kinds[] = {"particle", "stress point"};
+    static const char* const kinds[] = {"particle", "stress point", "rigid body"};
+    static_assert(std::size(kinds) == std::variant_size_v<Probe>, "check_same_probe: name every kind of probe");
     if (record.kind != probe.index() || record.index != probed_index(probe))
       throw Error("sphshell: probe file '" + path + "' is, in the checkpoint, the file of the " + kinds[record.kind] +
                   " probe of " + kinds[record.kind] + " " + std::to_string(record.index) + ", not of " +
