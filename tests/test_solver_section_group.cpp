@@ -3,13 +3,17 @@
 // for full and partial groups, points of two thicknesses, elastic and yielding
 // integral points, and a failing point that leaves the others of its group as
 // they would be alone; the lanes of a block that are not in the group keep
-// their bits.
+// their bits. SectionStates keeping the states in those blocks reads,
+// subsets and checkpoints them as it does point by point.
 
 // The group's lanes across points whatever the instruction set, so that they
 // are tested here.
 #define SPHSHELL_LANES_ACROSS_POINTS 1
+#include <sphshell/io/binary_stream.hpp>
 #include <sphshell/material/all.hpp>
+#include <sphshell/shell/model.hpp>
 #include <sphshell/solver/section_group.hpp>
+#include <sphshell/solver/section_states.hpp>
 #include <sphshell/thickness/all.hpp>
 
 #include <catch2/catch.hpp>
@@ -242,4 +246,71 @@ TEST_CASE("section group: one group over blocks of other thicknesses takes each 
       require_same_resultants(group.resultants(g), reference);
     }
   }
+}
+
+TEST_CASE("section states in lanes: each point's state, subsets and checkpoint bytes as point by point") {
+  using sphshell::ShellModel;
+  using sphshell::Vector2;
+  using Law = material::J2Plasticity;
+  using States = sphshell::solver::SectionStates<thickness::Gauss<5>, Law>;
+  using State = States::State;
+  STATIC_REQUIRE(States::in_lanes);
+  const Law law{{E, nu, sigma_y0, Ep}};
+  // 5 × 4 particles and 4 × 3 stress points: the particles' points start at a
+  // block of their own (slot 16), the last blocks of both groups are partial.
+  const ShellModel model = ShellModel::rectangular_plate(0.2, 0.1, 5, 4, 0.01);
+  const std::size_t stress_points = model.stress_point_count(), particles = model.particle_count();
+  REQUIRE(stress_points % points_per_group != 0);
+  States states(model, law, particles);
+  const std::size_t count = stress_points + particles;
+  REQUIRE(states.size() == count);
+  // A state of its own for every point and integral point, kept here point by point.
+  std::vector<State> expected(count);
+  for (std::size_t p = 0; p < count; ++p) {
+    for (std::size_t k = 0; k < expected[p].size(); ++k) {
+      const double x = double(p) + 0.1 * double(k);
+      expected[p][k] = Law::State{StressVoigt(1e6 * x, -2e6 * x, 3e5 * x), 1e-4 * x, sigma_y0 + 1e5 * x};
+    }
+    states.set_state(p, expected[p]);
+  }
+  const auto require_states = [](const States& got, const std::vector<State>& want) {
+    REQUIRE(got.size() == want.size());
+    for (std::size_t p = 0; p < want.size(); ++p) {
+      const State state = got.state(p);
+      for (std::size_t k = 0; k < state.size(); ++k) REQUIRE(same_bits(state[k], want[p][k]));
+    }
+  };
+  require_states(states, expected);
+  // Block b of each group holds its rows b·G … b·G + G − 1 (the assembler's
+  // groups are the blocks' rows).
+  for (std::size_t p = 0; p < count; ++p)
+    REQUIRE(states.lane_of(p) == int((p < stress_points ? p : p - stress_points) % points_per_group));
+  CHECK(states.quantity(sphshell::solver::IntegralPointQuantity::equivalent_plastic_strain, 17, 3) ==
+        expected[17][3].eps_p);
+  CHECK(states.section(17).law().equivalent_stress(expected[17][3]) ==
+        states.quantity(sphshell::solver::IntegralPointQuantity::equivalent_stress, 17, 3));
+
+  // A subset across both groups: its points renumbered in order, the stress
+  // points' first (a block boundary moves).
+  const std::vector<std::size_t> picked{1, 2, 7, 9, 11, 12, 13, 20, 31};
+  std::vector<State> picked_states;
+  for (std::size_t p : picked) picked_states.push_back(expected[p]);
+  const States part = states.subset(picked);
+  require_states(part, picked_states);
+  CHECK(part.lane_of(4) == 4);
+  CHECK(part.lane_of(5) == 0);  // the first particle's point
+
+  // The checkpoint holds the states point by point, then the other per-point
+  // arrays (all as constructed): the same bytes as writing them directly.
+  sphshell::io::BinaryWriter written, direct;
+  states.save(written);
+  direct(expected, std::vector<StrainVoigt>(count, StrainVoigt::Zero()), std::vector<StrainVoigt>(count, StrainVoigt::Zero()),
+         std::vector<Vector2>(count, Vector2::Zero()), std::vector<Vector2>(count, Vector2::Zero()),
+         std::vector<StressVoigt>(count, StressVoigt::Zero()), std::vector<StressVoigt>(count, StressVoigt::Zero()),
+         std::vector<double>(count, 0.0), std::vector<unsigned char>(count, 1));
+  REQUIRE(written.bytes() == direct.bytes());
+  States loaded(model, law, particles);
+  sphshell::io::BinaryReader reader(written.bytes(), "section states");
+  loaded.load(reader);
+  require_states(loaded, expected);
 }

@@ -40,9 +40,12 @@
 #include <type_traits>
 
 // Whether the grouped assembler stores the law states in lanes across points
-// and updates them there (1), or point by point (0). Define it before
-// including to force either; the default follows the measurement in
-// docs/performance.md ("Stress points in groups").
+// and updates them there (1), or point by point (0). By default as a section
+// alone (SPHSHELL_BATCHED_SECTIONS, thickness/section.hpp: with AVX-512):
+// with AVX2 the lanes, even with the states kept in them, measured no faster
+// than the point-by-point update (docs/performance.md, "Batched material
+// updates"). Define it (alike in every translation unit) before including to
+// force either.
 #ifndef SPHSHELL_LANES_ACROSS_POINTS
 #define SPHSHELL_LANES_ACROSS_POINTS SPHSHELL_BATCHED_SECTIONS
 #endif
