@@ -123,6 +123,9 @@ int compare_over_steps(const Law& law, int count, int steps) {
 TEST_CASE("section group: J2 through Gauss<5>, a full group and a partial one, agree with each point alone") {
   const material::J2Plasticity law{{E, nu, sigma_y0, Ep}};
   STATIC_REQUIRE(SectionGroup<thickness::Gauss<5>, material::J2Plasticity>::across_points);
+  // Asked for point by point, the same group keeps the states per point.
+  STATIC_REQUIRE(!SectionGroup<thickness::Gauss<5>, material::J2Plasticity, points_per_group,
+                               sphshell::solver::StateLayout::point_by_point>::across_points);
   CHECK(compare_over_steps<thickness::Gauss<5>>(law, points_per_group, 12) > 20);
   CHECK(compare_over_steps<thickness::Gauss<5>>(law, points_per_group - 1, 12) > 20);
   CHECK(compare_over_steps<thickness::Gauss<5>>(law, 3, 12) > 5);

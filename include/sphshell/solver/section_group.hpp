@@ -25,7 +25,8 @@
 // where the compiler contracts no multiply-adds. When the law has no batched
 // kernel, is rate-dependent (it needs the step's context at every integral
 // point), the section is not a stack of integral points (the resultant model
-// thickness::Global), or SPHSHELL_LANES_ACROSS_POINTS is 0, the states are
+// thickness::Global), or the layout asked for is point by point
+// (SPHSHELL_LANES_ACROSS_POINTS 0 by default, below), the states are
 // stored point by point and every point goes through its Section's own
 // update, exactly as one point alone would.
 
@@ -52,6 +53,15 @@
 
 namespace sphshell::solver {
 
+// The layout a SectionGroup asks for: the law states in lanes across points
+// (taken where the law and section allow it, see SectionGroup::across_points)
+// or point by point. The default follows SPHSHELL_LANES_ACROSS_POINTS; a
+// program may name either explicitly to hold the two side by side (the
+// benchmark bench/bench_section_group.cpp does).
+enum class StateLayout { point_by_point, lanes_across_points };
+inline constexpr StateLayout default_state_layout =
+    SPHSHELL_LANES_ACROSS_POINTS != 0 ? StateLayout::lanes_across_points : StateLayout::point_by_point;
+
 // Integration points the assembler integrates side by side. Eight points fill
 // an AVX-512 register per integral point of the rule (and two AVX2 or four
 // SSE2 registers); other sizes are yet to be measured against it.
@@ -66,7 +76,7 @@ inline constexpr bool layered_section_v =
     std::is_same_v<typename thickness::Section<Rule, Law>::State,
                    std::array<typename Law::State, std::size_t(thickness::Section<Rule, Law>::num_points)>>;
 
-template <class Rule, class Law, int G = points_per_group>
+template <class Rule, class Law, int G = points_per_group, StateLayout Layout = default_state_layout>
 class SectionGroup {
   static_assert(G >= 1, "sphshell::solver::SectionGroup<Rule, Law, G>: G must be at least 1");
 
@@ -91,7 +101,7 @@ class SectionGroup {
   // point by point through Section::update, on states stored per point.
   static constexpr bool across_points = [] {
     if constexpr (layered_section_v<Rule, Law>)
-      return SPHSHELL_LANES_ACROSS_POINTS != 0 && !material::is_rate_dependent_v<Law> &&
+      return Layout == StateLayout::lanes_across_points && !material::is_rate_dependent_v<Law> &&
              material::has_update_lanes_v<Law, G * Section::num_points>;
     else
       return false;
