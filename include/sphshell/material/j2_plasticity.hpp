@@ -160,13 +160,25 @@ struct J2Plasticity {
       returned_sigma_y[k] = lanes.sigma_y[k] + plastic_modulus * returned.increment;  // eq. (2.34)
       fast[k] = returned.fast ? 1.0 : 0.0;
     }
-    // Each lane's new state: the trial (elastic), the return (yielding, on the
-    // fast path), or the old state, flagged for update() (yielding, off it).
+    // Lanes that yield off the fast path are solved by update() first, on
+    // copies: if one of them throws, every lane is still as it was (the
+    // guarantee lanes.hpp states), and otherwise their results are written
+    // after the others'.
     alignas(64) std::array<double, n> alone;
+    for (std::size_t k = 0; k < n; ++k) alone[k] = yields[k] - yields[k] * fast[k];
+    const bool some_alone = detail::any_lane(alone);
+    std::array<State, n> solved_alone;
+    if (some_alone)
+      for (int k = 0; k < N; ++k) {
+        if (alone[std::size_t(k)] == 0.0) continue;
+        solved_alone[std::size_t(k)] = lanes.state(k);
+        update(solved_alone[std::size_t(k)], d_eps.at(k));
+      }
+    // Each lane's new state: the trial (elastic), the return (yielding, on the
+    // fast path), or the old state (yielding, off it: replaced below).
     for (std::size_t k = 0; k < n; ++k) {
       // 0/1 flags; detail::blend selects without a branch.
-      const double returned_here = yields[k] * fast[k], left = yields[k] - returned_here;
-      alone[k] = left;
+      const double returned_here = yields[k] * fast[k], left = alone[k];
       using detail::blend;
       lanes.stress.xx[k] = blend(returned_here, returned_xx[k], blend(left, lanes.stress.xx[k], trial_xx[k]));
       lanes.stress.yy[k] = blend(returned_here, returned_yy[k], blend(left, lanes.stress.yy[k], trial_yy[k]));
@@ -174,14 +186,9 @@ struct J2Plasticity {
       lanes.eps_p[k] = blend(returned_here, returned_eps_p[k], lanes.eps_p[k]);
       lanes.sigma_y[k] = blend(returned_here, returned_sigma_y[k], lanes.sigma_y[k]);
     }
-    if (detail::any_lane(alone)) {
-      for (int k = 0; k < N; ++k) {
-        if (alone[std::size_t(k)] == 0.0) continue;
-        State state = lanes.state(k);
-        update(state, d_eps.at(k));
-        lanes.set_state(k, state);
-      }
-    }
+    if (some_alone)
+      for (int k = 0; k < N; ++k)
+        if (alone[std::size_t(k)] != 0.0) lanes.set_state(k, solved_alone[std::size_t(k)]);
     int yielding = 0;
     for (std::size_t k = 0; k < n; ++k) yielding += yields[k] != 0.0;
     return yielding;

@@ -8,7 +8,10 @@
 //   template <int N> int update_lanes(Lanes<N>&, const VoigtLanes<N>& d_eps) const;
 // update_lanes(lanes, d_eps) gives every lane k the state that
 // update(state k, d_eps k) gives (to round-off: the same operations, in vector
-// registers), and returns how many lanes yielded. The single-point update()
+// registers), and returns how many lanes yielded; when it throws (a
+// non-finite increment, a return map that fails), every lane is left as it
+// was, so that a caller updating states in place can redo them one by one.
+// The single-point update()
 // stays the reference; tests/test_material_lanes.cpp holds the two together
 // over the fuzz stream. has_update_lanes_v<Law, N> tells whether a law offers
 // them; update_lanes(law, states, d_eps) below takes the batched path when it

@@ -343,20 +343,34 @@ class InternalForceAssembler {
   };
 
   // Integrates the rows [first_row, end_row) of a group of points, a
-  // SectionGroup of points_per_group active points at a time: each point's
-  // gather and strains, then the group's material update through the
-  // thickness (section_group.hpp), then each point's resultants, work,
-  // conjugate forces and tied shear. A failing point is kept in `failure`
-  // (the lowest row) and leaves the others of its group unaffected.
+  // SectionGroup of up to points_per_group active points at a time (across
+  // points: the active points of one block of the SectionStates, updated in
+  // place): each point's gather and strains, then the group's material update
+  // through the thickness (section_group.hpp), then each point's resultants,
+  // work, conjugate forces and tied shear. A failing point is kept in
+  // `failure` (the lowest row) and leaves the others of its group unaffected.
   template <class Approx, class Rule, class Law>
   void integrate_rows(PointGroup group, std::size_t first_row, std::size_t end_row,
                       const IntegrationPoints<Approx>& points, SectionStates<Rule, Law>& states,
                       PointFailure& failure) {
-    SectionGroup<Rule, Law> section_group;
+    using Group = SectionGroup<Rule, Law>;
+    // The runs start at a chunk's first row, so that a block of the states
+    // (section_states.hpp) is never shared by two runs, which two threads
+    // may integrate at once.
+    static_assert(PointChunks::rows % std::size_t(Group::group_size) == 0,
+                  "sphshell::solver: PointChunks::rows must be a multiple of points_per_group");
+    Group section_group;
     std::array<GroupMember, std::size_t(points_per_group)> members;
     for (std::size_t row = first_row; row < end_row;) {
       section_group.clear();
-      for (; row < end_row && !section_group.full(); ++row) {
+      // Across points the group is one block's points: the rows up to the block's end.
+      std::size_t group_end = end_row;
+      if constexpr (Group::across_points) {
+        const std::size_t p = points.point(group, row);
+        group_end = std::min(end_row, row + std::size_t(Group::group_size - states.lane_of(p)));
+        section_group.use_block(states.block(p));
+      }
+      for (; row < group_end && !section_group.full(); ++row) {
         const std::size_t p = points.point(group, row);
         if (!states.active(p)) {
           work_increment_[p] = 0.0;
@@ -370,7 +384,10 @@ class InternalForceAssembler {
           member.d_membrane = member.strains.membrane - states.membrane_strain(p);
           member.d_curvature = member.strains.curvature - states.curvature(p);
           member.d_shear = member.strains.shear - states.shear_strain(p);
-          section_group.add(states.section(p), states.state(p), member.d_membrane, member.d_curvature);
+          if constexpr (Group::across_points)
+            section_group.add(states.lane_of(p), states.section(p), member.d_membrane, member.d_curvature);
+          else
+            section_group.add(states.section(p), states.stored_state(p), member.d_membrane, member.d_curvature);
         } catch (...) {
           failure.keep_lowest(group, row, std::current_exception());
         }
