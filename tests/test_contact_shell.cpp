@@ -475,3 +475,143 @@ TEST_CASE("tube crush: mean crush force within 15 % of Guillow, Lu & Grzebieta (
   CHECK(std::abs(energy.balance()) < 0.01 * energy.internal);
   CHECK(mean_force == Approx(guillow).epsilon(0.15));
 }
+
+namespace {
+
+// Two 5 × 5 plates (10 mm spacing, 2 mm thick) 1.6 mm apart, the upper one
+// shifted by (shift, 4.3 mm), every particle moved and every director turned
+// a little (a fixed pseudo-random pattern), so pairs meet patches off their
+// centres, at several depths and, with a large shift, over the lower
+// plate's edge.
+ParticleArrays perturbed_plates(const ShellModel& model, double shift) {
+  ParticleArrays p = particles_of(model, steel_density);
+  unsigned state = 12345u;
+  const auto next = [&state] {
+    state = state * 1103515245u + 12345u;
+    return static_cast<double>((state >> 8) & 0xffffu) / 32768.0 - 1.0;  // in [−1, 1)
+  };
+  for (std::size_t i = 0; i < p.position.size(); ++i) {
+    if (p.position[i].z() > 1e-3) p.position[i] += Vector3(shift, 0.0043, 0.0);
+    p.position[i] += 2e-4 * Vector3(next(), next(), next());
+    p.director[i] = (p.director[i] + 0.05 * Vector3(next(), next(), next())).normalized();
+  }
+  return p;
+}
+
+double spring_energy_of(const ShellModel& model, const ParticleArrays& p) {
+  contact::ShellContact contact(model, {});
+  contact::ParticleContactLoads loads;
+  return contact.compute(p.view(), 1e-7, loads).spring_energy;
+}
+
+}  // namespace
+
+TEST_CASE("shell contact: the loads are the negative gradient of the spring energy", "[contact][shell_contact]") {
+  // An independent check of eq. (12.4) of docs/method.md: every force and
+  // moment component against a central difference of the spring energy E
+  // (a translation of one particle by ±ε, a turn of its director by ±θ).
+  const ShellModel model = two_plates(5, 0.04, 1.6e-3, 2e-3);
+  for (const double shift : {0.0, 0.0031, 0.036}) {
+    const ParticleArrays p = perturbed_plates(model, shift);
+    contact::ShellContact contact(model, {});
+    contact::ParticleContactLoads loads;
+    const double energy = contact.compute(p.view(), 1e-7, loads).spring_energy;
+    REQUIRE(energy > 0.0);
+    double largest_force = 0.0, largest_moment = 0.0;
+    for (std::size_t i = 0; i < p.position.size(); ++i) {
+      largest_force = std::max(largest_force, loads.force[i].cwiseAbs().maxCoeff());
+      largest_moment = std::max(largest_moment, loads.moment[i].cwiseAbs().maxCoeff());
+    }
+    const double step = 1e-9, turn = 1e-7;
+    double force_error = 0.0, moment_error = 0.0;
+    std::size_t lateral = 0;  // force components across the patches' normals: the weights' part
+    for (std::size_t i = 0; i < p.position.size(); ++i)
+      for (int axis = 0; axis < 3; ++axis) {
+        ParticleArrays plus = p, minus = p;
+        plus.position[i][axis] += step;
+        minus.position[i][axis] -= step;
+        const double force = -(spring_energy_of(model, plus) - spring_energy_of(model, minus)) / (2.0 * step);
+        force_error = std::max(force_error, std::abs(force - loads.force[i][axis]));
+        if (axis < 2 && std::abs(loads.force[i][axis]) > 1e-2 * largest_force) ++lateral;
+        plus = p;
+        minus = p;
+        plus.director[i] = Eigen::AngleAxisd(turn, Vector3::Unit(axis)) * p.director[i];
+        minus.director[i] = Eigen::AngleAxisd(-turn, Vector3::Unit(axis)) * p.director[i];
+        const double moment = -(spring_energy_of(model, plus) - spring_energy_of(model, minus)) / (2.0 * turn);
+        moment_error = std::max(moment_error, std::abs(moment - loads.moment[i][axis]));
+      }
+    INFO("shift " << shift << " m: E " << energy << " J, largest force " << largest_force << " N, error "
+                  << force_error << " N; largest moment " << largest_moment << " N m, error " << moment_error
+                  << " N m; " << lateral << " sizeable lateral components");
+    CHECK(force_error < 1e-7 * largest_force);
+    CHECK(moment_error < 1e-7 * largest_moment);
+    CHECK(lateral > 0);  // the weights' part is exercised
+  }
+}
+
+TEST_CASE("shell contact keeps each pair's side: a particle pressed past the other sheet's mid-surface is pushed back",
+          "[contact][shell_contact]") {
+  // Two 5 × 5 plates (10 mm spacing, 2 mm thick) 1.5 mm apart, the upper one
+  // moved down through the lower one step by step. With the side kept from
+  // the onset (docs/method.md eq. 12.5) the upper plate's particles are
+  // pushed up, with δ = c − g growing past c, all the way; the sign of the
+  // current gap would push them on through below g = 0.
+  const ShellModel model = two_plates(5, 0.04, 1.5e-3, 2e-3);
+  ParticleArrays p = particles_of(model, steel_density);
+  contact::ShellContact contact(model, {});
+  contact::ParticleContactLoads loads;
+  const std::size_t centre = 5 * 5 + 12;  // the upper plate's centre particle
+  for (const double gap : {1.5e-3, 1.0e-3, 0.5e-3, 0.1e-3, -0.1e-3, -0.5e-3, -1.0e-3}) {
+    for (std::size_t i = 0; i < p.position.size(); ++i)
+      if (model.particle_position[i].z() > 1e-4) p.position[i].z() = gap;
+    contact.compute(p.view(), 1e-7, loads);
+    INFO("gap " << gap << " m: force on the upper centre " << loads.force[centre].transpose());
+    CHECK(loads.force[centre].z() > 0.0);
+    CHECK(contact.statistics().largest_penetration == Approx(2e-3 - gap).epsilon(1e-12));
+  }
+  // A new contact takes the side a particle is on: from below, pushed down.
+  contact::ShellContact fresh(model, {});
+  fresh.compute(p.view(), 1e-7, loads);
+  CHECK(loads.force[centre].z() < 0.0);
+}
+
+TEST_CASE("shell contact at a sheet's edge: a lone patch carries its weight over a regular sheet's, not the whole spring",
+          "[contact][shell_contact]") {
+  // Two 5 × 5 plates (10 mm spacing, 2 mm thick) 1.6 mm apart, the upper one
+  // shifted 47 mm along x: its first column stands 7 mm beyond the lower
+  // plate's edge, inside the edge particles' patches (radius 7.5 mm) and
+  // over no other (the next lies √(7² + 10²) mm off), and b lies over a's
+  // patch alone. Each carries φ = w / W_sheet of its spring over the other's
+  // patch (eq. 12.2): w = (1 − 7²/7.5²)², W_sheet = 4 (1 − 1/(2 · 0.75²))²,
+  // so the normal force on a is φ δ (k_ab + k_ba),
+  // k_ab = s / (Δt² (1/m_a + 1/m_b + ρ²/I_b)) and k_ba with I_a.
+  const ShellModel model = two_plates(5, 0.04, 1.6e-3, 2e-3);
+  ParticleArrays p = particles_of(model, steel_density);
+  for (std::size_t i = 0; i < p.position.size(); ++i)
+    if (p.position[i].z() > 1e-3) p.position[i].x() += 0.047;
+  const double time_step = 1e-7;
+  contact::ShellContact contact(model, {});
+  contact::ParticleContactLoads loads;
+  contact.compute(p.view(), time_step, loads);
+  const double patch = 0.75 * 0.01, lateral = 0.007, penetration = 2e-3 - 1.6e-3;
+  const double weight = std::pow(1.0 - lateral * lateral / (patch * patch), 2);
+  const double sheet = 4.0 * std::pow(1.0 - 1.0 / (2.0 * 0.75 * 0.75), 2);
+  std::size_t checked = 0;
+  for (std::size_t a = 25; a < 50; ++a) {
+    if (std::abs(p.position[a].x() - 0.047) > 1e-9) continue;  // the upper plate's first column
+    const std::size_t b = a - 25 + 20;                          // the lower plate's edge particle beside it
+    const auto spring = [&](std::size_t rotating) {
+      const double rotary_inertia = p.mass[rotating] * 2e-3 * 2e-3 / 12.0;
+      return contact::default_penalty_stiffness_scale /
+             (time_step * time_step * (1.0 / p.mass[a] + 1.0 / p.mass[b] + lateral * lateral / rotary_inertia));
+    };
+    const double stiffness = spring(b) + spring(a);
+    const std::vector<contact::ShellContactPair> pairs = contact.pairs_of(a);
+    REQUIRE(pairs.size() == 1);
+    CHECK(pairs[0].partner == static_cast<int>(b));
+    INFO("particle " << a << ": force " << loads.force[a].transpose());
+    CHECK(loads.force[a].z() == Approx(weight / sheet * stiffness * penetration).epsilon(1e-9));
+    ++checked;
+  }
+  CHECK(checked == 5);
+}
