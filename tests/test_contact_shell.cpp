@@ -8,6 +8,7 @@
 #include <sphshell/approx/all.hpp>
 #include <sphshell/contact/all.hpp>
 #include <sphshell/crack/all.hpp>
+#include <sphshell/io/binary_stream.hpp>
 #include <sphshell/kernel/all.hpp>
 #include <sphshell/material/all.hpp>
 #include <sphshell/solver.hpp>
@@ -573,6 +574,19 @@ TEST_CASE("shell contact keeps each pair's side: a particle pressed past the oth
   contact::ShellContact fresh(model, {});
   fresh.compute(p.view(), 1e-7, loads);
   CHECK(loads.force[centre].z() < 0.0);
+  // The sides are state: a contact loaded from a checkpoint of the first
+  // pushes up, as the first does.
+  io::BinaryWriter out;
+  contact.save(out);
+  contact::ShellContact restarted(model, {});
+  io::BinaryReader in(out.bytes(), "shell contact history");
+  restarted.load(in);
+  restarted.compute(p.view(), 1e-7, loads);
+  CHECK(loads.force[centre].z() > 0.0);
+  // A history of another model is refused, naming it.
+  io::BinaryReader again(out.bytes(), "shell contact history");
+  contact::ShellContact other(two_plates(4, 0.04, 1.5e-3, 2e-3), {});
+  CHECK_THROWS_WITH(other.load(again), Catch::Contains("shell contact history: particle count = 50"));
 }
 
 TEST_CASE("shell contact at a sheet's edge: a lone patch carries its weight over a regular sheet's, not the whole spring",
