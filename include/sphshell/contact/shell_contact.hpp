@@ -16,7 +16,8 @@
 // weighed b, kept while it does (a deeply pressed pair is pushed back, never
 // through), or, for a new pair, the side a had of a patch of b's sheet it
 // weighed in the last step (a material neighbour b' of b within 60° of
-// parallel; s times the sign of d_b · d_b'), else the sign of g now.
+// parallel; s times the sign of d_b · d_b') unless that puts a beyond b's
+// far face (s g < −c), else the sign of g now.
 // A particle a meets the surface as a weighted mean of the patches it lies
 // over (node against surface, as a penalty contact's slave node against its
 // master segments), so that its force changes continuously as it slides from
@@ -312,9 +313,12 @@ class ShellContact {
 
   // The side of b's mid-surface a lies on: remembered from the last step if
   // a weighed b then; else taken over from a patch b' of the same sheet (a
-  // material neighbour of b, nearly parallel) that a weighed then; else the
-  // side a is on now (method.md §12).
-  int side_of(const ContactParticles& particles, std::size_t a, int b, double gap) const noexcept {
+  // material neighbour of b, nearly parallel) that a weighed then, unless
+  // that side puts a beyond b's far face (s g < −c: the pair would start
+  // deeper than both thicknesses, at full weight, where it weighed nothing a
+  // step before); else the side a is on now (method.md §12, eq. 12.5).
+  int side_of(const ContactParticles& particles, std::size_t a, int b, double gap,
+              double contact_distance) const noexcept {
     if (a < previous_count_.size()) {
       const ShellContactPair* previous = &previous_pairs_[a * max_patches_per_particle];
       const std::size_t count = previous_count_[a];
@@ -326,7 +330,9 @@ class ShellContact {
         if (!is_material_neighbour(static_cast<std::size_t>(b), other)) continue;
         const double alignment = db.dot(particles.director[static_cast<std::size_t>(other)]);
         if (std::abs(alignment) < side_transfer_alignment) continue;
-        return alignment > 0.0 ? previous[k].side : -previous[k].side;
+        const int side = alignment > 0.0 ? previous[k].side : -previous[k].side;
+        if (side * gap < -contact_distance) break;
+        return side;
       }
     }
     return gap >= 0.0 ? 1 : -1;
@@ -353,7 +359,7 @@ class ShellContact {
       const double patch_squared = patch * patch;
       if (!(lateral_squared < patch_squared)) return;
       const double contact_distance = half_a + 0.5 * particles.thickness[b];
-      const int side = side_of(particles, a, j, gap);
+      const int side = side_of(particles, a, j, gap, contact_distance);
       const double signed_gap = side * gap;  // > 0 on a's side of b, < 0 once past b's mid-surface
       if (!(signed_gap < 2.0 * contact_distance)) return;
       PatchTerm& term = terms[found];
