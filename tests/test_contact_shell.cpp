@@ -8,6 +8,7 @@
 #include <sphshell/approx/all.hpp>
 #include <sphshell/contact/all.hpp>
 #include <sphshell/crack/all.hpp>
+#include <sphshell/io/binary_stream.hpp>
 #include <sphshell/kernel/all.hpp>
 #include <sphshell/material/all.hpp>
 #include <sphshell/solver.hpp>
@@ -416,24 +417,35 @@ TEST_CASE("shell contact: a particle beyond the other sheet's edge is not pushed
   CHECK(moments > 1e-3 * scale);  // not balanced by accident: the moments are there
 }
 
-TEST_CASE("tube crush: mean crush force within 15 % of Guillow, Lu & Grzebieta (2001)",
-          "[contact][shell_contact][validation]") {
-  // examples/tube_crush.cpp at its defaults: a 6060-like aluminium tube, D 50 mm,
-  // t 2 mm (D/t = 25), 60 mm long, 3 mm spacing (52 × 21 particles), J2 with
-  // σ0 200 MPa and a 500 MPa plastic modulus, crushed 30 mm at 10 m/s
-  // (reached over the first 0.6 mm) between rigid walls with μ = 0.2, ends'
-  // rotations held, self contact on (exclusion 1.5 spacings).
-  // Guillow et al., Int. J. Mech. Sci. 43 (2001) 2103–2123, their fit to
-  // quasi-static axial crushing of circular 6060-T5 tubes:
-  //   F_av / M_p = 72.3 (D/t)^0.32,  M_p = σ0 t² / 4.
+namespace {
+
+// examples/tube_crush.cpp's tube: a 6060-like aluminium tube, D 50 mm, J2
+// with σ0 200 MPa and a 500 MPa plastic modulus, crushed at 10 m/s (reached
+// over the first 2 % of the crush) between rigid walls with μ = 0.2, ends'
+// rotations held, self contact on (patches of one spacing, exclusion 1.5
+// spacings). Guillow et al., Int. J. Mech. Sci. 43 (2001) 2103–2123, their
+// fit to quasi-static axial crushing of circular 6060-T5 tubes:
+//   F_av / M_p = 72.3 (D/t)^0.32,  M_p = σ0 t² / 4.
+struct TubeCrush {
+  double thickness = 2e-3, length = 0.06, spacing = 3e-3, crush = 0.03;
+};
+struct TubeCrushResult {
+  double crush = 0.0, mean_force = 0.0, guillow = 0.0;
+  std::size_t most_contacts = 0;
+  EnergyReport energy;
+};
+
+TubeCrushResult crush_tube(const TubeCrush& tube) {
   using TubeSolver = Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<5>, material::J2Plasticity>;
-  const double diameter = 0.05, thickness = 2e-3, length = 0.06, speed = 10.0, crush = 0.03;
-  const double yield_stress = 200e6, hardening = 500e6;
+  const double diameter = 0.05, speed = 10.0, yield_stress = 200e6, hardening = 500e6;
+  const int around = std::max(12, static_cast<int>(std::lround(pi * diameter / tube.spacing)));
+  const int along = std::max(5, static_cast<int>(std::lround(tube.length / tube.spacing)) + 1);
   SolverOptions options;
   options.density = 2700.0;
-  TubeSolver solver(ShellModel::cylindrical_panel(0.5 * diameter, length, 2.0 * pi, 52, 21, thickness),
+  TubeSolver solver(ShellModel::cylindrical_panel(0.5 * diameter, tube.length, 2.0 * pi, around, along, tube.thickness),
                     material::J2Plasticity::Parameters{70e9, 0.3, yield_stress, hardening}, options);
   contact::ShellContactOptions self_contact;
+  self_contact.patch_spacings = 1.0;
   self_contact.exclusion_spacings = 1.5;
   solver.enable_shell_contact(self_contact);
   const ShellModel& model = solver.model();
@@ -445,33 +457,254 @@ TEST_CASE("tube crush: mean crush force within 15 % of Guillow, Lu & Grzebieta (
   solver.add_rigid_body(contact::RigidBody<contact::Plane, contact::Fixed>(contact::Plane(Vector3::UnitZ()),
                                                                            contact::Fixed{}),
                         walls);
-  const double ramp_time = 0.02 * crush / speed;
+  const double ramp_time = 0.02 * tube.crush / speed;
   contact::RigidKinematics top;
-  top.position = Vector3(0.0, 0.0, length);
+  top.position = Vector3(0.0, 0.0, tube.length);
   const contact::RigidBodyId moving = solver.add_rigid_body(
       contact::RigidBody(contact::Plane(-Vector3::UnitZ()), contact::prescribed([=](double t) {
                            return Vector3(0.0, 0.0, -speed * std::min(1.0, t / ramp_time));
                          }),
                          top),
       walls);
-  double absorbed = 0.0, last_crush = 0.0, last_force = 0.0;
-  std::size_t most_contacts = 0;
-  solver.run_until(crush / speed + 0.5 * ramp_time, [&](const TubeSolver& s) {
+  TubeCrushResult result;
+  double absorbed = 0.0, last_force = 0.0;
+  solver.run_until(tube.crush / speed + 0.5 * ramp_time, [&](const TubeSolver& s) {
     const contact::RigidBodyState wall = s.rigid_body(moving);
-    const double now_crush = length - wall.kinematics.position.z();
-    absorbed += 0.5 * (wall.contact_force.z() + last_force) * (now_crush - last_crush);
-    last_crush = now_crush;
+    const double now_crush = tube.length - wall.kinematics.position.z();
+    absorbed += 0.5 * (wall.contact_force.z() + last_force) * (now_crush - result.crush);
+    result.crush = now_crush;
     last_force = wall.contact_force.z();
-    most_contacts = std::max(most_contacts, s.shell_contact_statistics().contacts);
+    result.most_contacts = std::max(result.most_contacts, s.shell_contact_statistics().contacts);
   });
-  const double mean_force = absorbed / last_crush;
-  const double guillow = 72.3 * std::pow(diameter / thickness, 0.32) * yield_stress * thickness * thickness / 4.0;
-  const EnergyReport energy = solver.energy();
-  INFO("crush " << last_crush << " m, mean force " << mean_force << " N, Guillow " << guillow << " N, ratio "
-                << mean_force / guillow << ", most self contacts " << most_contacts << ", balance "
-                << energy.balance() << " J of " << energy.internal << " J");
-  CHECK(last_crush == Approx(crush).epsilon(1e-3));
-  CHECK(most_contacts > 0);  // the folds touched
-  CHECK(std::abs(energy.balance()) < 0.01 * energy.internal);
-  CHECK(mean_force == Approx(guillow).epsilon(0.15));
+  result.mean_force = absorbed / result.crush;
+  result.guillow = 72.3 * std::pow(diameter / tube.thickness, 0.32) * yield_stress * tube.thickness * tube.thickness / 4.0;
+  result.energy = solver.energy();
+  return result;
+}
+
+void check_tube_crush(const TubeCrush& tube) {
+  const TubeCrushResult r = crush_tube(tube);
+  INFO("D/t " << 0.05 / tube.thickness << ": crush " << r.crush << " m, mean force " << r.mean_force
+              << " N, Guillow " << r.guillow << " N, ratio " << r.mean_force / r.guillow << ", most self contacts "
+              << r.most_contacts << ", balance " << r.energy.balance() << " J of " << r.energy.internal << " J");
+  CHECK(r.crush == Approx(tube.crush).epsilon(1e-3));
+  CHECK(r.most_contacts > 0);  // the folds touched
+  CHECK(std::abs(r.energy.balance()) < 0.01 * r.energy.internal);
+  CHECK(r.mean_force == Approx(r.guillow).epsilon(0.15));
+}
+
+}  // namespace
+
+TEST_CASE("tube crush: mean crush force within 15 % of Guillow, Lu & Grzebieta (2001)",
+          "[contact][shell_contact][validation]") {
+  // examples/tube_crush.cpp at its defaults: t 2 mm (D/t = 25), 60 mm long,
+  // 3 mm spacing (52 × 21 particles), crushed 30 mm.
+  check_tube_crush({});
+}
+
+TEST_CASE("tube crush: a thin tube (D/t = 40) folds stably, its mean crush force within 15 % of Guillow's",
+          "[contact][shell_contact][validation]") {
+  // t 1.25 mm, 40 mm long, 4 mm spacing (39 × 11 particles), crushed 20 mm:
+  // the flanks of its folds close onto each other (the self contact's sides,
+  // edge shares and patch cover, docs/method.md §12), where thin tubes' runs
+  // went unstable.
+  TubeCrush tube;
+  tube.thickness = 1.25e-3;
+  tube.length = 0.04;
+  tube.spacing = 4e-3;
+  tube.crush = 0.02;
+  check_tube_crush(tube);
+}
+
+namespace {
+
+// Two 5 × 5 plates (10 mm spacing, 2 mm thick) 1.6 mm apart, the upper one
+// shifted by (shift, 4.3 mm), every particle moved and every director turned
+// a little (a fixed pseudo-random pattern), so pairs meet patches off their
+// centres, at several depths and, with a large shift, over the lower
+// plate's edge.
+ParticleArrays perturbed_plates(const ShellModel& model, double shift) {
+  ParticleArrays p = particles_of(model, steel_density);
+  unsigned state = 12345u;
+  const auto next = [&state] {
+    state = state * 1103515245u + 12345u;
+    return static_cast<double>((state >> 8) & 0xffffu) / 32768.0 - 1.0;  // in [−1, 1)
+  };
+  for (std::size_t i = 0; i < p.position.size(); ++i) {
+    if (p.position[i].z() > 1e-3) p.position[i] += Vector3(shift, 0.0043, 0.0);
+    p.position[i] += 2e-4 * Vector3(next(), next(), next());
+    p.director[i] = (p.director[i] + 0.05 * Vector3(next(), next(), next())).normalized();
+  }
+  return p;
+}
+
+double spring_energy_of(const ShellModel& model, const ParticleArrays& p) {
+  contact::ShellContact contact(model, {});
+  contact::ParticleContactLoads loads;
+  return contact.compute(p.view(), 1e-7, loads).spring_energy;
+}
+
+}  // namespace
+
+TEST_CASE("shell contact: the loads are the negative gradient of the spring energy", "[contact][shell_contact]") {
+  // An independent check of eq. (12.4) of docs/method.md: every force and
+  // moment component against a central difference of the spring energy E
+  // (a translation of one particle by ±ε, a turn of its director by ±θ).
+  const ShellModel model = two_plates(5, 0.04, 1.6e-3, 2e-3);
+  for (const double shift : {0.0, 0.0031, 0.036}) {
+    const ParticleArrays p = perturbed_plates(model, shift);
+    contact::ShellContact contact(model, {});
+    contact::ParticleContactLoads loads;
+    const double energy = contact.compute(p.view(), 1e-7, loads).spring_energy;
+    REQUIRE(energy > 0.0);
+    double largest_force = 0.0, largest_moment = 0.0;
+    for (std::size_t i = 0; i < p.position.size(); ++i) {
+      largest_force = std::max(largest_force, loads.force[i].cwiseAbs().maxCoeff());
+      largest_moment = std::max(largest_moment, loads.moment[i].cwiseAbs().maxCoeff());
+    }
+    const double step = 1e-9, turn = 1e-7;
+    double force_error = 0.0, moment_error = 0.0;
+    std::size_t lateral = 0;  // force components across the patches' normals: the weights' part
+    for (std::size_t i = 0; i < p.position.size(); ++i)
+      for (int axis = 0; axis < 3; ++axis) {
+        ParticleArrays plus = p, minus = p;
+        plus.position[i][axis] += step;
+        minus.position[i][axis] -= step;
+        const double force = -(spring_energy_of(model, plus) - spring_energy_of(model, minus)) / (2.0 * step);
+        force_error = std::max(force_error, std::abs(force - loads.force[i][axis]));
+        if (axis < 2 && std::abs(loads.force[i][axis]) > 1e-2 * largest_force) ++lateral;
+        plus = p;
+        minus = p;
+        plus.director[i] = Eigen::AngleAxisd(turn, Vector3::Unit(axis)) * p.director[i];
+        minus.director[i] = Eigen::AngleAxisd(-turn, Vector3::Unit(axis)) * p.director[i];
+        const double moment = -(spring_energy_of(model, plus) - spring_energy_of(model, minus)) / (2.0 * turn);
+        moment_error = std::max(moment_error, std::abs(moment - loads.moment[i][axis]));
+      }
+    INFO("shift " << shift << " m: E " << energy << " J, largest force " << largest_force << " N, error "
+                  << force_error << " N; largest moment " << largest_moment << " N m, error " << moment_error
+                  << " N m; " << lateral << " sizeable lateral components");
+    CHECK(force_error < 1e-7 * largest_force);
+    CHECK(moment_error < 1e-7 * largest_moment);
+    CHECK(lateral > 0);  // the weights' part is exercised
+  }
+}
+
+TEST_CASE("shell contact keeps each pair's side: a particle pressed past the other sheet's mid-surface is pushed back",
+          "[contact][shell_contact]") {
+  // Two 5 × 5 plates (10 mm spacing, 2 mm thick) 1.5 mm apart, the upper one
+  // moved down through the lower one step by step. With the side kept from
+  // the onset (docs/method.md eq. 12.5) the upper plate's particles are
+  // pushed up, with δ = c − g growing past c, all the way; the sign of the
+  // current gap would push them on through below g = 0.
+  const ShellModel model = two_plates(5, 0.04, 1.5e-3, 2e-3);
+  ParticleArrays p = particles_of(model, steel_density);
+  contact::ShellContact contact(model, {});
+  contact::ParticleContactLoads loads;
+  const std::size_t centre = 5 * 5 + 12;  // the upper plate's centre particle
+  for (const double gap : {1.5e-3, 1.0e-3, 0.5e-3, 0.1e-3, -0.1e-3, -0.5e-3, -1.0e-3}) {
+    for (std::size_t i = 0; i < p.position.size(); ++i)
+      if (model.particle_position[i].z() > 1e-4) p.position[i].z() = gap;
+    contact.compute(p.view(), 1e-7, loads);
+    INFO("gap " << gap << " m: force on the upper centre " << loads.force[centre].transpose());
+    CHECK(loads.force[centre].z() > 0.0);
+    CHECK(contact.statistics().largest_penetration == Approx(2e-3 - gap).epsilon(1e-12));
+  }
+  // A new contact takes the side a particle is on: from below, pushed down.
+  contact::ShellContact fresh(model, {});
+  fresh.compute(p.view(), 1e-7, loads);
+  CHECK(loads.force[centre].z() < 0.0);
+  // The sides are state: a contact loaded from a checkpoint of the first
+  // pushes up, as the first does.
+  io::BinaryWriter out;
+  contact.save(out);
+  contact::ShellContact restarted(model, {});
+  io::BinaryReader in(out.bytes(), "shell contact history");
+  restarted.load(in);
+  restarted.compute(p.view(), 1e-7, loads);
+  CHECK(loads.force[centre].z() > 0.0);
+  // A history of another model is refused, naming it.
+  io::BinaryReader again(out.bytes(), "shell contact history");
+  contact::ShellContact other(two_plates(4, 0.04, 1.5e-3, 2e-3), {});
+  CHECK_THROWS_WITH(other.load(again), Catch::Contains("shell contact history: particle count = 50"));
+}
+
+TEST_CASE("shell contact: a new pair takes no side that starts it beyond both thicknesses",
+          "[contact][shell_contact]") {
+  // Two 5 × 5 plates (10 mm spacing, 2 mm thick, c = 2 mm) 1.5 mm apart. An
+  // upper particle a first lies 2 mm from the lower plate's particle b' (x = 0),
+  // over b' alone, on its upper side. Then it stands below the lower plate,
+  // g = −2.5 mm from b's mid-plane (b at x = 10 mm, a at x = 8 mm: off b''s
+  // patch, 2 mm from b). b' is b's material neighbour and parallel to it, but
+  // its side (+1) would start the pair a–b at s g = −2.5 mm < −c, δ = 4.5 mm
+  // at full weight where a weighed nothing of b a step before: the pair takes
+  // the side a is on now (docs/method.md eq. 12.5), s g = 2.5 mm > c: no
+  // penetration. So with b over a's patch (b weighed the upper particle over
+  // it, a's neighbour). The other upper particles stay 0.5 mm into the lower
+  // plate, the largest penetration.
+  const ShellModel model = two_plates(5, 0.04, 1.5e-3, 2e-3);
+  ParticleArrays p = particles_of(model, steel_density);
+  const std::size_t a = 25 + 2;  // the upper plate's particle at x = 0, y = 20 mm
+  contact::ShellContact contact(model, {});
+  contact::ParticleContactLoads loads;
+  p.position[a] = Vector3(0.002, 0.02, 1.5e-3);
+  contact.compute(p.view(), 1e-7, loads);
+  REQUIRE(contact.pairs_of(a).size() == 1);
+  CHECK(contact.pairs_of(a)[0].side == 1);
+  p.position[a] = Vector3(0.008, 0.02, -2.5e-3);
+  contact.compute(p.view(), 1e-7, loads);
+  const std::vector<contact::ShellContactPair> pairs = contact.pairs_of(a);
+  REQUIRE(pairs.size() == 1);
+  CHECK(pairs[0].partner == 5 + 2);
+  CHECK(pairs[0].side == -1);
+  CHECK(pairs[0].penetration == 0.0);
+  std::size_t reverse = 0;
+  for (const contact::ShellContactPair& pair : contact.pairs_of(5 + 2))
+    if (pair.partner == static_cast<int>(a)) {
+      CHECK(pair.side == 1);
+      CHECK(pair.penetration == 0.0);
+      ++reverse;
+    }
+  CHECK(reverse == 1);
+  CHECK(contact.statistics().largest_penetration == Approx(0.5e-3).epsilon(1e-12));
+}
+
+TEST_CASE("shell contact at a sheet's edge: a lone patch carries its weight over a regular sheet's, not the whole spring",
+          "[contact][shell_contact]") {
+  // Two 5 × 5 plates (10 mm spacing, 2 mm thick) 1.6 mm apart, the upper one
+  // shifted 47 mm along x: its first column stands 7 mm beyond the lower
+  // plate's edge, inside the edge particles' patches (radius 7.5 mm) and
+  // over no other (the next lies √(7² + 10²) mm off), and b lies over a's
+  // patch alone. Each carries φ = w / W_sheet of its spring over the other's
+  // patch (eq. 12.2): w = (1 − 7²/7.5²)², W_sheet = 4 (1 − 1/(2 · 0.75²))²,
+  // so the normal force on a is φ δ (k_ab + k_ba),
+  // k_ab = s / (Δt² (1/m_a + 1/m_b + ρ²/I_b)) and k_ba with I_a.
+  const ShellModel model = two_plates(5, 0.04, 1.6e-3, 2e-3);
+  ParticleArrays p = particles_of(model, steel_density);
+  for (std::size_t i = 0; i < p.position.size(); ++i)
+    if (p.position[i].z() > 1e-3) p.position[i].x() += 0.047;
+  const double time_step = 1e-7;
+  contact::ShellContact contact(model, {});
+  contact::ParticleContactLoads loads;
+  contact.compute(p.view(), time_step, loads);
+  const double patch = 0.75 * 0.01, lateral = 0.007, penetration = 2e-3 - 1.6e-3;
+  const double weight = std::pow(1.0 - lateral * lateral / (patch * patch), 2);
+  const double sheet = 4.0 * std::pow(1.0 - 1.0 / (2.0 * 0.75 * 0.75), 2);
+  std::size_t checked = 0;
+  for (std::size_t a = 25; a < 50; ++a) {
+    if (std::abs(p.position[a].x() - 0.047) > 1e-9) continue;  // the upper plate's first column
+    const std::size_t b = a - 25 + 20;                          // the lower plate's edge particle beside it
+    const auto spring = [&](std::size_t rotating) {
+      const double rotary_inertia = p.mass[rotating] * 2e-3 * 2e-3 / 12.0;
+      return contact::default_penalty_stiffness_scale /
+             (time_step * time_step * (1.0 / p.mass[a] + 1.0 / p.mass[b] + lateral * lateral / rotary_inertia));
+    };
+    const double stiffness = spring(b) + spring(a);
+    const std::vector<contact::ShellContactPair> pairs = contact.pairs_of(a);
+    REQUIRE(pairs.size() == 1);
+    CHECK(pairs[0].partner == static_cast<int>(b));
+    INFO("particle " << a << ": force " << loads.force[a].transpose());
+    CHECK(loads.force[a].z() == Approx(weight / sheet * stiffness * penetration).epsilon(1e-9));
+    ++checked;
+  }
+  CHECK(checked == 5);
 }

@@ -557,11 +557,14 @@ class RigidBodySet {
     for (const auto& body : bodies_) body->save(out);
     out(energy_.body_kinetic, energy_.spring, energy_.friction_dissipation, energy_.shell_contact_work,
         energy_.body_work);
+    // The shell contact's pair history (a run without it writes nothing more).
+    if (shell_contact_) shell_contact_->save(out);
   }
   void load(io::BinaryReader& in) {
     for (auto& body : bodies_) body->load(in);
     in(energy_.body_kinetic, energy_.spring, energy_.friction_dissipation, energy_.shell_contact_work,
        energy_.body_work);
+    if (shell_contact_) shell_contact_->load(in);
   }
 
   RigidBodyState state(RigidBodyId id) const {

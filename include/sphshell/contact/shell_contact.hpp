@@ -5,25 +5,31 @@
 // body set (body_set.hpp) adds its loads in the particle pass and books its
 // work and spring energy with the rigid contacts'.
 //
-// Geometry. A particle a is a point of the mid-surface; the shell it stands
-// for is the tangent plane through it (normal d_a, the unit director) out to
-// a patch radius r_a = patch_spacings · Δ_a (Δ_a its local spacing,
-// solver/local_spacing.hpp), with faces h_a/2 to either side. A particle a
-// meets particle b's patch when, with r = x_a − x_b and g = r · d_b its
-// distance from b's mid-plane,
-//   |r − g d_b| ≤ r_b       (a lies over b's patch) and
-//   |g| < (h_a + h_b)/2     (the mid-surfaces are closer than the two half thicknesses):
-// penetration δ = (h_a + h_b)/2 − |g|, normal n = sign(g) d_b (from b towards a).
+// Geometry (docs/method.md §12). A particle a is a point of the mid-surface;
+// the shell it stands for is the tangent plane through it (normal d_a, the
+// unit director) out to a patch radius R_a = patch_spacings · Δ_a (Δ_a its
+// local spacing, solver/local_spacing.hpp), with faces h_a/2 to either side.
+// With r = x_a − x_b, g = r · d_b (a's distance from b's mid-plane),
+// ρ² = |r|² − g² (a's lateral offset from b) and c = (h_a + h_b)/2, a meets
+// b's patch when ρ < R_b and, on its side s = ±1 of b, s g < 2c; penetration
+// δ = max(0, c − s g). The side is history: the sign of g when a first
+// weighed b, kept while it does (a deeply pressed pair is pushed back, never
+// through), or, for a new pair, the side a had of a patch of b's sheet it
+// weighed in the last step (a material neighbour b' of b within 60° of
+// parallel; s times the sign of d_b · d_b') unless that puts a beyond b's
+// far face (s g < −c), else the sign of g now.
 // A particle a meets the surface as a weighted mean of the patches it lies
 // over (node against surface, as a penalty contact's slave node against its
 // master segments), so that its force changes continuously as it slides from
-// patch to patch (taking the nearest patch alone made the penetration jump by
-// the surface's sag over a spacing, κ Δ²/8, at each change: energy put in at
-// every switch, enough to blow a folding tube apart). Patch b's weight is
-//   w_b = (1 − ρ²/r_b²)² · w_n(|g|),  w_n = 1 for |g| ≤ c, (1 − ((|g| − c)/c)²)²
-//   up to 2c, 0 beyond  (ρ = |r − g d_b|, c = (h_a + h_b)/2),
-// so a patch enters and leaves with weight 0 both sideways and along its normal;
-// pair ab carries the share w_b / Σ w of a's spring. Every particle plays both
+// patch to patch. Patch b's weight is
+//   w_b = σ(ρ²) ν(s g),  σ = (1 − ρ²/R_b²)²,  ν = 1 for s g ≤ c,
+//   (1 − ((s g − c)/c)²)² up to 2c, 0 beyond,
+// so a patch enters and leaves with weight 0 both sideways and along its
+// normal; pair ab carries the share φ_b = w_b / S_a of a's spring, with
+// S_a = max(Σ w, W_sheet) and W_sheet = 4 (1 − 1/(2 patch_spacings²))², the
+// smallest Σ w over a regular square sheet (at a cell's centre): inside a
+// sheet the shares sum to 1, at its edge they fade to 0 instead of a lone
+// patch of tiny weight taking the whole spring. Every particle plays both
 // parts (a symmetric contact): on two matching sheets a pair is met twice.
 // At most max_patches_per_particle patches count per particle (the first in
 // the search's order): a sheet's patches of radius 0.75 Δ overlap at most four
@@ -41,25 +47,28 @@
 // patch_spacings: then a particle of a flat sheet lies over no patch of its
 // own sheet that is not excluded.
 //
-// Forces. The pair's spring k = s m_ab / Δt² (penalty.hpp's rule, with the
-// reduced mass m_ab = m_a m_b / (m_a + m_b): the pair oscillates at ω Δt = √s)
-// and share w gives f = w k δ n on a, −f on b and, on b's rotation, the
-// moment M_b = (x_a − x_b) × (−f): the force on b acts where a meets b's
-// patch, not at x_b. That moment is what makes the pair's spring conservative:
-// δ depends on b's director through g = r · d_b, and turning d_b by θ changes
-// ½ k δ² by −θ · M_b (without it, the folds of a crushed tube gained energy
-// from the springs until the run blew up). The forces are exactly opposite,
-// so they sum to zero in floating point (momentum is conserved to
-// round-off), and with M_b the pair conserves angular momentum too. The
-// spring's mass is the pair's effective mass at the contact point,
-// 1/m_ab = 1/m_a + 1/m_b + ρ²/I_b (I_b = s_I m_b h_b²/12, the solver's rotary
-// inertia, docs/method.md §1; ρ the lateral offset, b's rotation moving the
-// patch under a by ρ θ), so the pair oscillates at ω Δt = √s whatever arm it
-// acts on. The thickness offsets are in the gap. A particle carries the
-// shares of its own spring (summing to 1) and of the springs of the particles
-// that meet its patch: with the default s = 0.1 a few leave (ω Δt)² well
-// below the 4 the central difference allows beside the shell's 2.56
-// (penalty.hpp). No friction: the contact is frictionless.
+// Forces. The pair's spring k_ab = s m_ab / Δt² (penalty.hpp's rule) with the
+// pair's effective mass at the contact point, 1/m_ab = 1/m_a + 1/m_b + ρ²/I_b
+// (I_b = s_I m_b h_b²/12, the solver's rotary inertia, docs/method.md §1;
+// b's rotation moves the patch under a by ρ θ), so the pair oscillates at
+// ω Δt = √s whatever arm it acts on. The contact is a potential: the spring
+// energy E = Σ_a E_a, E_a = Σ_b ½ k_ab φ_b δ_b², a function of the positions
+// and directors alone, and the loads are its exact negative gradient:
+// f_a = −∂E_a/∂x_a, f_b = −∂E_a/∂x_b = −f_a, and on b's rotation
+// M_b = −d_b × ∂E_a/∂d_b (turning d_b by θ changes it by θ × d_b), through
+// δ_b, the weights (as a slides over a patch or off a sheet's edge its
+// share changes, and that change is pushed against) and k_ab(ρ²). So the
+// contact neither makes nor loses energy (the books close to the central
+// difference's error), the forces are exactly opposite (momentum to
+// round-off), and E_a is unchanged by a rigid rotation, so the moments
+// balance the forces' moment (angular momentum). With only the normal
+// force k φ δ n, a patch's share rising as a slid under it put ½ k φ δ² in
+// with no work done: enough, where a fold's edge slid in sideways, to blow a
+// thin crushed tube apart. A particle carries the shares of its own spring
+// (summing to at most 1) and of the springs of the particles that meet its
+// patch: with the default s = 0.1 a few leave (ω Δt)² well below the 4 the
+// central difference allows beside the shell's 2.56 (penalty.hpp). No
+// friction: the contact is frictionless.
 //
 // Search: a cell list (approx/neighbour_search.hpp) rebuilt from the current
 // positions every step, with cells as wide as the farthest a patch can weigh
@@ -67,9 +76,9 @@
 // around it, so a step costs O(N). candidate_pairs() counts the pairs within
 // that reach (each ordered pair once), the work the search does per step.
 //
-// Energy: the spring energy Σ ½ k δ² at configuration n; its work on the
-// shell is the shell's external work, booked by the body set like the rigid
-// contacts'.
+// Energy: the spring energy E at configuration n; its work on the shell is
+// the shell's external work, booked by the body set like the rigid contacts'.
+// The sides are state: a checkpoint holds every particle's pairs (save/load).
 
 #include <sphshell/approx/neighbour_search.hpp>
 #include <sphshell/contact/penalty.hpp>
@@ -83,6 +92,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <iterator>
 #include <limits>
 #include <string>
@@ -100,6 +110,20 @@ inline constexpr double default_patch_spacings = 0.75;
 inline constexpr double default_exclusion_spacings = 3.0;
 // Patches that count per particle (see the header comment).
 inline constexpr std::size_t max_patches_per_particle = 8;
+// A new pair takes its side over from a remembered patch of the same sheet
+// only when the two directors are within 60° of parallel (cos 60°): across a
+// tighter bend the sheet's sides are not told apart by the directors.
+inline constexpr double side_transfer_alignment = 0.5;
+// A square grid's cell centre lies Δ/√2 from its four corners: a patch of
+// radius patch_spacings · Δ must reach beyond it to cover a regular sheet.
+inline constexpr double half_cell_diagonal_spacings = 0.70710678118654752440;
+
+// Σ w over a regular square sheet at its thinnest, the cell centre: four
+// patches at ρ = Δ/√2, each of weight (1 − ρ²/r²)² (method.md §12, eq. 12.2).
+inline double regular_sheet_weight(double patch_spacings) {
+  const double inside = 1.0 - 0.5 / (patch_spacings * patch_spacings);
+  return 4.0 * inside * inside;
+}
 
 struct ShellContactOptions {
   double stiffness_scale = default_penalty_stiffness_scale;  // s in k = s m_ab / Δt², 0 < s < 4
@@ -111,6 +135,10 @@ inline void validate(const ShellContactOptions& options) {
   sphshell::detail::require_open_interval("shell contact stiffness_scale", options.stiffness_scale, 0.0,
                                           penalty_stiffness_scale_bound);
   sphshell::detail::require_positive("shell contact patch_spacings", options.patch_spacings);
+  if (!(options.patch_spacings > half_cell_diagonal_spacings))
+    sphshell::detail::invalid_parameter("shell contact patch_spacings", options.patch_spacings,
+                                        "must exceed 1/√2 ≈ 0.7071: smaller patches leave holes at a regular sheet's "
+                                        "cell centres");
   sphshell::detail::require_positive("shell contact exclusion_spacings", options.exclusion_spacings);
   if (!(options.exclusion_spacings > options.patch_spacings))
     sphshell::detail::invalid_parameter("shell contact exclusion_spacings", options.exclusion_spacings,
@@ -121,10 +149,11 @@ inline void validate(const ShellContactOptions& options) {
 // One particle's contact with a patch it meets.
 struct ShellContactPair {
   int partner = -1;             // b, whose patch a meets
+  int side = 0;                 // s = ±1: a is on the side s d_b of b's mid-surface, kept from the pair's onset
   double stiffness = 0.0;       // w k, the share of a's spring this pair carries (N/m)
-  double penetration = 0.0;     // δ = (h_a + h_b)/2 − |g| (m), 0 where the patch only weighs
+  double penetration = 0.0;     // δ = (h_a + h_b)/2 − s g (m), 0 where the patch only weighs
   Vector3 force = Vector3::Zero();  // on a; −force on b
-  Vector3 partner_moment = Vector3::Zero();  // on b's rotation, (x_a − x_b) × (−force)
+  Vector3 partner_moment = Vector3::Zero();  // on b's rotation
 };
 
 // What the last evaluation found.
@@ -158,6 +187,7 @@ class ShellContact {
       largest_spacing = std::max(largest_spacing, spacing_[i]);
     }
     reach_ = std::hypot(2.0 * largest_thickness, options_.patch_spacings * largest_spacing);
+    sheet_weight_ = regular_sheet_weight(options_.patch_spacings);
     find_material_neighbours(model);
   }
 
@@ -174,6 +204,9 @@ class ShellContact {
     if (count != reference_.size())
       sphshell::detail::invalid_parameter("shell contact particle count", count,
                                           "must equal the model's " + std::to_string(reference_.size()));
+    // The last step's pairs are the history that keeps each pair's side.
+    previous_pairs_.swap(pairs_);
+    previous_count_.swap(pair_count_);
     pairs_.assign(count * max_patches_per_particle, ShellContactPair{});
     pair_count_.assign(count, 0);
     candidates_.assign(count, 0);
@@ -191,13 +224,19 @@ class ShellContact {
       for (std::size_t k = 0; k < pair_count_[a]; ++k) {
         const ShellContactPair& pair = pairs_[a * max_patches_per_particle + k];
         if (!(pair.penetration > 0.0)) continue;
+        result.spring_energy += 0.5 * pair.stiffness * pair.penetration * pair.penetration;
+        statistics_.largest_penetration = std::max(statistics_.largest_penetration, pair.penetration);
+        touches = true;
+      }
+      // Where a touches, every patch it weighs carries a load (the shares'
+      // change is part of the force); where it does not, none does.
+      if (!touches) continue;
+      for (std::size_t k = 0; k < pair_count_[a]; ++k) {
+        const ShellContactPair& pair = pairs_[a * max_patches_per_particle + k];
         const auto b = static_cast<std::size_t>(pair.partner);
         loads.force[a] += pair.force;
         loads.force[b] -= pair.force;
         loads.moment[b] += pair.partner_moment;
-        result.spring_energy += 0.5 * pair.stiffness * pair.penetration * pair.penetration;
-        statistics_.largest_penetration = std::max(statistics_.largest_penetration, pair.penetration);
-        touches = true;
       }
       if (touches) ++result.contacts;
     }
@@ -214,13 +253,97 @@ class ShellContact {
     return {first, first + static_cast<std::ptrdiff_t>(pair_count_.at(a))};
   }
 
+  // Checkpoints: the history, every particle's pairs of the last compute()
+  // (partner and side; the rest is recomputed from the configuration).
+  template <class Writer>
+  void save(Writer& out) const {
+    std::vector<std::int32_t> partners, sides;
+    for (std::size_t a = 0; a < pair_count_.size(); ++a)
+      for (std::size_t k = 0; k < pair_count_[a]; ++k) {
+        partners.push_back(pairs_[a * max_patches_per_particle + k].partner);
+        sides.push_back(pairs_[a * max_patches_per_particle + k].side);
+      }
+    out(pair_count_, partners, sides);
+  }
+  template <class Reader>
+  void load(Reader& in) {
+    std::vector<std::size_t> counts;
+    std::vector<std::int32_t> partners, sides;
+    in(counts, partners, sides);
+    const std::size_t count = reference_.size();
+    if (!counts.empty() && counts.size() != count)
+      sphshell::detail::invalid_parameter("checkpoint's shell contact history: particle count", counts.size(),
+                                          "must be the model's " + std::to_string(count));
+    std::size_t total = 0;
+    for (std::size_t c : counts) {
+      if (c > max_patches_per_particle)
+        sphshell::detail::invalid_parameter("checkpoint's shell contact history: pairs of a particle", c,
+                                            "must be at most " + std::to_string(max_patches_per_particle));
+      total += c;
+    }
+    if (partners.size() != total || sides.size() != total)
+      sphshell::detail::invalid_parameter("checkpoint's shell contact history: pair count", partners.size(),
+                                          "must be the sum of the particles' counts " + std::to_string(total));
+    std::vector<ShellContactPair> pairs(counts.size() * max_patches_per_particle);
+    std::size_t next = 0;
+    for (std::size_t a = 0; a < counts.size(); ++a)
+      for (std::size_t k = 0; k < counts[a]; ++k, ++next) {
+        if (partners[next] < 0 || static_cast<std::size_t>(partners[next]) >= count ||
+            (sides[next] != 1 && sides[next] != -1))
+          sphshell::detail::invalid_parameter("checkpoint's shell contact history: pair " + std::to_string(next),
+                                              partners[next], "must name a particle with a side of ±1");
+        pairs[a * max_patches_per_particle + k].partner = partners[next];
+        pairs[a * max_patches_per_particle + k].side = sides[next];
+      }
+    pairs_ = std::move(pairs);
+    pair_count_ = std::move(counts);
+  }
+
  private:
+  // One patch that a weighs, while its share is being formed.
+  struct PatchTerm {
+    Vector3 arm = Vector3::Zero();  // r = x_a − x_b
+    Vector3 director = Vector3::Zero();  // d_b
+    double gap = 0.0;               // g = r · d_b
+    double lateral_squared = 0.0;   // ρ²
+    double sideways = 0.0, sideways_slope = 0.0;  // σ(ρ²) and dσ/dρ²
+    double along = 0.0, along_slope = 0.0;        // ν(s g) and dν/d(s g)
+    double stiffness = 0.0, stiffness_slope = 0.0;  // k(ρ²) and dk/dρ²
+  };
+
+  // The side of b's mid-surface a lies on: remembered from the last step if
+  // a weighed b then; else taken over from a patch b' of the same sheet (a
+  // material neighbour of b, nearly parallel) that a weighed then, unless
+  // that side puts a beyond b's far face (s g < −c: the pair would start
+  // deeper than both thicknesses, at full weight, where it weighed nothing a
+  // step before); else the side a is on now (method.md §12, eq. 12.5).
+  int side_of(const ContactParticles& particles, std::size_t a, int b, double gap,
+              double contact_distance) const noexcept {
+    if (a < previous_count_.size()) {
+      const ShellContactPair* previous = &previous_pairs_[a * max_patches_per_particle];
+      const std::size_t count = previous_count_[a];
+      for (std::size_t k = 0; k < count; ++k)
+        if (previous[k].partner == b) return previous[k].side;
+      const Vector3& db = particles.director[static_cast<std::size_t>(b)];
+      for (std::size_t k = 0; k < count; ++k) {
+        const int other = previous[k].partner;
+        if (!is_material_neighbour(static_cast<std::size_t>(b), other)) continue;
+        const double alignment = db.dot(particles.director[static_cast<std::size_t>(other)]);
+        if (std::abs(alignment) < side_transfer_alignment) continue;
+        const int side = alignment > 0.0 ? previous[k].side : -previous[k].side;
+        if (side * gap < -contact_distance) break;
+        return side;
+      }
+    }
+    return gap >= 0.0 ? 1 : -1;
+  }
+
   void find_pairs(const ContactParticles& particles, const approx::CellList& cells, double time_step,
                   std::size_t a) noexcept {
     const Vector3& xa = particles.position[a];
     const double half_a = 0.5 * particles.thickness[a];
     ShellContactPair* pairs = &pairs_[a * max_patches_per_particle];
-    double weights[max_patches_per_particle];
+    PatchTerm terms[max_patches_per_particle];
     std::size_t found = 0, candidates = 0;
     double weight_sum = 0.0;
     cells.for_each_within(xa, reach_, [&](int j, double distance_squared) {
@@ -229,41 +352,81 @@ class ShellContact {
       ++candidates;
       if (found == max_patches_per_particle || is_material_neighbour(a, j)) return;
       const Vector3& db = particles.director[b];
-      const double gap = (xa - particles.position[b]).dot(db);
+      const Vector3 arm = xa - particles.position[b];
+      const double gap = arm.dot(db);
       const double lateral_squared = std::max(0.0, distance_squared - gap * gap);
       const double patch = options_.patch_spacings * spacing_[b];
-      if (!(lateral_squared < patch * patch)) return;
+      const double patch_squared = patch * patch;
+      if (!(lateral_squared < patch_squared)) return;
       const double contact_distance = half_a + 0.5 * particles.thickness[b];
-      const double distance = std::abs(gap);
-      if (!(distance < 2.0 * contact_distance)) return;
-      const double sideways = 1.0 - lateral_squared / (patch * patch);
-      double along = 1.0;
-      if (distance > contact_distance) {
-        const double beyond = (distance - contact_distance) / contact_distance;
-        along = (1.0 - beyond * beyond) * (1.0 - beyond * beyond);
+      const int side = side_of(particles, a, j, gap, contact_distance);
+      const double signed_gap = side * gap;  // > 0 on a's side of b, < 0 once past b's mid-surface
+      if (!(signed_gap < 2.0 * contact_distance)) return;
+      PatchTerm& term = terms[found];
+      term.arm = arm;
+      term.director = db;
+      term.gap = gap;
+      term.lateral_squared = lateral_squared;
+      const double inside = 1.0 - lateral_squared / patch_squared;
+      term.sideways = inside * inside;
+      term.sideways_slope = -2.0 * inside / patch_squared;
+      term.along = 1.0;
+      term.along_slope = 0.0;
+      if (signed_gap > contact_distance) {
+        const double beyond = (signed_gap - contact_distance) / contact_distance;
+        const double fade = 1.0 - beyond * beyond;
+        term.along = fade * fade;
+        term.along_slope = -4.0 * beyond * fade / contact_distance;
       }
-      const double weight = sideways * sideways * along;
-      ShellContactPair& pair = pairs[found];
-      pair.partner = j;
-      pair.penetration = std::max(0.0, contact_distance - distance);
       const double mass_b = particles.mass[b], thickness_b = particles.thickness[b];
       const double rotary_inertia_b = rotary_inertia_scale_ * mass_b * thickness_b * thickness_b / 12.0;
       const double compliance = 1.0 / particles.mass[a] + 1.0 / mass_b + lateral_squared / rotary_inertia_b;
-      pair.stiffness = penalty_stiffness(1.0 / compliance, time_step, options_.stiffness_scale);
-      // The normal from b towards a; the arm of b's moment, x_a − x_b.
-      pair.force = gap >= 0.0 ? Vector3(db) : Vector3(-db);
-      pair.partner_moment = xa - particles.position[b];
-      weights[found] = weight;
-      weight_sum += weight;
+      term.stiffness = penalty_stiffness(1.0 / compliance, time_step, options_.stiffness_scale);
+      term.stiffness_slope = -term.stiffness / (compliance * rotary_inertia_b);
+      ShellContactPair& pair = pairs[found];
+      pair.partner = j;
+      pair.side = side;
+      pair.penetration = std::max(0.0, contact_distance - signed_gap);
+      weight_sum += term.sideways * term.along;
       ++found;
     });
     candidates_[a] = candidates;
     pair_count_[a] = found;
+    // Shares φ_b = w_b / S, S = max(Σ w, W_sheet) (method.md §12, eq. 12.2),
+    // and a's spring energy E_a = Σ ½ k_b φ_b δ_b².
+    const double share_sum = std::max(weight_sum, sheet_weight_);
+    const bool normalised = weight_sum > sheet_weight_;
+    double energy = 0.0;
     for (std::size_t k = 0; k < found; ++k) {
       ShellContactPair& pair = pairs[k];
-      pair.stiffness *= weight_sum > 0.0 ? weights[k] / weight_sum : 0.0;
-      pair.force *= pair.stiffness * pair.penetration;
-      pair.partner_moment = pair.partner_moment.cross(Vector3(-pair.force));
+      const PatchTerm& term = terms[k];
+      const double share = share_sum > 0.0 ? term.sideways * term.along / share_sum : 0.0;
+      pair.stiffness = share * term.stiffness;
+      energy += 0.5 * pair.stiffness * pair.penetration * pair.penetration;
+    }
+    // The loads are −∂E_a/∂(x_a, x_b, θ_b) (eq. 12.4): through δ_b, through
+    // the weights (the shares' change as a slides over and off the patches)
+    // and through k_b(ρ²).
+    for (std::size_t k = 0; k < found; ++k) {
+      ShellContactPair& pair = pairs[k];
+      const PatchTerm& term = terms[k];
+      const double delta = pair.penetration;
+      const double share = pair.stiffness > 0.0 ? pair.stiffness / term.stiffness : 0.0;
+      // ∂E_a/∂w_b.
+      const double per_weight =
+          share_sum > 0.0 ? (0.5 * term.stiffness * delta * delta - (normalised ? energy : 0.0)) / share_sum : 0.0;
+      // ∂E_a/∂ρ_b² and ∂E_a/∂(s g_b).
+      const double per_lateral = per_weight * term.sideways_slope * term.along +
+                                 0.5 * share * delta * delta * term.stiffness_slope;
+      const double per_gap = per_weight * term.sideways * term.along_slope - pair.stiffness * delta;
+      const double side = pair.side;
+      // ρ² = |r|² − g², g = r · d: ∂ρ²/∂r = 2 (r − g d), ∂ρ²/∂d = −2 g r; ∂(s g)/∂r = s d, ∂(s g)/∂d = s r.
+      const Vector3 by_arm =
+          (2.0 * per_lateral) * (term.arm - term.gap * term.director) + (per_gap * side) * term.director;
+      const Vector3 by_director = (-2.0 * per_lateral * term.gap + per_gap * side) * term.arm;
+      pair.force = -by_arm;
+      // A turn θ of b's director changes it by θ × d_b: the moment is −d_b × ∂E_a/∂d_b.
+      pair.partner_moment = -term.director.cross(by_director);
     }
   }
 
@@ -332,8 +495,11 @@ class ShellContact {
   std::vector<int> neighbours_;
   std::vector<double> spacing_;
   double reach_ = 0.0;
+  double sheet_weight_ = 0.0;  // W_sheet, regular_sheet_weight
   std::vector<ShellContactPair> pairs_;  // max_patches_per_particle slots per particle
   std::vector<std::size_t> pair_count_;
+  std::vector<ShellContactPair> previous_pairs_;  // the last step's: each pair's side
+  std::vector<std::size_t> previous_count_;
   std::vector<std::size_t> candidates_;
   ShellContactStatistics statistics_;
 };
