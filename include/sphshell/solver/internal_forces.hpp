@@ -52,6 +52,103 @@
 
 namespace sphshell::solver {
 
+// Parts of the InternalForceAssembler below, kept outside its class.
+namespace assembler_parts {
+
+// One particle's sum (InternalForceAssembler::sum_particle_forces): what it
+// reads, gathered once per pass: the points' conjugate forces and the tied
+// shear's corner forces the assembler keeps.
+template <class Approx>
+class ForceSum {
+ public:
+  ForceSum(const IntegrationPoints<Approx>& points, const shell::ConjugateForces* conjugate,
+           const Vector3* tied_force, const Vector3* tied_director_force)
+      : begin_(points.particle_slot_begin().data()),
+        entries_(points.force_entries().data()),
+        conjugate_(conjugate),
+        tied_force_(tied_force),
+        tied_director_force_(tied_director_force),
+        untied_(points.untied_corner()),
+        // Each group's Φ, ∂Φ/∂X1, ∂Φ/∂X2, picked by whether the entry's point
+        // is a particle point (those follow the stress points).
+        value_of_{points.shape(PointGroup::stress_points).value.data(),
+                  points.shape(PointGroup::particles).value.data()},
+        first_particle_point_(points.point(PointGroup::particles, 0)) {}
+
+  void operator()(std::size_t i, ParticleForces& forces) const {
+    Vector3 force = Vector3::Zero(), director_force = Vector3::Zero();
+    for (std::size_t k = begin_[i]; k < begin_[i + 1]; ++k) {
+      const auto& entry = entries_[k];
+      const shell::ConjugateForces& f = conjugate_[entry.point];
+      const std::size_t g = entry.point >= first_particle_point_ ? 1 : 0;
+      const approx::ShapeValue& value = value_of_[g][entry.slot];
+      const double phi = value.phi, dphi_d1 = value.dphi_d1, dphi_d2 = value.dphi_d2;
+      Vector3 slot_force = dphi_d1 * f.a1 + dphi_d2 * f.a2;
+      Vector3 slot_director_force = phi * f.n + dphi_d1 * f.n1 + dphi_d2 * f.n2;
+      if (entry.tied_corner != untied_) {
+        slot_force += tied_force_[entry.tied_corner];
+        slot_director_force += tied_director_force_[entry.tied_corner];
+      }
+      force += slot_force;
+      director_force += slot_director_force;
+    }
+    forces.internal[i] = force;
+    forces.internal_director[i] = director_force;
+  }
+
+ private:
+  const std::size_t* begin_;
+  const typename IntegrationPoints<Approx>::ForceEntry* entries_;
+  const shell::ConjugateForces* conjugate_;
+  const Vector3 *tied_force_, *tied_director_force_;
+  std::size_t untied_;
+  const approx::ShapeValue* value_of_[2];
+  std::size_t first_particle_point_;
+};
+
+// The lowest failing point of a segment, in the order of the separate
+// passes (every stress point before every particle point), so that the
+// error names the same point for any number of threads.
+struct PointFailure {
+  std::size_t group = point_groups.size();  // index_of(group); point_groups.size(): none
+  std::size_t row = 0;
+  std::exception_ptr error;
+  void keep_lowest(PointGroup failed_group, std::size_t failed_row, std::exception_ptr failed) {
+    const std::size_t g = index_of(failed_group);
+    if (g < group || (g == group && failed_row < row)) {
+      group = g;
+      row = failed_row;
+      error = std::move(failed);
+    }
+  }
+};
+
+// Per band of the schedule: the segments still to report in this
+// compute(). A segment's report releases the forces it wrote and the last
+// one's acquires the others', so the band's sums read every point's forces
+// of this step. (A copy starts without counts: compute() sets them.)
+class BandCountdown {
+ public:
+  BandCountdown() = default;
+  BandCountdown(const BandCountdown&) {}
+  BandCountdown& operator=(const BandCountdown&) { return *this; }
+  void start(const AssemblySchedule& schedule) {
+    if (size_ != schedule.band_count()) {
+      size_ = schedule.band_count();
+      remaining_ = std::make_unique<std::atomic<std::uint32_t>[]>(size_);
+    }
+    for (std::size_t b = 0; b < size_; ++b) remaining_[b].store(schedule.band_parts(b), std::memory_order_relaxed);
+  }
+  // True for the segment that reports last.
+  bool report(std::size_t band) { return remaining_[band].fetch_sub(1, std::memory_order_acq_rel) == 1; }
+
+ private:
+  std::size_t size_ = 0;
+  std::unique_ptr<std::atomic<std::uint32_t>[]> remaining_;
+};
+
+}  // namespace assembler_parts
+
 class InternalForceAssembler {
  public:
   template <class Approx>
@@ -91,14 +188,15 @@ class InternalForceAssembler {
     // Each segment integrates its runs and sums the particles that each run
     // completes; a band of particles whose points lie in several segments is
     // summed by the segment that finishes its share of them last.
-    const ForceSum<Approx> sum(points, *this);
+    const assembler_parts::ForceSum<Approx> sum(points, conjugate_.data(), tied_force_.data(),
+                                                tied_director_force_.data());
     const PointChunks chunks(points);
     work_chunk_sums_.resize(chunks.count());
     const auto work_of = [this](std::size_t p) { return work_increment_[p]; };
-    failures_.assign(schedule_.segments(), PointFailure{});
+    failures_.assign(schedule_.segments(), assembler_parts::PointFailure{});
     band_countdown_.start(schedule_);
     parallel::for_each_task(schedule_.segments(), [&](std::size_t segment) noexcept {
-      PointFailure& failure = failures_[segment];
+      assembler_parts::PointFailure& failure = failures_[segment];
       for (std::size_t run = schedule_.first_run(segment); run < schedule_.end_run(segment); ++run) {
         const AssemblySchedule::Run& rows = schedule_.run(run);
         integrate_rows(rows.group, rows.first_row, rows.end_row, points, states, failure);
@@ -147,7 +245,8 @@ class InternalForceAssembler {
   // (compute() forms the same sums interleaved with the points' updates.)
   template <class Approx>
   void sum_particle_forces(const IntegrationPoints<Approx>& points, ParticleForces& forces) const {
-    const ForceSum<Approx> sum(points, *this);
+    const assembler_parts::ForceSum<Approx> sum(points, conjugate_.data(), tied_force_.data(),
+                                                tied_director_force_.data());
     parallel::for_each(std::size_t{0}, forces.internal.size(), [&](std::size_t i) noexcept { sum(i, forces); });
   }
 
@@ -212,53 +311,6 @@ class InternalForceAssembler {
   }
 
  private:
-  // One particle's sum (sum_particle_forces): what it reads, gathered once per pass.
-  template <class Approx>
-  class ForceSum {
-   public:
-    ForceSum(const IntegrationPoints<Approx>& points, const InternalForceAssembler& assembler)
-        : begin_(points.particle_slot_begin().data()),
-          entries_(points.force_entries().data()),
-          conjugate_(assembler.conjugate_.data()),
-          tied_force_(assembler.tied_force_.data()),
-          tied_director_force_(assembler.tied_director_force_.data()),
-          untied_(points.untied_corner()),
-          // Each group's Φ, ∂Φ/∂X1, ∂Φ/∂X2, picked by whether the entry's point
-          // is a particle point (those follow the stress points).
-          value_of_{points.shape(PointGroup::stress_points).value.data(),
-                    points.shape(PointGroup::particles).value.data()},
-          first_particle_point_(points.point(PointGroup::particles, 0)) {}
-
-    void operator()(std::size_t i, ParticleForces& forces) const {
-      Vector3 force = Vector3::Zero(), director_force = Vector3::Zero();
-      for (std::size_t k = begin_[i]; k < begin_[i + 1]; ++k) {
-        const auto& entry = entries_[k];
-        const shell::ConjugateForces& f = conjugate_[entry.point];
-        const std::size_t g = entry.point >= first_particle_point_ ? 1 : 0;
-        const approx::ShapeValue& value = value_of_[g][entry.slot];
-        const double phi = value.phi, dphi_d1 = value.dphi_d1, dphi_d2 = value.dphi_d2;
-        Vector3 slot_force = dphi_d1 * f.a1 + dphi_d2 * f.a2;
-        Vector3 slot_director_force = phi * f.n + dphi_d1 * f.n1 + dphi_d2 * f.n2;
-        if (entry.tied_corner != untied_) {
-          slot_force += tied_force_[entry.tied_corner];
-          slot_director_force += tied_director_force_[entry.tied_corner];
-        }
-        force += slot_force;
-        director_force += slot_director_force;
-      }
-      forces.internal[i] = force;
-      forces.internal_director[i] = director_force;
-    }
-
-   private:
-    const std::size_t* begin_;
-    const typename IntegrationPoints<Approx>::ForceEntry* entries_;
-    const shell::ConjugateForces* conjugate_;
-    const Vector3 *tied_force_, *tied_director_force_;
-    std::size_t untied_;
-    const approx::ShapeValue* value_of_[2];
-    std::size_t first_particle_point_;
-  };
 
   // The sums of value(p) over the chunks of a run's rows (a run starts at a
   // chunk's first row and ends at a chunk's end), each in row order.
@@ -273,27 +325,11 @@ class InternalForceAssembler {
     }
   }
 
-  // The lowest failing point of a segment, in the order of the separate
-  // passes (every stress point before every particle point), so that the
-  // error names the same point for any number of threads.
-  struct PointFailure {
-    std::size_t group = point_groups.size();  // index_of(group); point_groups.size(): none
-    std::size_t row = 0;
-    std::exception_ptr error;
-    void keep_lowest(PointGroup failed_group, std::size_t failed_row, std::exception_ptr failed) {
-      const std::size_t g = index_of(failed_group);
-      if (g < group || (g == group && failed_row < row)) {
-        group = g;
-        row = failed_row;
-        error = std::move(failed);
-      }
-    }
-  };
 
   template <class Approx>
   void report_failure(const StepTime& at, const IntegrationPoints<Approx>& points) {
-    PointFailure lowest;
-    for (const PointFailure& failure : failures_)
+    assembler_parts::PointFailure lowest;
+    for (const assembler_parts::PointFailure& failure : failures_)
       if (failure.error) lowest.keep_lowest(point_groups[failure.group], failure.row, failure.error);
     if (!lowest.error) return;
     const PointGroup group = point_groups[lowest.group];
@@ -352,7 +388,7 @@ class InternalForceAssembler {
   template <class Approx, class Rule, class Law>
   void integrate_rows(PointGroup group, std::size_t first_row, std::size_t end_row,
                       const IntegrationPoints<Approx>& points, SectionStates<Rule, Law>& states,
-                      PointFailure& failure) {
+                      assembler_parts::PointFailure& failure) {
     using Group = SectionGroup<Rule, Law>;
     // The runs start at a chunk's first row, so that a block of the states
     // (section_states.hpp) is never shared by two runs, which two threads
@@ -482,29 +518,6 @@ class InternalForceAssembler {
     return energy;
   }
 
-  // Per band of the schedule: the segments still to report in this
-  // compute(). A segment's report releases the forces it wrote and the last
-  // one's acquires the others', so the band's sums read every point's forces
-  // of this step. (A copy starts without counts: compute() sets them.)
-  class BandCountdown {
-   public:
-    BandCountdown() = default;
-    BandCountdown(const BandCountdown&) {}
-    BandCountdown& operator=(const BandCountdown&) { return *this; }
-    void start(const AssemblySchedule& schedule) {
-      if (size_ != schedule.band_count()) {
-        size_ = schedule.band_count();
-        remaining_ = std::make_unique<std::atomic<std::uint32_t>[]>(size_);
-      }
-      for (std::size_t b = 0; b < size_; ++b) remaining_[b].store(schedule.band_parts(b), std::memory_order_relaxed);
-    }
-    // True for the segment that reports last.
-    bool report(std::size_t band) { return remaining_[band].fetch_sub(1, std::memory_order_acq_rel) == 1; }
-
-   private:
-    std::size_t size_ = 0;
-    std::unique_ptr<std::atomic<std::uint32_t>[]> remaining_;
-  };
 
   bool nonlinear_;
   material::UpdateContext update_context_{std::numeric_limits<double>::quiet_NaN()};
@@ -519,8 +532,8 @@ class InternalForceAssembler {
   double internal_work_ = 0.0;
   std::vector<PackedKinematics> packed_;  // this step's positions and directors
   AssemblySchedule schedule_;
-  std::vector<PointFailure> failures_;  // per segment of the last compute()
-  BandCountdown band_countdown_;
+  std::vector<assembler_parts::PointFailure> failures_;  // per segment of the last compute()
+  assembler_parts::BandCountdown band_countdown_;
 };
 
 }  // namespace sphshell::solver
