@@ -48,6 +48,7 @@ struct Arguments {
   double friction = 0.2;
   double safety_factor = 0.8;
   double exclusion_spacings = 1.5;
+  double patch_spacings = 1.0;
   double contact_stiffness = contact::default_penalty_stiffness_scale;
   bool no_self_contact = false;
   std::string output = "tube_crush";
@@ -75,6 +76,9 @@ std::optional<Arguments> parse(int argc, char** argv) {
   command_line.number("--safety-factor", a.safety_factor, "", "time step / stable bound, in (0, 1)");
   command_line.number("--exclusion-spacings", a.exclusion_spacings, "",
                       "self contact: material neighbours' reach in spacings (ShellContactOptions::exclusion_spacings)");
+  command_line.number("--patch-spacings", a.patch_spacings, "",
+                      "self contact: patch radius in spacings (ShellContactOptions::patch_spacings), in (1/√2, "
+                      "--exclusion-spacings)");
   command_line.number("--contact-stiffness", a.contact_stiffness, "",
                       "penalty stiffness scale s of walls and self contact (k = s m / dt^2), in (0, 4)");
   command_line.flag("--no-self-contact", a.no_self_contact, "leave the shell's self contact off (folds pass through each other)");
@@ -113,9 +117,6 @@ constexpr double ramp_share = 0.02;
 // Guillow, Lu & Grzebieta (2001), eq. (5): F_av / M_p = 72.3 (D/t)^0.32.
 constexpr double guillow_coefficient = 72.3;
 constexpr double guillow_exponent = 0.32;
-// The self contact's patch radius in spacings (ShellContactOptions::patch_spacings; see run()).
-constexpr double tube_patch_spacings = 1.0;
-
 int run(const Arguments& a) {
   using TubeSolver = Solver<approx::MLS<kernel::CubicSpline>, thickness::Gauss<5>, material::J2Plasticity>;
   const double radius = 0.5 * a.diameter;
@@ -136,13 +137,14 @@ int run(const Arguments& a) {
   // ≈ 0.99 √(R t) each (Alexander's estimate, about 7 mm here): the self
   // contact must spare fewer neighbours than that, or it lets the fold pass
   // through itself at a coarse spacing.
-  // Patches of a whole spacing: the flanks of a closing fold meet near each
-  // other's patch rims, where patches of 0.75 Δ (Σ w down to 0.05 on a
-  // regular sheet) let the shares fade as at a sheet's edge (docs/method.md
-  // eq. 12.2) and the flanks press deep into each other; patches of Δ
-  // overlap to Σ w ≥ 1, so the shares sum to 1 wherever the sheet is.
+  // Patches of a whole spacing by default (--patch-spacings): the flanks of
+  // a closing fold meet near each other's patch rims, where patches of
+  // 0.75 Δ (Σ w down to 0.05 on a regular sheet) let the shares fade as at a
+  // sheet's edge (docs/method.md eq. 12.2) and the flanks press deep into
+  // each other; patches of Δ overlap to Σ w ≥ 1, so the shares sum to 1
+  // wherever the sheet is.
   contact::ShellContactOptions self_contact;
-  self_contact.patch_spacings = tube_patch_spacings;
+  self_contact.patch_spacings = a.patch_spacings;
   self_contact.exclusion_spacings = a.exclusion_spacings;
   self_contact.stiffness_scale = a.contact_stiffness;
   if (!a.no_self_contact) solver.enable_shell_contact(self_contact);
