@@ -387,6 +387,75 @@ TEST_CASE("Statics: the kept factorisation (modified Newton) reaches the equilib
   CHECK(krylov_report.factorisations < newton_report.factorisations);
 }
 
+TEST_CASE("Statics: a load step starts where NewtonOptions::predictor says", "[statics]") {
+  // The strip under a tip force in load steps 0 → 0.5 → 0.75 → 1. At the
+  // third step the test computes the two possible starts itself: the state
+  // converged at 0.75 (LoadPredictor::last_state), and that state moved on by
+  // the whole last step (LoadPredictor::extrapolated: equal steps, so the
+  // translations advance by x(0.75) − x(0.5) and each director turns once more
+  // by the rotation that took it from d(0.5) to d(0.75)); their relative
+  // residuals at λ = 1 must be what the third step started from.
+  struct Starts {
+    double last_state, extrapolated, reported;
+    double tip_last_state, tip_extrapolated, tip_converged;  // tip deflections (m)
+  };
+  auto third_step = [](statics::LoadPredictor predictor, double tip_force) {
+    Strip strip(11, 3);
+    strip.conditions.add_force(strip.model.set("x_max"), Vector3(0.0, 0.0, tip_force));
+    NonlinearSolver solver(strip.model, {Strip::E, 0.0});
+    statics::NewtonOptions options;
+    options.tolerance = 1e-8;
+    options.predictor = predictor;
+    statics::PathFollower<NonlinearSolver> path(solver, strip.conditions, options);
+    path.solve_to(0.5, 0.5);
+    const std::vector<Vector3> x_half = solver.positions(), d_half = solver.directors();
+    path.solve_to(0.75, 0.25);
+    const std::vector<Vector3> x = solver.positions(), d = solver.directors();
+    statics::TangentAssembly<NonlinearSolver>& assembly = path.assembly();
+    auto relative_residual_at_one = [&](std::vector<Vector3> xs, std::vector<Vector3> ds) {
+      assembly.set_configuration(std::move(xs), std::move(ds));
+      const statics::DegreesOfFreedom dofs = assembly.degrees_of_freedom();
+      return assembly.residual(dofs, 1.0).norm() / assembly.load_norm(dofs, 1.0);
+    };
+    const int tip = strip.model.set("x_max")[1];
+    std::vector<Vector3> x_ahead(x.size()), d_ahead(d.size());
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      x_ahead[i] = 2.0 * x[i] - x_half[i];
+      d_ahead[i] = Eigen::Quaterniond::FromTwoVectors(d_half[i], d[i]) * d[i];
+    }
+    Starts starts{};
+    starts.tip_last_state = path.displacement(tip).z();
+    starts.tip_extrapolated = starts.tip_last_state + (x[tip] - x_half[tip]).z();
+    starts.extrapolated = relative_residual_at_one(x_ahead, d_ahead);
+    starts.last_state = relative_residual_at_one(x, d);  // and the solver back at the converged state
+    const int steps = path.report().load_steps;
+    path.solve_to(1.0, 0.25);
+    CHECK(path.report().load_steps == steps + 1);  // one step, not halved
+    starts.reported = path.report().load_step_start_residual;
+    starts.tip_converged = path.displacement(tip).z();
+    return starts;
+  };
+  // The tip force of 1/3 bends the strip to a deflection near L/3. There
+  // the straight-line extrapolation of the turning strip stretches its
+  // membrane: it starts nearer the converged deflection but at a far larger
+  // residual than the last state (the case LoadPredictor::last_state is for).
+  const double tip_force = 1.0 / 3.0;
+  const Starts from_last = third_step(statics::LoadPredictor::last_state, tip_force);
+  const Starts from_extrapolation = third_step(statics::LoadPredictor::extrapolated, tip_force);
+  std::printf("Strip, third load step starts at relative residual %.6e (last state; computed %.6e) and %.6e "
+              "(extrapolated; computed %.6e); tip deflection %.6f, %.6f at the starts, %.6f converged\n",
+              from_last.reported, from_last.last_state, from_extrapolation.reported, from_extrapolation.extrapolated,
+              from_extrapolation.tip_last_state, from_extrapolation.tip_extrapolated,
+              from_extrapolation.tip_converged);
+  CHECK(from_last.reported == Approx(from_last.last_state).epsilon(1e-9));
+  CHECK(from_extrapolation.reported == Approx(from_extrapolation.extrapolated).epsilon(1e-6));
+  // The two starts differ by far more than the tolerances above.
+  CHECK(std::abs(std::log(from_extrapolation.reported / from_last.reported)) > std::log(2.0));
+  // The path is smooth in the deflection: the extrapolation starts nearer it.
+  CHECK(std::abs(from_extrapolation.tip_extrapolated - from_extrapolation.tip_converged) <
+        0.5 * std::abs(from_extrapolation.tip_last_state - from_extrapolation.tip_converged));
+}
+
 TEST_CASE("Statics: GMRES solves a nonsymmetric system to the tolerance asked, with and without a preconditioner",
           "[statics]") {
   // A convection–diffusion matrix (tridiagonal: a diagonal growing from 4

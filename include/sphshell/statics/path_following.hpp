@@ -405,6 +405,7 @@ class PathFollower {
       const Eigen::VectorXd r = assembly_.residual(dofs, lambda);
       const double reference = assembly_.load_norm(dofs, lambda);
       const double relative = r.norm() / reference;
+      if (iteration == 0) assembly_.report().load_step_start_residual = relative;
       if (!std::isfinite(relative)) return false;
       if (relative <= options_.tolerance) return true;
       if (options_.trace)

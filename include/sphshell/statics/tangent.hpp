@@ -41,6 +41,10 @@ struct NewtonReport {
   long force_evaluations = 0;  // internal-force computations in all
   int factorisations = 0;      // tangents assembled and factorised for Newton steps
   long krylov_iterations = 0;  // tangent products of the GMRES Newton steps (NewtonOptions::krylov_iterations)
+  // Load control: the relative residual ‖r‖ / ‖λ f_ext‖ where the last load
+  // step's Newton iteration started (at its predictor, NewtonOptions::predictor;
+  // the last attempt when the step was halved).
+  double load_step_start_residual = 0.0;
 };
 
 // The finite-difference steps of the tangent.
