@@ -564,6 +564,15 @@ class RigidBodySet {
     for (auto& body : bodies_) body->load(in);
     in(energy_.body_kinetic, energy_.spring, energy_.friction_dissipation, energy_.shell_contact_work,
        energy_.body_work);
+    // The history is there exactly when the saving run had the shell contact
+    // (a file of a library from before the history was kept has none either).
+    if (shell_contact_ && in.at_end())
+      in.fail("it holds no shell contact pair history (the side of each pair), which this solver's shell contact "
+              "needs: it was written by a run without enable_shell_contact(), or by a library that did not save "
+              "the pairs' sides; restart without the shell contact or from a checkpoint written with it");
+    if (!shell_contact_ && !in.at_end())
+      in.fail("it holds a shell contact pair history and this solver has no shell contact: call "
+              "enable_shell_contact() before loading it");
     if (shell_contact_) shell_contact_->load(in);
   }
 
