@@ -442,7 +442,12 @@ class RigidBodySet {
   template <class GlobalOf, class Gather>
   void finish_step(const StepTime& at, double time_step, double velocity_step, std::size_t particles_per_chunk,
                    GlobalOf&& global_of, Gather&& gather) {
+    std::size_t term_count = 0;
+    for (const auto& body : bodies_)
+      for (const std::vector<ContactTerm>& chunk : body->chunk_terms()) term_count += chunk.size();
+    for (const std::vector<ContactTerm>& chunk : shell_chunk_terms_) term_count += chunk.size();
     std::vector<ContactTerm> mine;
+    mine.reserve(term_count);
     for (std::size_t b = 0; b < bodies_.size(); ++b)
       for (const std::vector<ContactTerm>& chunk : bodies_[b]->chunk_terms())
         for (ContactTerm term : chunk) {

@@ -220,7 +220,8 @@ class ShellContact {
       // A particle that meets more patches than there are slots counts them
       // all but keeps the first slots_; the store then grows to the most met
       // and the step is searched again, so that none is left out.
-      pairs_.assign(count * slots_, ShellContactPair{});
+      // Every slot below a particle's count is written before it is read.
+      pairs_.resize(count * slots_);
       pair_count_.assign(count, 0);
       candidates_.assign(count, 0);
       std::atomic<bool> out_of_memory{false};
@@ -385,14 +386,13 @@ class ShellContact {
       const auto b = static_cast<std::size_t>(j);
       if (b == a) return;
       ++candidates;
-      if (is_material_neighbour(a, j)) return;
       const Vector3& db = particles.director[b];
       const Vector3 arm = xa - particles.position[b];
       const double gap = arm.dot(db);
       const double lateral_squared = std::max(0.0, distance_squared - gap * gap);
       const double patch = options_.patch_spacings * spacing_[b];
       const double patch_squared = patch * patch;
-      if (!(lateral_squared < patch_squared)) return;
+      if (!(lateral_squared < patch_squared) || is_material_neighbour(a, j)) return;
       const double contact_distance = half_a + 0.5 * particles.thickness[b];
       const int side = side_of(particles, a, j, gap, contact_distance);
       const double signed_gap = side * gap;  // > 0 on a's side of b, < 0 once past b's mid-surface
