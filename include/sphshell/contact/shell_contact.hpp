@@ -310,7 +310,7 @@ class ShellContact {
     for (std::size_t c : counts) {
       if (c > count)
         sphshell::detail::invalid_parameter("checkpoint's shell contact history: pairs of a particle", c,
-                                            "must be below the model's particle count " + std::to_string(count));
+                                            "must not exceed the model's particle count " + std::to_string(count));
       total += c;
       most = std::max(most, c);
     }
