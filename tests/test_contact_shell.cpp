@@ -14,6 +14,8 @@
 #include <sphshell/solver.hpp>
 #include <sphshell/thickness/all.hpp>
 
+#include "support/mesh_files.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -707,4 +709,141 @@ TEST_CASE("shell contact at a sheet's edge: a lone patch carries its weight over
     ++checked;
   }
   CHECK(checked == 5);
+}
+
+namespace {
+
+// `layers` n × n square plates of side `side` (directors +z) stacked `gap`
+// apart, each its own sheet (no cell joins two), layer l at z = l · gap; the
+// middle layer shifted by half a spacing along x and y, so that its
+// particles stand over the centres of the other layers' cells.
+ShellModel stacked_plates(int layers, int n, double side, double gap, double thickness) {
+  std::vector<Vector3> positions, normals;
+  std::vector<Quad> quads;
+  const double spacing = side / (n - 1);
+  for (int layer = 0; layer < layers; ++layer) {
+    const int base = layer * n * n;
+    const double shift = layer == layers / 2 ? 0.5 * spacing : 0.0;
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        positions.emplace_back(i * spacing + shift, j * spacing + shift, layer * gap);
+        normals.push_back(Vector3::UnitZ());
+      }
+    for (int i = 0; i + 1 < n; ++i)
+      for (int j = 0; j + 1 < n; ++j)
+        quads.push_back({base + i * n + j, base + (i + 1) * n + j, base + (i + 1) * n + j + 1, base + i * n + j + 1});
+  }
+  return ShellModel::from_quads(positions, normals, quads, thickness);
+}
+
+}  // namespace
+
+TEST_CASE("shell contact counts every patch a particle lies over: 16 between four stacked sheets, none dropped",
+          "[contact][shell_contact]") {
+  // Five 5 × 5 plates (10 mm spacing, 2 mm thick, c = 2 mm) 1.5 mm apart; the
+  // middle one shifted by (5, 5) mm. Its particle a at (15, 15, 3) mm stands
+  // over the centre of a cell of each other plate: four patches of each
+  // (ρ = 7.07 mm < R = 7.5 mm; the next at 15.8 mm), 16 in all, twice the
+  // store's initial slots. The plates 1.5 mm away press (δ = 0.5 mm, ν = 1),
+  // those 3 mm away only weigh (c < s g < 2c: ν = (1 − ((3 − 2)/2)²)², δ = 0).
+  // Each pair carries φ_b = w_b / Σ w of a's spring (eq. 12.2; Σ w is 12.5
+  // patches' worth of σ, above W_sheet = 4 σ): with a patch dropped the
+  // shares of the others would be larger.
+  const double spacing = 0.01, thickness = 2e-3, gap = 1.5e-3, time_step = 1e-7;
+  const ShellModel model = stacked_plates(5, 5, 0.04, gap, thickness);
+  ParticleArrays p = particles_of(model, steel_density);
+  const std::size_t a = 2 * 25 + 1 * 5 + 1;
+  REQUIRE(p.position[a].isApprox(Vector3(0.015, 0.015, 2.0 * gap)));
+  contact::ShellContact contact(model, {});
+  REQUIRE(contact.patch_slots() == contact::initial_patch_slots);
+  contact::ParticleContactLoads loads;
+  contact.compute(p.view(), time_step, loads);
+  CHECK(contact.statistics().most_patches == 16);
+  CHECK(contact.patch_slots() == 16);
+  const std::vector<contact::ShellContactPair> pairs = contact.pairs_of(a);
+  REQUIRE(pairs.size() == 16);
+
+  const double patch = 0.75 * spacing, lateral_squared = 2.0 * 0.005 * 0.005;
+  const double sideways = std::pow(1.0 - lateral_squared / (patch * patch), 2);
+  const double far_along = std::pow(1.0 - std::pow((2.0 * gap - thickness) / thickness, 2), 2);
+  const double weight_sum = 8.0 * sideways + 8.0 * sideways * far_along;
+  REQUIRE(weight_sum > contact::regular_sheet_weight(0.75));
+  std::vector<int> near(5, 0), far(5, 0);
+  double share_sum = 0.0;
+  for (const contact::ShellContactPair& pair : pairs) {
+    const auto b = static_cast<std::size_t>(pair.partner);
+    const int layer = static_cast<int>(b / 25);
+    const bool pressing = layer == 1 || layer == 3;
+    INFO("partner " << b << " (layer " << layer << ")");
+    const double offset = std::hypot(p.position[b].x() - p.position[a].x(), p.position[b].y() - p.position[a].y());
+    CHECK(offset == Approx(std::sqrt(lateral_squared)).epsilon(1e-12));
+    const double rotary_inertia = p.mass[b] * thickness * thickness / 12.0;
+    const double spring = contact::default_penalty_stiffness_scale /
+                          (time_step * time_step * (1.0 / p.mass[a] + 1.0 / p.mass[b] + lateral_squared / rotary_inertia));
+    const double share = (pressing ? sideways : sideways * far_along) / weight_sum;
+    CHECK(pair.stiffness == Approx(share * spring).epsilon(1e-10));
+    CHECK(pair.penetration == Approx(pressing ? thickness - gap : 0.0).margin(1e-15));
+    share_sum += pair.stiffness / spring;
+    ++(pressing ? near : far)[static_cast<std::size_t>(layer)];
+  }
+  CHECK(share_sum == Approx(1.0).epsilon(1e-12));
+  CHECK(near == std::vector<int>{0, 4, 0, 4, 0});
+  CHECK(far == std::vector<int>{4, 0, 0, 0, 4});
+  // Mirror symmetric about the middle plate: a is pushed neither up nor down.
+  double pushes = 0.0;
+  for (const contact::ShellContactPair& pair : pairs) pushes += pair.force.norm();
+  REQUIRE(pushes > 0.0);
+  CHECK(std::abs(loads.force[a].z()) < 1e-9 * pushes);
+
+  // The sides of all 16 are state: a contact loaded from a checkpoint of this
+  // one grows its store and computes the same loads, bit for bit.
+  io::BinaryWriter out;
+  contact.save(out);
+  contact::ShellContact restarted(model, {});
+  io::BinaryReader in(out.bytes(), "shell contact history");
+  restarted.load(in);
+  CHECK(restarted.patch_slots() == 16);
+  contact::ParticleContactLoads again, restarted_loads;
+  contact.compute(p.view(), time_step, again);
+  restarted.compute(p.view(), time_step, restarted_loads);
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < p.position.size(); ++i)
+    differing += again.force[i] == restarted_loads.force[i] && again.moment[i] == restarted_loads.moment[i] ? 0 : 1;
+  CHECK(differing == 0);
+}
+
+TEST_CASE("a checkpoint without the shell contact's pair history is refused by a solver with the shell contact, naming it",
+          "[contact][shell_contact][checkpoint]") {
+  // A run without the shell contact writes its BODY section without the
+  // pair history, as a library that did not keep the pairs' sides wrote it
+  // with the shell contact on: a solver with the shell contact must not
+  // start from it with sides made up, nor a solver without it skip one.
+  const test_support::ScratchDirectory directory("shell_contact_history");
+  const std::string without = (directory.path() / "without.ckpt").string();
+  const std::string with = (directory.path() / "with.ckpt").string();
+  const ShellModel model = two_plates(4, 0.03, 0.035, 2e-3);
+  SolverOptions options;
+  options.density = steel_density;
+  {
+    PlateSolver plain(model, steel, options);
+    for (int k = 0; k < 3; ++k) plain.step();
+    plain.save_checkpoint(without);
+    PlateSolver contacting(model, steel, options);
+    contacting.enable_shell_contact();
+    for (int k = 0; k < 3; ++k) contacting.step();
+    contacting.save_checkpoint(with);
+  }
+  PlateSolver contacting(model, steel, options);
+  contacting.enable_shell_contact();
+  CHECK_THROWS_WITH(contacting.load_checkpoint(without),
+                    Catch::Contains("without.ckpt', section 'BODY': it holds no shell contact pair history") &&
+                        Catch::Contains("enable_shell_contact()"));
+  PlateSolver plain(model, steel, options);
+  CHECK_THROWS_WITH(plain.load_checkpoint(with),
+                    Catch::Contains("with.ckpt', section 'BODY': it holds a shell contact pair history and this solver "
+                                    "has no shell contact"));
+  PlateSolver restarted(model, steel, options);
+  restarted.enable_shell_contact();
+  restarted.load_checkpoint(with);
+  CHECK(restarted.steps() == 3);
 }

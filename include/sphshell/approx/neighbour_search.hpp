@@ -128,9 +128,36 @@ class CellList {
     // box are empty (skipping them spares a flat plate 18 of its 27 lookups).
     const auto first = [&](std::int64_t c) { return std::max(c - layers, std::int64_t{0}); };
     const auto last = [&](std::int64_t c, int axis) { return std::min(c + layers, cells_per_axis_[axis] - 1); };
+    const std::int64_t first_z = first(centre.z), last_z = last(centre.z, 2);
+    if (dense_) {
+      // A column's cells (cx, cy, first_z … last_z) are consecutive in the
+      // dense array and so are their points: one run of points per column,
+      // in the order the cells would give them one by one; per slab (cx) when
+      // the columns span the grid's height (a flat set one or a few cells high).
+      if (first_z > last_z) return;
+      // The points of the cells bottom … top (dense indices), in that order.
+      const auto visit_run = [&](const Cell& bottom, const Cell& top) {
+        const auto end = static_cast<std::size_t>(cell_begin_[static_cast<std::size_t>(dense_index(top)) + 1]);
+        for (auto k = static_cast<std::size_t>(cell_begin_[static_cast<std::size_t>(dense_index(bottom))]); k < end;
+             ++k) {
+          const double distance_squared = (point_in_cell_[k] - x).squaredNorm();
+          if (distance_squared < radius_squared) visit(cell_points_[k], distance_squared);
+        }
+      };
+      const bool whole_height = first_z == 0 && last_z == cells_per_axis_[2] - 1;
+      const std::int64_t first_y = first(centre.y), last_y = last(centre.y, 1);
+      for (std::int64_t cx = first(centre.x); cx <= last(centre.x, 0); ++cx) {
+        if (whole_height) {
+          if (first_y <= last_y) visit_run({cx, first_y, first_z}, {cx, last_y, last_z});
+          continue;
+        }
+        for (std::int64_t cy = first_y; cy <= last_y; ++cy) visit_run({cx, cy, first_z}, {cx, cy, last_z});
+      }
+      return;
+    }
     for (std::int64_t cx = first(centre.x); cx <= last(centre.x, 0); ++cx)
       for (std::int64_t cy = first(centre.y); cy <= last(centre.y, 1); ++cy)
-        for (std::int64_t cz = first(centre.z); cz <= last(centre.z, 2); ++cz) {
+        for (std::int64_t cz = first_z; cz <= last_z; ++cz) {
           const Cell cell{cx, cy, cz};
           const int index = dense_ ? dense_index(cell) : find(pack(cell));
           if (index < 0) continue;

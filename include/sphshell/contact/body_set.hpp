@@ -442,7 +442,12 @@ class RigidBodySet {
   template <class GlobalOf, class Gather>
   void finish_step(const StepTime& at, double time_step, double velocity_step, std::size_t particles_per_chunk,
                    GlobalOf&& global_of, Gather&& gather) {
+    std::size_t term_count = 0;
+    for (const auto& body : bodies_)
+      for (const std::vector<ContactTerm>& chunk : body->chunk_terms()) term_count += chunk.size();
+    for (const std::vector<ContactTerm>& chunk : shell_chunk_terms_) term_count += chunk.size();
     std::vector<ContactTerm> mine;
+    mine.reserve(term_count);
     for (std::size_t b = 0; b < bodies_.size(); ++b)
       for (const std::vector<ContactTerm>& chunk : bodies_[b]->chunk_terms())
         for (ContactTerm term : chunk) {
@@ -564,6 +569,15 @@ class RigidBodySet {
     for (auto& body : bodies_) body->load(in);
     in(energy_.body_kinetic, energy_.spring, energy_.friction_dissipation, energy_.shell_contact_work,
        energy_.body_work);
+    // The history is there exactly when the saving run had the shell contact
+    // (a file of a library from before the history was kept has none either).
+    if (shell_contact_ && in.at_end())
+      in.fail("it holds no shell contact pair history (the side of each pair), which this solver's shell contact "
+              "needs: it was written by a run without enable_shell_contact(), or by a library that did not save "
+              "the pairs' sides; restart without the shell contact or from a checkpoint written with it");
+    if (!shell_contact_ && !in.at_end())
+      in.fail("it holds a shell contact pair history and this solver has no shell contact: call "
+              "enable_shell_contact() before loading it");
     if (shell_contact_) shell_contact_->load(in);
   }
 

@@ -31,9 +31,12 @@
 // sheet the shares sum to 1, at its edge they fade to 0 instead of a lone
 // patch of tiny weight taking the whole spring. Every particle plays both
 // parts (a symmetric contact): on two matching sheets a pair is met twice.
-// At most max_patches_per_particle patches count per particle (the first in
-// the search's order): a sheet's patches of radius 0.75 Δ overlap at most four
-// deep, two sheets' eight.
+// Every patch a particle lies over counts, however many: the store holds
+// initial_patch_slots per particle to start with (a sheet's patches of radius
+// 0.75 Δ overlap at most four deep, two sheets' eight) and grows, for every
+// particle, to the most that one particle met whenever a step finds more (the
+// step is then searched again); ShellContactStatistics::most_patches reports
+// the most of the last step, patch_slots() the store's size.
 //
 // Material neighbours never touch: particle a's neighbours are the particles
 // connected to it through the model's cells (corners of a common cell, step
@@ -90,6 +93,7 @@
 #include <sphshell/solver/local_spacing.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -108,8 +112,9 @@ inline constexpr double default_patch_spacings = 0.75;
 // beyond the solver's default support radius (2 spacings,
 // SolverOptions::support_radius_factor).
 inline constexpr double default_exclusion_spacings = 3.0;
-// Patches that count per particle (see the header comment).
-inline constexpr std::size_t max_patches_per_particle = 8;
+// Slots per particle for the patches it lies over, to start with; the store
+// grows when a particle meets more (see the header comment).
+inline constexpr std::size_t initial_patch_slots = 8;
 // A new pair takes its side over from a remembered patch of the same sheet
 // only when the two directors are within 60° of parallel (cos 60°): across a
 // tighter bend the sheet's sides are not told apart by the directors.
@@ -162,6 +167,7 @@ struct ShellContactStatistics {
   std::size_t candidate_pairs = 0;  // ordered pairs within the search reach
   double largest_penetration = 0.0; // max δ (m)
   double spring_energy = 0.0;       // Σ ½ k δ² (J)
+  std::size_t most_patches = 0;     // the most patches one particle lay over (all of them count)
 };
 
 class ShellContact {
@@ -207,22 +213,45 @@ class ShellContact {
     // The last step's pairs are the history that keeps each pair's side.
     previous_pairs_.swap(pairs_);
     previous_count_.swap(pair_count_);
-    pairs_.assign(count * max_patches_per_particle, ShellContactPair{});
-    pair_count_.assign(count, 0);
-    candidates_.assign(count, 0);
+    previous_slots_ = slots_;
     const approx::CellList cells(particles.position, reach_);
-    parallel::for_each_range(std::size_t{0}, count, [&](std::size_t first, std::size_t last) noexcept {
-      for (std::size_t a = first; a < last; ++a) find_pairs(particles, cells, time_step, a);
-    });
+    std::size_t most_patches = 0;
+    for (;;) {
+      // A particle that meets more patches than there are slots counts them
+      // all but keeps the first slots_; the store then grows to the most met
+      // and the step is searched again, so that none is left out.
+      // Every slot below a particle's count is written before it is read.
+      pairs_.resize(count * slots_);
+      pair_count_.assign(count, 0);
+      candidates_.assign(count, 0);
+      std::atomic<bool> out_of_memory{false};
+      parallel::for_each_range(std::size_t{0}, count, [&](std::size_t first, std::size_t last) noexcept {
+        std::vector<PatchTerm> terms;
+        try {
+          terms.resize(slots_);
+        } catch (...) {
+          out_of_memory.store(true);
+          return;
+        }
+        for (std::size_t a = first; a < last; ++a) find_pairs(particles, cells, time_step, a, terms.data());
+      });
+      if (out_of_memory.load())
+        throw Error("sphshell: shell contact: no memory for the terms of " + std::to_string(slots_) +
+                    " patches per particle");
+      most_patches = count == 0 ? 0 : *std::max_element(pair_count_.begin(), pair_count_.end());
+      if (most_patches <= slots_) break;
+      slots_ = most_patches;
+    }
     loads.force.assign(count, Vector3::Zero());
     loads.moment.assign(count, Vector3::Zero());
     ContactStepResult result;
     statistics_ = ShellContactStatistics{};
+    statistics_.most_patches = most_patches;
     for (std::size_t a = 0; a < count; ++a) {
       statistics_.candidate_pairs += candidates_[a];
       bool touches = false;
       for (std::size_t k = 0; k < pair_count_[a]; ++k) {
-        const ShellContactPair& pair = pairs_[a * max_patches_per_particle + k];
+        const ShellContactPair& pair = pairs_[a * slots_ + k];
         if (!(pair.penetration > 0.0)) continue;
         result.spring_energy += 0.5 * pair.stiffness * pair.penetration * pair.penetration;
         statistics_.largest_penetration = std::max(statistics_.largest_penetration, pair.penetration);
@@ -232,7 +261,7 @@ class ShellContact {
       // change is part of the force); where it does not, none does.
       if (!touches) continue;
       for (std::size_t k = 0; k < pair_count_[a]; ++k) {
-        const ShellContactPair& pair = pairs_[a * max_patches_per_particle + k];
+        const ShellContactPair& pair = pairs_[a * slots_ + k];
         const auto b = static_cast<std::size_t>(pair.partner);
         loads.force[a] += pair.force;
         loads.force[b] -= pair.force;
@@ -246,10 +275,13 @@ class ShellContact {
   }
 
   const ShellContactStatistics& statistics() const { return statistics_; }
+  // Slots per particle in the pair store: initial_patch_slots, or the most
+  // patches one particle has met since (the store never drops a patch).
+  std::size_t patch_slots() const { return slots_; }
   // Particle a's pairs of the last compute(): the patches it weighs (those
   // with penetration 0 carry no force).
   std::vector<ShellContactPair> pairs_of(std::size_t a) const {
-    const auto first = pairs_.begin() + static_cast<std::ptrdiff_t>(a * max_patches_per_particle);
+    const auto first = pairs_.begin() + static_cast<std::ptrdiff_t>(a * slots_);
     return {first, first + static_cast<std::ptrdiff_t>(pair_count_.at(a))};
   }
 
@@ -260,8 +292,8 @@ class ShellContact {
     std::vector<std::int32_t> partners, sides;
     for (std::size_t a = 0; a < pair_count_.size(); ++a)
       for (std::size_t k = 0; k < pair_count_[a]; ++k) {
-        partners.push_back(pairs_[a * max_patches_per_particle + k].partner);
-        sides.push_back(pairs_[a * max_patches_per_particle + k].side);
+        partners.push_back(pairs_[a * slots_ + k].partner);
+        sides.push_back(pairs_[a * slots_ + k].side);
       }
     out(pair_count_, partners, sides);
   }
@@ -274,17 +306,19 @@ class ShellContact {
     if (!counts.empty() && counts.size() != count)
       sphshell::detail::invalid_parameter("checkpoint's shell contact history: particle count", counts.size(),
                                           "must be the model's " + std::to_string(count));
-    std::size_t total = 0;
+    std::size_t total = 0, most = 0;
     for (std::size_t c : counts) {
-      if (c > max_patches_per_particle)
+      if (c > count)
         sphshell::detail::invalid_parameter("checkpoint's shell contact history: pairs of a particle", c,
-                                            "must be at most " + std::to_string(max_patches_per_particle));
+                                            "must not exceed the model's particle count " + std::to_string(count));
       total += c;
+      most = std::max(most, c);
     }
     if (partners.size() != total || sides.size() != total)
       sphshell::detail::invalid_parameter("checkpoint's shell contact history: pair count", partners.size(),
                                           "must be the sum of the particles' counts " + std::to_string(total));
-    std::vector<ShellContactPair> pairs(counts.size() * max_patches_per_particle);
+    const std::size_t slots = std::max(slots_, most);
+    std::vector<ShellContactPair> pairs(counts.size() * slots);
     std::size_t next = 0;
     for (std::size_t a = 0; a < counts.size(); ++a)
       for (std::size_t k = 0; k < counts[a]; ++k, ++next) {
@@ -292,9 +326,10 @@ class ShellContact {
             (sides[next] != 1 && sides[next] != -1))
           sphshell::detail::invalid_parameter("checkpoint's shell contact history: pair " + std::to_string(next),
                                               partners[next], "must name a particle with a side of ±1");
-        pairs[a * max_patches_per_particle + k].partner = partners[next];
-        pairs[a * max_patches_per_particle + k].side = sides[next];
+        pairs[a * slots + k].partner = partners[next];
+        pairs[a * slots + k].side = sides[next];
       }
+    slots_ = slots;
     pairs_ = std::move(pairs);
     pair_count_ = std::move(counts);
   }
@@ -320,7 +355,7 @@ class ShellContact {
   int side_of(const ContactParticles& particles, std::size_t a, int b, double gap,
               double contact_distance) const noexcept {
     if (a < previous_count_.size()) {
-      const ShellContactPair* previous = &previous_pairs_[a * max_patches_per_particle];
+      const ShellContactPair* previous = &previous_pairs_[a * previous_slots_];
       const std::size_t count = previous_count_[a];
       for (std::size_t k = 0; k < count; ++k)
         if (previous[k].partner == b) return previous[k].side;
@@ -338,30 +373,34 @@ class ShellContact {
     return gap >= 0.0 ? 1 : -1;
   }
 
+  // Particle a's pairs into its slots_ slots (terms: slots_ of scratch); a
+  // patch beyond them is counted, not kept, and compute() searches again.
   void find_pairs(const ContactParticles& particles, const approx::CellList& cells, double time_step,
-                  std::size_t a) noexcept {
+                  std::size_t a, PatchTerm* terms) noexcept {
     const Vector3& xa = particles.position[a];
     const double half_a = 0.5 * particles.thickness[a];
-    ShellContactPair* pairs = &pairs_[a * max_patches_per_particle];
-    PatchTerm terms[max_patches_per_particle];
+    ShellContactPair* pairs = &pairs_[a * slots_];
     std::size_t found = 0, candidates = 0;
     double weight_sum = 0.0;
     cells.for_each_within(xa, reach_, [&](int j, double distance_squared) {
       const auto b = static_cast<std::size_t>(j);
       if (b == a) return;
       ++candidates;
-      if (found == max_patches_per_particle || is_material_neighbour(a, j)) return;
       const Vector3& db = particles.director[b];
       const Vector3 arm = xa - particles.position[b];
       const double gap = arm.dot(db);
       const double lateral_squared = std::max(0.0, distance_squared - gap * gap);
       const double patch = options_.patch_spacings * spacing_[b];
       const double patch_squared = patch * patch;
-      if (!(lateral_squared < patch_squared)) return;
+      if (!(lateral_squared < patch_squared) || is_material_neighbour(a, j)) return;
       const double contact_distance = half_a + 0.5 * particles.thickness[b];
       const int side = side_of(particles, a, j, gap, contact_distance);
       const double signed_gap = side * gap;  // > 0 on a's side of b, < 0 once past b's mid-surface
       if (!(signed_gap < 2.0 * contact_distance)) return;
+      if (found >= slots_) {
+        ++found;
+        return;
+      }
       PatchTerm& term = terms[found];
       term.arm = arm;
       term.director = db;
@@ -392,6 +431,7 @@ class ShellContact {
     });
     candidates_[a] = candidates;
     pair_count_[a] = found;
+    if (found > slots_) return;  // compute() grows the store and searches again
     // Shares φ_b = w_b / S, S = max(Σ w, W_sheet) (method.md §12, eq. 12.2),
     // and a's spring energy E_a = Σ ½ k_b φ_b δ_b².
     const double share_sum = std::max(weight_sum, sheet_weight_);
@@ -496,7 +536,9 @@ class ShellContact {
   std::vector<double> spacing_;
   double reach_ = 0.0;
   double sheet_weight_ = 0.0;  // W_sheet, regular_sheet_weight
-  std::vector<ShellContactPair> pairs_;  // max_patches_per_particle slots per particle
+  std::size_t slots_ = initial_patch_slots;  // pairs_'s slots per particle
+  std::size_t previous_slots_ = initial_patch_slots;  // previous_pairs_'s
+  std::vector<ShellContactPair> pairs_;  // slots_ slots per particle
   std::vector<std::size_t> pair_count_;
   std::vector<ShellContactPair> previous_pairs_;  // the last step's: each pair's side
   std::vector<std::size_t> previous_count_;
