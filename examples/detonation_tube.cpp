@@ -396,15 +396,18 @@ int run(const Arguments& a) {
   const int notch_particle = model.nearest_particle(a.radius * radial + Vector3(0, 0, notch_centre));
   const auto start = std::chrono::steady_clock::now();
   long next_progress = 0;
+  auto sample = [&](const TubeSolver& s) {
+    const auto [rear, front] = tips(s);
+    const auto [rear_path, front_path] = path_lengths(s);
+    const double radial_displacement = s.displacement(notch_particle).dot(model.particle_normal[notch_particle]);
+    const auto [rear_arc, front_arc] = arc_extents(s);
+    samples.push_back({s.time(), rear, front, rear_path, front_path, s.crack().total_length(), radial_displacement,
+                       std::max(rear_arc, front_arc), rear_arc, front_arc,
+                       s.damaged_stress_point_count(), s.crack().crack_count()});
+  };
   auto observe = [&](const TubeSolver& s) {
     if (s.time() >= next_sample - 1e-12) {
-      const auto [rear, front] = tips(s);
-      const auto [rear_path, front_path] = path_lengths(s);
-      const double radial_displacement = s.displacement(notch_particle).dot(model.particle_normal[notch_particle]);
-      const auto [rear_arc, front_arc] = arc_extents(s);
-      samples.push_back({s.time(), rear, front, rear_path, front_path, s.crack().total_length(), radial_displacement,
-                         std::max(rear_arc, front_arc), rear_arc, front_arc,
-                         s.damaged_stress_point_count(), s.crack().crack_count()});
+      sample(s);
       next_sample += sample_interval;
     }
     if (s.steps() >= next_progress) {
@@ -429,9 +432,12 @@ int run(const Arguments& a) {
       run_end = std::min(a.end_time, std::max(run_end + 1e-5, solver.time() + solver.time_step()));
       solver.run_until(run_end, observe);
     }
-    if (solver.time() < a.end_time - 0.5 * solver.time_step())
+    if (solver.time() < a.end_time - 0.5 * solver.time_step()) {
+      // The last sample may be up to 2 µs older than the stop: the state at the stop closes the history.
+      if (samples.empty() || samples.back().t < solver.time()) sample(solver);
       std::printf("stopped at %.0f µs: both ends have grown %.1f mm axially\n", solver.time() * 1e6,
                   a.stop_growth * 1e3);
+    }
   } else {
     solver.run_until(a.end_time, observe);
   }
