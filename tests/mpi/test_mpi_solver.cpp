@@ -560,7 +560,7 @@ TEST_CASE("Distributed static solution by dynamic relaxation: bitwise the serial
   }
   SECTION("J2 plasticity, two load steps (a path)") {
     // Bitwise agreement along a plastic path, no figure: a coarser grid of the
-    // same plate (the same stresses, a third of the relaxation's cost).
+    // same plate (the same stresses; fewer particles and relaxation steps).
     const ShellModel coarse = ShellModel::rectangular_plate(0.5, 0.5, 15, 15, 0.01);
     const material::J2Plasticity::Parameters law{steel_E, steel_nu, steel_yield, steel_Ep};
     Serial<material::J2Plasticity> serial(coarse, law, options);
