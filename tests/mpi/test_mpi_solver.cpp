@@ -559,9 +559,12 @@ TEST_CASE("Distributed static solution by dynamic relaxation: bitwise the serial
     CHECK(relative(distributed.energy().elastic, serial.energy().elastic) < 1e-12);
   }
   SECTION("J2 plasticity, two load steps (a path)") {
+    // Bitwise agreement along a plastic path, no figure: a coarser grid of the
+    // same plate (the same stresses; fewer particles and relaxation steps).
+    const ShellModel coarse = ShellModel::rectangular_plate(0.5, 0.5, 15, 15, 0.01);
     const material::J2Plasticity::Parameters law{steel_E, steel_nu, steel_yield, steel_Ep};
-    Serial<material::J2Plasticity> serial(model, law, options);
-    Distributed<material::J2Plasticity> distributed(comm, model, law, options);
+    Serial<material::J2Plasticity> serial(coarse, law, options);
+    Distributed<material::J2Plasticity> distributed(comm, coarse, law, options);
     clamped_pressure(serial, 2.5e6);
     clamped_pressure(distributed, 2.5e6);
     parameters.load_factors = {0.5, 1.0};
@@ -571,7 +574,7 @@ TEST_CASE("Distributed static solution by dynamic relaxation: bitwise the serial
     CHECK(mpi_test::differing_components(distributed.positions(), serial.positions()) == 0);
     CHECK(mpi_test::differing_components(distributed.directors(), serial.directors()) == 0);
     double largest = 0.0;
-    for (std::size_t p = 0; p < model.stress_point_count(); ++p)
+    for (std::size_t p = 0; p < coarse.stress_point_count(); ++p)
       largest = std::max(largest, serial.equivalent_plastic_strain(static_cast<int>(p), 0));
     CHECK(largest > 0.0);  // the path is plastic: an elastic answer would prove nothing
   }
