@@ -14,6 +14,9 @@
 //    (three translations, two rotations normal to the director).
 //    Known limit: on the cantilever strip (free edges) its Newton steps stall
 //    even under small load steps; the clamped plates converge in 1–2 steps.
+//    With StaticParameters::krylov_iterations the steps are solved by GMRES on
+//    the current tangent (products by differences of the forces),
+//    preconditioned by a kept factorisation of an earlier one.
 //  - StaticMass::particle_bound (the default): adaptive dynamic relaxation (Underwood 1983)
 //    with a diagonal fictitious mass per degree of freedom from the
 //    Gershgorin bound of the tangent's rows, m_a = (h²/4) Σ_b |K_ab| with the
