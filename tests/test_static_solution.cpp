@@ -396,3 +396,61 @@ TEST_CASE("The automatic relaxation budget grows with the particles per side and
   // Twice as slender: twice the budget.
   CHECK(budget(51, 0.001, 1e-8) == Approx(2.0 * budget(51, 0.002, 1e-8)).epsilon(0.01));
 }
+
+TEST_CASE("Newton's steps by GMRES on a kept factorisation reach the equilibrium full Newton reaches",
+          "[static][plate]") {
+  // The clamped plate at L/d = 100, nonlinear, under a pressure that bends it
+  // to about its thickness (membrane action: Newton iterates), in two load
+  // steps to the relative residual 1e-9: a fresh tangent at every Newton
+  // iteration, and GMRES on the current tangent preconditioned by the
+  // factorisation of an earlier one (StaticParameters::krylov_iterations).
+  // Both stop below 1e-9, so their deflections agree to about that.
+  auto solve = [](int krylov_iterations, solver::StaticResult& result) {
+    SolverOptions options = Plate::options();
+    options.nonlinear = true;
+    const double d = 0.01;
+    PlateSolver plate(ShellModel::rectangular_plate(1.0, 1.0, 21, 21, d), {210e9, 0.3}, options);
+    plate.clamp(plate.model().set("boundary"));
+    // w ≈ 0.00126 q L⁴ / D ≈ d at q = d D / (0.00126 L⁴).
+    const double D = 210e9 * d * d * d / (12 * (1 - 0.09)), q = d * D / 0.00126;
+    plate.add_uniform_pressure(plate.model().all_particles(), q, time_function::Step{}, PressureDirection::fixed);
+    solver::StaticParameters parameters;
+    parameters.mass = solver::StaticMass::tangent;
+    parameters.load_factors = {0.5, 1.0};
+    parameters.tolerance = 1e-9;
+    parameters.krylov_iterations = krylov_iterations;
+    result = plate.solve_static(parameters);
+    return -plate.displacement(plate.model().set("centre")[0]).z() / d;
+  };
+  solver::StaticResult newton, krylov;
+  const double w_newton = solve(0, newton), w_krylov = solve(20, krylov);
+  WARN("nonlinear clamped plate, w/d at the centre: full Newton " << w_newton << " (" << newton.iterations
+                                                                  << " iterations, " << newton.factorisations
+                                                                  << " factorisations), GMRES " << w_krylov << " ("
+                                                                  << krylov.iterations << " iterations, "
+                                                                  << krylov.factorisations << " factorisations, "
+                                                                  << krylov.krylov_iterations << " products)");
+  CHECK(newton.converged);
+  CHECK(krylov.converged);
+  CHECK(newton.residual <= 1e-9);
+  CHECK(krylov.residual <= 1e-9);
+  // Membrane action: the deflection is well below the linear one (about d).
+  CHECK(w_newton > 0.3);
+  CHECK(w_newton < 0.9);
+  CHECK(w_krylov == Approx(w_newton).epsilon(1e-6));
+  // Full Newton factorises at every iteration; GMRES keeps one factorisation
+  // as its preconditioner across iterations and load steps.
+  CHECK(newton.factorisations == newton.iterations);
+  CHECK(newton.krylov_iterations == 0);
+  CHECK(krylov.krylov_iterations > 0);
+  CHECK(krylov.factorisations < krylov.iterations);
+  // Bad GMRES parameters are named.
+  Plate plate(50);
+  solver::StaticParameters bad;
+  bad.mass = solver::StaticMass::tangent;
+  bad.krylov_iterations = -1;
+  CHECK_THROWS_WITH(plate.solver.solve_static(bad), Catch::Contains("StaticParameters::krylov_iterations"));
+  bad.krylov_iterations = 10;
+  bad.krylov_tolerance = 1.0;
+  CHECK_THROWS_WITH(plate.solver.solve_static(bad), Catch::Contains("StaticParameters::krylov_tolerance"));
+}

@@ -297,6 +297,10 @@ ThinPlateSolve thin_plate_newton(int n, double tolerance) {
   solver::StaticParameters parameters;
   parameters.mass = solver::StaticMass::tangent;
   parameters.tolerance = tolerance;
+  // Newton's steps by GMRES on the kept factorisation (one factorisation in
+  // all), each to 1e-6 of its residual, so the iterates follow full Newton's.
+  parameters.krylov_iterations = 40;
+  parameters.krylov_tolerance = 1e-6;
   ThinPlateSolve solve;
   solve.result = solver.solve_static(parameters, [&](const solver::StaticIteration& it) {
     solve.residuals.push_back(it.residual);
@@ -328,10 +332,11 @@ TEST_CASE("Statics: Newton on the thin clamped plate (L/d = 500) reaches 1e-8 at
   // plate"), so 51 x 51 is asked 1e-8 and 31 x 31, whose floor is lower, 1e-10.
   const ThinPlateSolve fine = thin_plate_newton(51, 1e-8);
   std::printf("Thin clamped plate 51 x 51, L/d = 500: w D/(qL^4) = %.8f (%+.3f %% from Kirchhoff); residual %.3e "
-              "after %ld Newton iterations, %ld force evaluations\n",
+              "after %ld Newton iterations, %ld factorisations, %ld force evaluations\n",
               fine.coefficient, 100.0 * (fine.coefficient / kirchhoff_clamped - 1.0), fine.result.residual,
-              fine.result.iterations, fine.result.force_evaluations);
+              fine.result.iterations, fine.result.factorisations, fine.result.force_evaluations);
   CHECK(fine.result.converged);
+  CHECK(fine.result.factorisations < fine.result.iterations);
   CHECK(fine.result.residual <= 1e-8);
   CHECK(fine.result.iterations <= 11);
   CHECK(fine.coefficient == Approx(kirchhoff_clamped).epsilon(0.01));
@@ -454,6 +459,81 @@ TEST_CASE("Statics: a load step starts where NewtonOptions::predictor says", "[s
   // The path is smooth in the deflection: the extrapolation starts nearer it.
   CHECK(std::abs(from_extrapolation.tip_extrapolated - from_extrapolation.tip_converged) <
         0.5 * std::abs(from_extrapolation.tip_last_state - from_extrapolation.tip_converged));
+}
+
+TEST_CASE("Statics: a displacement-control or arc-length step starts where the extrapolation in the control says",
+          "[statics]") {
+  // The strip under a tip force, its path followed by the tip's deflection
+  // (steps of 0.5) and by arc length (steps of 0.3). Before the third step
+  // the test extrapolates the last two converged states and load factors
+  // itself, by the ratio of the step to the last one (1 for the equal
+  // deflection steps; the arc length over the last step's root-mean-square
+  // motion): the translations linearly, each director turned on by that
+  // ratio of its last rotation. The relative residual there must be what the
+  // third step reports it started from.
+  Strip strip(11, 3);
+  strip.conditions.add_force(strip.model.set("x_max"), Vector3(0.0, 0.0, 1.0 / 3.0));
+  const int tip = strip.model.set("x_max")[1];
+  auto extrapolated_residual = [](statics::TangentAssembly<NonlinearSolver>& assembly,
+                                  const std::vector<Vector3>& x_before, const std::vector<Vector3>& d_before,
+                                  double lambda_before, double lambda, double ratio) {
+    const std::vector<Vector3> x = assembly.solver().positions(), d = assembly.solver().directors();
+    std::vector<Vector3> x_ahead(x.size()), d_ahead(d.size());
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      x_ahead[i] = x[i] + ratio * (x[i] - x_before[i]);
+      const Vector3 axis = d_before[i].cross(d[i]);
+      const double angle = std::atan2(axis.norm(), d_before[i].dot(d[i]));
+      d_ahead[i] = axis.norm() > 0.0 ? Eigen::AngleAxisd(ratio * angle, axis.normalized()) * d[i] : d[i];
+    }
+    const double lambda_ahead = lambda + ratio * (lambda - lambda_before);
+    assembly.set_configuration(x_ahead, d_ahead);
+    const statics::DegreesOfFreedom dofs = assembly.degrees_of_freedom();
+    const double relative = assembly.residual(dofs, lambda_ahead).norm() / assembly.load_norm(dofs, lambda_ahead);
+    assembly.set_configuration(x, d);
+    return relative;
+  };
+  statics::NewtonOptions options;
+  options.tolerance = 1e-8;
+  {
+    NonlinearSolver solver(strip.model, {Strip::E, 0.0});
+    statics::PathFollower<NonlinearSolver> path(solver, strip.conditions, options);
+    const statics::ControlDisplacement w_tip{{{tip, 1.0}}, Vector3::UnitZ()};
+    path.solve_to_displacement(w_tip, 0.5, 0.5);
+    CHECK(path.report().load_step_start_residual == 0.0);  // from the unloaded state
+    const std::vector<Vector3> x_before = solver.positions(), d_before = solver.directors();
+    const double lambda_before = path.load_factor();
+    path.solve_to_displacement(w_tip, 1.0, 0.5);
+    const double computed =
+        extrapolated_residual(path.assembly(), x_before, d_before, lambda_before, path.load_factor(), 1.0);
+    const int steps = path.report().load_steps;
+    path.solve_to_displacement(w_tip, 1.5, 0.5);
+    REQUIRE(path.report().load_steps == steps + 1);  // one step, not halved
+    const double reported = path.report().load_step_start_residual;
+    std::printf("Strip, third displacement-control step starts at relative residual %.6e (computed %.6e)\n", reported,
+                computed);
+    CHECK(computed > 1e-6);
+    CHECK(reported == Approx(computed).epsilon(1e-6));
+  }
+  {
+    NonlinearSolver solver(strip.model, {Strip::E, 0.0});
+    statics::PathFollower<NonlinearSolver> path(solver, strip.conditions, options);
+    const double length = 0.3;
+    REQUIRE(path.arc_length_step(length) == length);
+    CHECK(path.report().load_step_start_residual == 0.0);  // from the unloaded state
+    const std::vector<Vector3> x_before = solver.positions(), d_before = solver.directors();
+    const double lambda_before = path.load_factor();
+    REQUIRE(path.arc_length_step(length) == length);
+    double squared = 0.0;
+    for (std::size_t i = 0; i < x_before.size(); ++i) squared += (solver.positions()[i] - x_before[i]).squaredNorm();
+    const double last_length = std::sqrt(squared / static_cast<double>(x_before.size()));
+    const double computed = extrapolated_residual(path.assembly(), x_before, d_before, lambda_before,
+                                                  path.load_factor(), length / last_length);
+    REQUIRE(path.arc_length_step(length) == length);
+    const double reported = path.report().load_step_start_residual;
+    std::printf("Strip, third arc-length step starts at relative residual %.6e (computed %.6e)\n", reported, computed);
+    CHECK(computed > 1e-6);
+    CHECK(reported == Approx(computed).epsilon(1e-6));
+  }
 }
 
 TEST_CASE("Statics: GMRES solves a nonsymmetric system to the tolerance asked, with and without a preconditioner",

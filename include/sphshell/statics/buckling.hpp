@@ -65,6 +65,56 @@ inline int subspace_size(int modes, int dofs) { return std::min(dofs, std::max(2
 // K_σ below this fraction of K₀ (Frobenius norms) has no stress in it.
 inline constexpr double least_geometric_stiffness = 1e-12;
 
+// A block of vectors stored row by row, so that the p values of one degree of
+// freedom lie together: the sparse products and triangular solves below take
+// each stored entry once for the whole block (Eigen's take the matrix once per
+// column of a column-major block).
+using RowBlock = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+// y = m x for a block x.
+inline RowBlock block_product(const SparseMatrix& m, const RowBlock& x) {
+  const Eigen::Index p = x.cols();
+  RowBlock y = RowBlock::Zero(m.rows(), p);
+  for (Eigen::Index j = 0; j < m.outerSize(); ++j) {
+    const double* xj = x.data() + j * p;
+    for (SparseMatrix::InnerIterator it(m, j); it; ++it) {
+      double* yi = y.data() + it.index() * p;
+      const double v = it.value();
+      for (Eigen::Index c = 0; c < p; ++c) yi[c] += v * xj[c];
+    }
+  }
+  return y;
+}
+
+// K⁻¹ b for a block b with the LDLᵀ of K (P K Pᵀ = L D Lᵀ, L unit lower
+// triangular with its diagonal not stored): one pass over L forward, one
+// backward.
+template <class Ldlt>
+RowBlock block_solve(const Ldlt& ldlt, const RowBlock& b) {
+  const SparseMatrix& l = ldlt.matrixL().nestedExpression();
+  const Eigen::VectorXd& d = ldlt.vectorD();
+  RowBlock x = ldlt.permutationP() * b;
+  const Eigen::Index p = x.cols();
+  for (Eigen::Index j = 0; j < l.outerSize(); ++j) {
+    const double* xj = x.data() + j * p;
+    for (SparseMatrix::InnerIterator it(l, j); it; ++it) {
+      double* xi = x.data() + it.index() * p;
+      const double v = it.value();
+      for (Eigen::Index c = 0; c < p; ++c) xi[c] -= v * xj[c];
+    }
+  }
+  for (Eigen::Index j = 0; j < x.rows(); ++j) x.row(j) /= d[j];
+  for (Eigen::Index j = l.outerSize() - 1; j >= 0; --j) {
+    double* xj = x.data() + j * p;
+    for (SparseMatrix::InnerIterator it(l, j); it; ++it) {
+      const double* xi = x.data() + it.index() * p;
+      const double v = it.value();
+      for (Eigen::Index c = 0; c < p; ++c) xj[c] -= v * xi[c];
+    }
+  }
+  return ldlt.permutationPinv() * x;
+}
+
 inline void check(const BucklingOptions& options) {
   if (options.modes < 1) sphshell::detail::invalid_parameter("BucklingOptions::modes", options.modes, "must be >= 1");
   sphshell::detail::require_half_open_interval("BucklingOptions::probe_load_factor", options.probe_load_factor, 0.0,
@@ -108,19 +158,21 @@ BucklingResult linear_buckling(Solver& solver, const Conditions& conditions, con
                                           "the solver must be geometrically nonlinear (SolverOptions::nonlinear)");
     const int n = dofs.count();
     const int p = detail::subspace_size(options.modes, n);
-    Eigen::MatrixXd x(n, p);
+    detail::RowBlock x(n, p);
     for (int j = 0; j < p; ++j)
       for (int i = 0; i < n; ++i) x(i, j) = std::sin(1.0 + detail::start_vector_increment * (i + 1.0) * (j + 1.0));
     Eigen::VectorXd previous = Eigen::VectorXd::Constant(p, std::numeric_limits<double>::quiet_NaN());
     Eigen::VectorXd mu;
-    Eigen::MatrixXd vectors;
+    detail::RowBlock vectors;
+    // A x, carried from one iteration to the next: the Ritz vectors are
+    // combinations of the block y, so A times them is the same combination of A y.
+    detail::RowBlock ax = detail::block_product(a, x);
     bool converged = false;
     for (int iteration = 1; iteration <= options.max_iterations && !converged; ++iteration) {
-      const Eigen::MatrixXd y = ldlt.solve(Eigen::MatrixXd(a * x));
-      const Eigen::MatrixXd ay = a * y;
-      Eigen::MatrixXd by(n, p);
-      for (int j = 0; j < p; ++j) by.col(j) = k0 * y.col(j);
-      const Eigen::MatrixXd reduced_a = y.transpose() * ay, reduced_b = y.transpose() * by;
+      // y = K₀⁻¹ A x, so K₀ y = A x: the reduced K₀ is yᵀ A x.
+      const detail::RowBlock y = detail::block_solve(ldlt, ax);
+      const detail::RowBlock ay = detail::block_product(a, y);
+      const Eigen::MatrixXd reduced_a = y.transpose() * ay, reduced_b = y.transpose() * ax;
       Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> ritz(0.5 * (reduced_a + reduced_a.transpose()),
                                                                     0.5 * (reduced_b + reduced_b.transpose()));
       if (ritz.info() != Eigen::Success)
@@ -128,9 +180,13 @@ BucklingResult linear_buckling(Solver& solver, const Conditions& conditions, con
                                             "the Rayleigh-Ritz step failed: the block lost rank; ask for fewer modes");
       // Largest μ first: the lowest positive buckling factors.
       mu = ritz.eigenvalues().reverse();
-      vectors = y * ritz.eigenvectors().rowwise().reverse();
-      x = vectors;
-      for (int j = 0; j < p; ++j) x.col(j).normalize();
+      const Eigen::MatrixXd ritz_vectors = ritz.eigenvectors().rowwise().reverse();
+      vectors = y * ritz_vectors;
+      ax = ay * ritz_vectors;
+      for (int j = 0; j < p; ++j) {
+        const double scale = 1.0 / vectors.col(j).norm();
+        ax.col(j) *= scale;
+      }
       result.iterations = iteration;
       converged = true;
       for (int j = 0; j < options.modes; ++j)

@@ -349,6 +349,7 @@ class PathFollower {
       if (options_.trace)
         std::fprintf(stderr, "  iteration %d: load factor %.8g, residual %.3e (relative %.3e), gap %.3e\n", iteration,
                      lambda_, r.norm(), reference > 0.0 ? r.norm() / reference : 0.0, gap);
+      if (iteration == 0) assembly_.report().load_step_start_residual = reference > 0.0 ? r.norm() / reference : 0.0;
       if (!std::isfinite(r.norm())) return false;
       // At λ = 0 (the first iteration from the unloaded state) there is no
       // load to measure the residual against: iterate.

@@ -14,6 +14,9 @@
 //    (three translations, two rotations normal to the director).
 //    Known limit: on the cantilever strip (free edges) its Newton steps stall
 //    even under small load steps; the clamped plates converge in 1–2 steps.
+//    With StaticParameters::krylov_iterations the steps are solved by GMRES on
+//    the current tangent (products by differences of the forces),
+//    preconditioned by a kept factorisation of an earlier one.
 //  - StaticMass::particle_bound (the default): adaptive dynamic relaxation (Underwood 1983)
 //    with a diagonal fictitious mass per degree of freedom from the
 //    Gershgorin bound of the tangent's rows, m_a = (h²/4) Σ_b |K_ab| with the
@@ -52,6 +55,7 @@
 #include <sphshell/solver/particles.hpp>
 #include <sphshell/solver/run_checks.hpp>
 #include <sphshell/statics/coupling.hpp>
+#include <sphshell/statics/krylov.hpp>
 #include <sphshell/statics/static_share.hpp>
 
 #include <Eigen/Eigenvalues>
@@ -65,6 +69,7 @@
 #include <cstddef>
 #include <iostream>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <ostream>
 #include <sstream>
@@ -99,6 +104,16 @@ struct StaticParameters {
   // relaxation steps (StaticMass::particle_bound). An exhausted budget is a
   // StaticNotConverged Error that leaves the solver at the step's best state.
   long max_newton_iterations = 40;
+  // Newton's steps by GMRES (statics/krylov.hpp, as NewtonOptions::krylov_iterations
+  // of the path following): K δ = r solved to ‖r − K δ‖ ≤ krylov_tolerance ‖r‖
+  // with the current tangent K applied by central differences of the forces
+  // (two evaluations a product) and the kept factorisation of an earlier
+  // tangent, of this or an earlier load step, as the preconditioner; a solve
+  // that needs more than krylov_iterations products assembles and factorises
+  // a fresh tangent and solves with it. 0: off (a tangent assembled and
+  // factorised at every Newton iteration).
+  int krylov_iterations = 0;
+  double krylov_tolerance = 1e-2;  // in (0, 1)
   // Unset: automatic_relaxation_steps(model, tolerance), which grows with the
   // model's stiffness spread (see there); a value given is used as it is.
   std::optional<long> max_relaxation_steps;
@@ -129,6 +144,8 @@ struct StaticIteration {
 struct StaticResult {
   long iterations = 0;         // over all load steps (Newton iterations or relaxation steps)
   long force_evaluations = 0;  // internal-force evaluations, the cost
+  long factorisations = 0;     // tangents assembled and factorised (StaticMass::tangent)
+  long krylov_iterations = 0;  // tangent products of the GMRES steps (StaticParameters::krylov_iterations)
   double residual = 0.0;       // ‖r‖ / ‖λ f_ext‖ of the state held
   double load_factor = 0.0;    // λ of the load step of the state held
   int load_step = 0;           // 1-based number of that load step
@@ -169,6 +186,10 @@ inline void validate(const StaticParameters& p) {
   if (p.max_relaxation_steps && *p.max_relaxation_steps < 1)
     sphshell::detail::invalid_parameter("StaticParameters::max_relaxation_steps", *p.max_relaxation_steps,
                               "must be >= 1 (or unset for the automatic budget)");
+  if (p.krylov_iterations < 0)
+    sphshell::detail::invalid_parameter("StaticParameters::krylov_iterations", p.krylov_iterations,
+                                        "must be >= 0 (0: no GMRES)");
+  sphshell::detail::require_open_interval("StaticParameters::krylov_tolerance", p.krylov_tolerance, 0.0, 1.0);
   sphshell::detail::require_open_interval("StaticParameters::perturbation", p.perturbation, 0.0, 1e-2);
   if (p.progress_interval < 0)
     sphshell::detail::invalid_parameter("StaticParameters::progress_interval", p.progress_interval, "must be >= 0");
@@ -393,32 +414,45 @@ inline long automatic_relaxation_steps(const ShellModel& model, double tolerance
   return std::max(detail::least_relaxation_steps, static_cast<long>(std::ceil(steps)));
 }
 
-// The Newton step K dq = r: a sparse LDLᵀ of the symmetric part when the
-// tangent is symmetric to finite-difference accuracy (conservative loads on
-// an elastic or path-dependent law), else a sparse LU; an Error when the
-// tangent is singular. (A template for the reason given above free_directions.)
+// The factorised tangent of a Newton step, K dq = r: a sparse LDLᵀ of the
+// symmetric part when the tangent is symmetric to finite-difference accuracy
+// (conservative loads on an elastic or path-dependent law), else a sparse LU;
+// an Error when the tangent is singular. Kept as the preconditioner of the
+// GMRES steps (StaticParameters::krylov_iterations). (A template for the
+// reason given above free_directions.)
 template <class SparseMatrix>
-Eigen::VectorXd newton_step(const SparseMatrix& K, const Eigen::VectorXd& r, int load_step, double lambda) {
-  auto singular = [&] {
-    return Error("sphshell: static solve: the tangent stiffness is singular at load step " + std::to_string(load_step) +
-                 " (load factor " + solver::number_text(lambda) +
-                 "): the model has a mechanism, or it buckled; add supports or take smaller load steps");
-  };
-  const SparseMatrix transpose = K.transpose();
-  Eigen::VectorXd dq;
-  if ((K - transpose).norm() <= detail::symmetric_tangent_tolerance * K.norm()) {
-    const SparseMatrix symmetric = 0.5 * (K + transpose);
-    Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt(symmetric);
-    if (ldlt.info() != Eigen::Success) throw singular();
-    dq = ldlt.solve(r);
-  } else {
-    Eigen::SparseLU<SparseMatrix, Eigen::COLAMDOrdering<int>> lu(K);
-    if (lu.info() != Eigen::Success) throw singular();
-    dq = lu.solve(r);
+class NewtonFactorisation {
+ public:
+  NewtonFactorisation(const SparseMatrix& K, int load_step, double lambda) : load_step_(load_step), lambda_(lambda) {
+    const SparseMatrix transpose = K.transpose();
+    if ((K - transpose).norm() <= detail::symmetric_tangent_tolerance * K.norm()) {
+      ldlt_ = std::make_unique<Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>>>(
+          SparseMatrix(0.5 * (K + transpose)));
+      if (ldlt_->info() != Eigen::Success) throw singular();
+    } else {
+      lu_ = std::make_unique<Eigen::SparseLU<SparseMatrix, Eigen::COLAMDOrdering<int>>>(K);
+      if (lu_->info() != Eigen::Success) throw singular();
+    }
   }
-  if (!dq.allFinite()) throw singular();
-  return dq;
-}
+  Eigen::Index size() const { return ldlt_ ? ldlt_->rows() : lu_->rows(); }
+  // K⁻¹ r, an Error when it is not finite.
+  Eigen::VectorXd solve(const Eigen::VectorXd& r) const {
+    Eigen::VectorXd dq = ldlt_ ? Eigen::VectorXd(ldlt_->solve(r)) : Eigen::VectorXd(lu_->solve(r));
+    if (!dq.allFinite()) throw singular();
+    return dq;
+  }
+
+ private:
+  Error singular() const {
+    return Error("sphshell: static solve: the tangent stiffness is singular at load step " +
+                 std::to_string(load_step_) + " (load factor " + solver::number_text(lambda_) +
+                 "): the model has a mechanism, or it buckled; add supports or take smaller load steps");
+  }
+  int load_step_;
+  double lambda_;
+  std::unique_ptr<Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>>> ldlt_;
+  std::unique_ptr<Eigen::SparseLU<SparseMatrix, Eigen::COLAMDOrdering<int>>> lu_;
+};
 
 // The solve itself (Solver::solve_static calls it).
 template <class System, class Observer>
@@ -545,6 +579,48 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
     return K;
   };
 
+  // The Newton update K dq = r of StaticMass::tangent at the current state:
+  // by GMRES on the current tangent, applied by central differences of the
+  // residual along the vector (the configuration moved by ±h v as `move`
+  // moves it, h taking v's largest component to the difference step of the
+  // tangent), preconditioned by the kept factorisation; without one that
+  // fits, or when GMRES needs more than krylov_iterations products, by a
+  // fresh tangent's factorisation, which is kept. The configuration is left
+  // as it was (its residual in r only when no product was taken).
+  std::unique_ptr<NewtonFactorisation<SparseMatrix>> kept;
+  auto newton_update = [&](const Eigen::VectorXd& r0, double lambda, int load_step) {
+    if (parameters.krylov_iterations > 0 && kept && kept->size() == basis.size) {
+      const std::vector<Vector3> x0 = particles.position, d0 = particles.director;
+      auto product = [&](const Eigen::VectorXd& v) {
+        const double largest = v.cwiseAbs().maxCoeff();
+        if (!(largest > 0.0)) return Eigen::VectorXd(Eigen::VectorXd::Zero(v.size()));
+        const double h = step_translation / largest;
+        Eigen::VectorXd response[2];
+        for (int side = 0; side < 2; ++side) {
+          particles.position = x0;
+          particles.director = d0;
+          move((side == 0 ? h : -h) * v);
+          residual(lambda);
+          response[side] = r;
+        }
+        return Eigen::VectorXd((response[1] - response[0]) / (2.0 * h));
+      };
+      Eigen::VectorXd dq;
+      const KrylovSolve krylov =
+          gmres(product, [&](const Eigen::VectorXd& v) { return kept->solve(v); }, r0, parameters.krylov_tolerance,
+                parameters.krylov_iterations, dq);
+      result.krylov_iterations += krylov.iterations;
+      particles.position = x0;
+      particles.director = d0;
+      domain.exchange({&particles.position, &particles.director});
+      if (krylov.converged) return dq;
+    }
+    const SparseMatrix K = tangent(lambda, negligible_tangent_entry);
+    kept = std::make_unique<NewtonFactorisation<SparseMatrix>>(K, load_step, lambda);
+    ++result.factorisations;
+    return kept->solve(r0);
+  };
+
   std::ostream& progress = system.progress_stream ? *system.progress_stream : std::clog;
   const auto wall_start = std::chrono::steady_clock::now();
   const int steps = static_cast<int>(parameters.load_factors.size());
@@ -627,8 +703,7 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
           fail_budget("Newton, StaticMass::tangent", "max_newton_iterations", parameters.max_newton_iterations,
                       false, relative);
         const Eigen::VectorXd r0 = r;
-        const SparseMatrix K = tangent(lambda, negligible_tangent_entry);
-        const Eigen::VectorXd dq = newton_step(K, r0, load_step, lambda);
+        const Eigen::VectorXd dq = newton_update(r0, lambda, load_step);
         // Backtracking: the longest of 1, 1/2, 1/4, ... that lowers ‖r‖, else the best tried.
         const std::vector<Vector3> x0 = particles.position, d0 = particles.director;
         double best_norm = std::numeric_limits<double>::infinity(), best_scale = 1.0, scale = 1.0;

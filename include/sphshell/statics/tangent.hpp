@@ -41,9 +41,11 @@ struct NewtonReport {
   long force_evaluations = 0;  // internal-force computations in all
   int factorisations = 0;      // tangents assembled and factorised for Newton steps
   long krylov_iterations = 0;  // tangent products of the GMRES Newton steps (NewtonOptions::krylov_iterations)
-  // Load control: the relative residual ‖r‖ / ‖λ f_ext‖ where the last load
-  // step's Newton iteration started (at its predictor, NewtonOptions::predictor;
-  // the last attempt when the step was halved).
+  // The relative residual ‖r‖ / ‖λ f_ext‖ where the last step's Newton
+  // iteration started, at its predictor (load control: NewtonOptions::predictor;
+  // displacement control and arc length: the last two converged states and load
+  // factors extrapolated in the control), the last attempt when the step was
+  // halved; 0 for a step that starts unloaded (λ = 0: nothing to measure against).
   double load_step_start_residual = 0.0;
 };
 
