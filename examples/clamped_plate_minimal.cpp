@@ -40,6 +40,7 @@ int main(int argc, char** argv) try {
   });
   std::cout << "centre deflection at 2 ms: " << solver.displacement(centre).z() * 1e3 << " mm, "
             << solver.steps() << " steps\n";
+  return 0;
 } catch (const std::exception& error) {
   std::cerr << "clamped_plate_minimal: " << error.what() << '\n';
   return 1;
