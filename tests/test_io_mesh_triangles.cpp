@@ -3,6 +3,7 @@
 // and the clamped plate's static deflection against the quad plate's at the
 // same node spacing (and the Mindlin value of docs/method.md's plate tests).
 #include "support/mesh_files.hpp"
+#include "support/relaxation.hpp"
 #include "support/stiffness.hpp"
 
 #include <sphshell/approx/mls.hpp>
@@ -112,13 +113,8 @@ std::pair<double, double> clamped_coefficient(const ShellModel& model, double d)
   // Period by period, up to 6; stopped early once the coefficient moves by
   // less than 1e-8 of itself over one (after 5 periods at 31 x 31, L/d = 50,
   // where it then agrees with the value after 6 to ~1e-11).
-  double before = 0.0, change = 1.0;
-  for (int k = 1; k <= 6 && change >= 1e-8; ++k) {
-    solver.run_until(k * period);
-    change = std::abs(coefficient() - before) / coefficient();
-    before = coefficient();
-  }
-  return {coefficient(), change};
+  const test_support::Settled settled = test_support::relax_until_settled(solver, period, 6, 1e-8, coefficient);
+  return {settled.value, settled.last_change};
 }
 
 // The clamped plate at n × n particles and L/d = slenderness, as quads and as

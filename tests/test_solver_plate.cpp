@@ -6,6 +6,8 @@
 #include <sphshell/solver.hpp>
 #include <sphshell/thickness/gauss.hpp>
 
+#include "support/relaxation.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -57,13 +59,9 @@ StaticResult static_centre_deflection(int n, double slenderness, Support support
   // Period by period, up to `periods`; stopped early once the coefficient
   // moves by less than 1e-8 of itself over one (after 5 periods at L/d = 50
   // and 100, where it then agrees with the value after 6 or 8 to ~1e-10).
-  double before = 0.0, change = 1.0;
-  for (int k = 1; k <= periods && change >= 1e-8; ++k) {
-    solver.run_until(k * period);
-    change = std::abs(coefficient() - before) / coefficient();
-    before = coefficient();
-  }
-  return {coefficient(), change};
+  const test_support::Settled settled =
+      test_support::relax_until_settled(solver, period, periods, 1e-8, coefficient);
+  return {settled.value, settled.last_change};
 }
 
 // The relaxation has settled (relative change over the last period below

@@ -9,6 +9,8 @@
 #include <sphshell/solver.hpp>
 #include <sphshell/thickness/all.hpp>
 
+#include "support/relaxation.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -52,13 +54,7 @@ double cantilever_tip_deflection(double load_factor, bool nonlinear) {
     return deflection / L;
   };
   const double period = 2 * M_PI / omega;
-  double previous = 0.0;
-  for (int k = 1; k <= 12; ++k) {
-    solver.run_until(k * period);
-    if (std::abs(tip_deflection() - previous) < 1e-9 * std::abs(tip_deflection())) break;
-    previous = tip_deflection();
-  }
-  return tip_deflection();
+  return test_support::relax_until_settled(solver, period, 12, 1e-9, tip_deflection).value;
 }
 
 }  // namespace
