@@ -1,5 +1,5 @@
 // Cost of the grouped material update through the thickness
-// (solver/section_group.hpp) per stress point, as the assembler runs it: a
+// (thickness/section_group.hpp) per stress point, as the assembler runs it: a
 // SectionGroup of eight points at a time over many points, J2 through
 // Gauss<5>, with the law states in lanes across points (StateLayout::
 // lanes_across_points: one batched call per block of eight points, 40 lanes,
@@ -19,7 +19,7 @@
 // ns_per_stress_point is the CPU time of an iteration over the points.
 #include <sphshell/core/simd.hpp>
 #include <sphshell/material/all.hpp>
-#include <sphshell/solver/section_group.hpp>
+#include <sphshell/thickness/section_group.hpp>
 #include <sphshell/thickness/all.hpp>
 
 #include <benchmark/benchmark.h>
@@ -55,8 +55,8 @@ constexpr double time_step = 1e-7;
 using Rule = thickness::Gauss<5>;
 using Law = material::J2Plasticity;
 using Section = thickness::Section<Rule, Law>;
-using Lanes = solver::SectionGroup<Rule, Law, solver::points_per_group, solver::StateLayout::lanes_across_points>;
-using PointByPoint = solver::SectionGroup<Rule, Law, solver::points_per_group, solver::StateLayout::point_by_point>;
+using Lanes = thickness::SectionGroup<Rule, Law, thickness::points_per_group, thickness::StateLayout::lanes_across_points>;
+using PointByPoint = thickness::SectionGroup<Rule, Law, thickness::points_per_group, thickness::StateLayout::point_by_point>;
 static_assert(Lanes::across_points && !PointByPoint::across_points,
               "bench_section_group compares the two layouts of the same group");
 

@@ -50,7 +50,7 @@ TEST_CASE("A support too small for the spacing names support_radius_factor", "[b
   // A plate 10⁴ times longer than wide (cells 0.1 m × 10 µm): √(cell area) is
   // far below the cells' length, but the local spacing takes each stress
   // point's distance to its farthest corner and each particle's long side
-  // (solver/local_spacing.hpp), so every row reaches particles off its line
+  // (shell/local_spacing.hpp), so every row reaches particles off its line
   // and fits linear fields: the strip is legal (with one support radius from
   // √A it was refused naming support_radius_factor).
   const ShellModel strip = ShellModel::rectangular_plate(1.0, 1e-4, 11, 11, 1e-5);

@@ -214,7 +214,7 @@ TEST_CASE("a folded strip touches itself where it is folded back, its material n
   contact::ParticleContactLoads loads;
   contact.compute(folded.particles.view(), dt, loads);
   const std::size_t count = folded.model.particle_count();
-  const std::vector<double> spacing = solver::local_spacing(folded.model).particle;
+  const std::vector<double> spacing = local_spacing(folded.model).particle;
   std::size_t far_leg_particles = 0;
   for (std::size_t a = 0; a < count; ++a) {
     const Vector3& X = folded.model.particle_position[a];

@@ -1,4 +1,4 @@
-// The local support radius (solver/local_spacing.hpp; docs/method.md,
+// The local support radius (shell/local_spacing.hpp; docs/method.md,
 // "Support radius"): on graded plates every row follows its own spacing, the
 // shape functions stay first-order consistent at every point, and a graded
 // clamped plate's static centre deflection is close to Mindlin's.

@@ -87,7 +87,7 @@ int main(int argc, char** argv) {
     sink = sink + s;
   });
   const double exact = time_of([&] {
-    mpi::ExactSum s;
+    sphshell::ExactSum s;
     for (double t : terms) s.add(t);
     sink = sink + s.value();
   });

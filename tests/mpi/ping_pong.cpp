@@ -82,7 +82,7 @@ int main(int argc, char** argv) {
                   *std::min_element(samples.begin(), samples.end()) * 1e6, median(samples) * 1e6);
   };
   time_collective("agree_on_failure (no failure)", [&] { sphshell::mpi::agree_on_failure(comm, std::nullopt); });
-  sphshell::mpi::ExactSum accumulator;
+  sphshell::ExactSum accumulator;
   accumulator.add(1.0);
   time_collective("mpi::sum(ExactSum) (568-byte all-reduce)", [&] { (void)sphshell::mpi::sum(comm, accumulator); });
   time_collective("Communicator::max(double)", [&] { (void)comm.max(1.0); });

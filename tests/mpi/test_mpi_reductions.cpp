@@ -1,4 +1,4 @@
-// Deterministic reductions and the Error rule (include/sphshell/mpi/exact_sum.hpp,
+// Deterministic reductions and the Error rule (include/sphshell/core/exact_sum.hpp,
 // reductions.hpp, error_agreement.hpp) on 1, 2 and 3 ranks: ExactSum is the
 // correctly rounded sum (checked against an exact 113-bit reference), the
 // same for any order and any split between ranks; the global-order sum is the
@@ -42,7 +42,7 @@ double exact_reference(const std::vector<double>& terms) {
   return static_cast<double>(sum);
 }
 double exact_sum_of(const std::vector<double>& terms) {
-  mpi::ExactSum sum;
+  sphshell::ExactSum sum;
   for (double term : terms) sum.add(term);
   return sum.value();
 }
@@ -90,7 +90,7 @@ TEST_CASE("ExactSum: independent of the order and of the split into accumulators
   for (int shuffle = 0; shuffle < 5; ++shuffle) {
     std::shuffle(terms.begin(), terms.end(), random);
     CHECK(same_bits(exact_sum_of(terms), first));
-    mpi::ExactSum a, b, c;
+    sphshell::ExactSum a, b, c;
     for (std::size_t k = 0; k < terms.size(); ++k) (k % 3 == 0 ? a : k % 3 == 1 ? b : c).add(terms[k]);
     c += a;
     c += b;
@@ -123,7 +123,7 @@ TEST_CASE("reductions: identical on 1, 2 and 3 ranks", "[mpi][reductions]") {
   CHECK(comm.min(-static_cast<double>(comm.rank())) == -(comm.size() - 1));
   CHECK(comm.sum(std::int64_t{1}) == comm.size());
   // A non-finite term on one rank makes the sum non-finite everywhere.
-  mpi::ExactSum local;
+  sphshell::ExactSum local;
   local.add(comm.rank() == comm.size() - 1 ? std::numeric_limits<double>::quiet_NaN() : 1.0);
   CHECK(std::isnan(mpi::sum(comm, local)));
   // Indices that do not cover [0, total) once are an Error on every rank.

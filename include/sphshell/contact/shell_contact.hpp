@@ -8,7 +8,7 @@
 // Geometry (docs/method.md §12). A particle a is a point of the mid-surface;
 // the shell it stands for is the tangent plane through it (normal d_a, the
 // unit director) out to a patch radius R_a = patch_spacings · Δ_a (Δ_a its
-// local spacing, solver/local_spacing.hpp), with faces h_a/2 to either side.
+// local spacing, shell/local_spacing.hpp), with faces h_a/2 to either side.
 // With r = x_a − x_b, g = r · d_b (a's distance from b's mid-plane),
 // ρ² = |r|² − g² (a's lateral offset from b) and c = (h_a + h_b)/2, a meets
 // b's patch when ρ < R_b and, on its side s = ±1 of b, s g < 2c; penetration
@@ -90,7 +90,7 @@
 #include <sphshell/core/types.hpp>
 #include <sphshell/shell/cell.hpp>
 #include <sphshell/shell/model.hpp>
-#include <sphshell/solver/local_spacing.hpp>
+#include <sphshell/shell/local_spacing.hpp>
 
 #include <algorithm>
 #include <atomic>
@@ -182,7 +182,7 @@ class ShellContact {
       sphshell::detail::invalid_parameter("shell contact rotary_inertia_scale", rotary_inertia_scale,
                                           "must be finite and >= 1");
     reference_ = model.particle_position;
-    spacing_ = solver::local_spacing(model).particle;
+    spacing_ = local_spacing(model).particle;
     const std::vector<double>& thickness = model.particle_thicknesses();
     double largest_thickness = 0.0, largest_spacing = 0.0;
     for (std::size_t i = 0; i < reference_.size(); ++i) {

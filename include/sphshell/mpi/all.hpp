@@ -5,7 +5,7 @@
 #include <sphshell/mpi/communicator.hpp>
 #include <sphshell/mpi/distributed_solver.hpp>
 #include <sphshell/mpi/error_agreement.hpp>
-#include <sphshell/mpi/exact_sum.hpp>
+#include <sphshell/core/exact_sum.hpp>
 #include <sphshell/mpi/halo.hpp>
 #include <sphshell/mpi/layout.hpp>
 #include <sphshell/mpi/partition.hpp>

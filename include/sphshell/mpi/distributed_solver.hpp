@@ -9,7 +9,7 @@
 
 #include <sphshell/mpi/communicator.hpp>
 #include <sphshell/mpi/domain.hpp>
-#include <sphshell/mpi/exact_sum.hpp>
+#include <sphshell/core/exact_sum.hpp>
 #include <sphshell/solver.hpp>
 
 namespace sphshell::mpi {

@@ -10,7 +10,7 @@
 #include <sphshell/domain/domain.hpp>
 #include <sphshell/mpi/communicator.hpp>
 #include <sphshell/mpi/error_agreement.hpp>
-#include <sphshell/mpi/exact_sum.hpp>
+#include <sphshell/core/exact_sum.hpp>
 #include <sphshell/mpi/halo.hpp>
 #include <sphshell/mpi/layout.hpp>
 #include <sphshell/mpi/partition.hpp>

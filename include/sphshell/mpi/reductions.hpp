@@ -4,7 +4,7 @@
 // distributed run give the same value for any rank count.
 //
 //  - max and min are exact: Communicator::max / min.
-//  - sum(comm, ExactSum): each rank's exact accumulator (mpi/exact_sum.hpp),
+//  - sum(comm, ExactSum): each rank's exact accumulator (core/exact_sum.hpp),
 //    added limb by limb with MPI_SUM on 64-bit integers — integer addition is
 //    associative, so the reduction tree does not matter — and rounded once.
 //    The result is the correctly rounded sum of all terms, the same for 1, 2
@@ -15,7 +15,7 @@
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/mpi/communicator.hpp>
-#include <sphshell/mpi/exact_sum.hpp>
+#include <sphshell/core/exact_sum.hpp>
 
 #include <algorithm>
 #include <array>

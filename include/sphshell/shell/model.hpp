@@ -288,7 +288,7 @@ class ShellModel {
     return std::sqrt(largest);
   }
   // The spacing of stress point p's own cell, √(area per particle) as above;
-  // the solver's local support radius starts from it (solver/local_spacing.hpp).
+  // the solver's local support radius starts from it (shell/local_spacing.hpp).
   double stress_point_spacing(std::size_t p) const {
     detail::model_checks::check_index("stress point", p, stress_point_count());
     return std::sqrt(area_per_particle(p));

@@ -231,7 +231,7 @@ struct EnergyLedger {
 // The books of a run over a domain (domain/domain.hpp). One process keeps
 // running totals, each step's added once (the chunks' sums in chunk order),
 // so they are the same for any thread count. Several keep exact
-// accumulators of every owned particle's and point's term (mpi/exact_sum.hpp)
+// accumulators of every owned particle's and point's term (core/exact_sum.hpp)
 // and round once when a report is due (one all-reduce, collective): the
 // books are the same for any rank count and differ from the serial ones only
 // by the serial rounding; energies do not feed back into the motion. No

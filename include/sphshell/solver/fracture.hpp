@@ -137,7 +137,7 @@ void reject_particles_on(const Crack& crack, const std::vector<Vector3>& polylin
 }
 
 // Released energy: a plain sum on one process (in the serial order), an
-// exact one over several (mpi/exact_sum.hpp: the same for any process count).
+// exact one over several (core/exact_sum.hpp: the same for any process count).
 inline void book(double& sum, double energy) { sum += energy; }
 template <class Sum>
 void book(Sum& sum, double energy) {

@@ -18,7 +18,7 @@
 #include <sphshell/shell/cuts.hpp>
 #include <sphshell/shell/kinematics.hpp>
 #include <sphshell/shell/model.hpp>
-#include <sphshell/solver/local_spacing.hpp>
+#include <sphshell/shell/local_spacing.hpp>
 #include <sphshell/solver/options.hpp>
 #include <sphshell/solver/particles.hpp>
 #include <sphshell/solver/point_group.hpp>
@@ -46,7 +46,7 @@ class IntegrationPoints {
   IntegrationPoints(const ShellModel& model, const PhysicsOptions& physics,
                     const ParticleIntegrationOptions& particle_integration, double shear_modulus,
                     double poisson_ratio = std::numeric_limits<double>::quiet_NaN()) {
-    // Each point's support follows its own local spacing (solver/local_spacing.hpp).
+    // Each point's support follows its own local spacing (shell/local_spacing.hpp).
     const LocalSpacing spacing = local_spacing(model);
     const bool particles_integrate = particle_integration.particle_integration_share > 0.0 ||
                                      particle_integration.particle_shear_weight > 0.0;

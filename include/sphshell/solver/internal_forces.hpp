@@ -4,7 +4,7 @@
 // (Green or linear, shell/kinematics.hpp) → material update through the
 // thickness (Section) → resultants → the point's five conjugate forces (and
 // the corner forces of its edge-tied shear) kept per point. The points go
-// through this in groups of points_per_group (SectionGroup,
+// through this in groups of thickness::points_per_group (SectionGroup,
 // section_group.hpp): the material update of a group's points runs side by
 // side, a vector lane a pair of point and integral point; a point alone is
 // the group of one. Then each particle
@@ -35,7 +35,7 @@
 #include <sphshell/solver/assembly_schedule.hpp>
 #include <sphshell/solver/integration_points.hpp>
 #include <sphshell/solver/particles.hpp>
-#include <sphshell/solver/section_group.hpp>
+#include <sphshell/thickness/section_group.hpp>
 #include <sphshell/solver/section_states.hpp>
 
 #include <algorithm>
@@ -389,14 +389,14 @@ class InternalForceAssembler {
   void integrate_rows(PointGroup group, std::size_t first_row, std::size_t end_row,
                       const IntegrationPoints<Approx>& points, SectionStates<Rule, Law>& states,
                       assembler_parts::PointFailure& failure) {
-    using Group = SectionGroup<Rule, Law>;
+    using Group = thickness::SectionGroup<Rule, Law>;
     // The runs start at a chunk's first row, so that a block of the states
     // (section_states.hpp) is never shared by two runs, which two threads
     // may integrate at once.
     static_assert(PointChunks::rows % std::size_t(Group::group_size) == 0,
                   "sphshell::solver: PointChunks::rows must be a multiple of points_per_group");
     Group section_group;
-    std::array<GroupMember, std::size_t(points_per_group)> members;
+    std::array<GroupMember, std::size_t(Group::group_size)> members;
     for (std::size_t row = first_row; row < end_row;) {
       section_group.clear();
       // Across points the group is one block's points: the rows up to the block's end.

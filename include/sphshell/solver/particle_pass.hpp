@@ -1,5 +1,5 @@
 #pragma once
-// The particles' part of a step (Solver and mpi::DistributedSolver alike),
+// The particles' part of a Solver's step (on one process or many),
 // in one parallel pass over the energy books' chunks of the owned particles
 // (ParticleEnergyTerms::sum_chunk), each chunk on one thread while its data
 // is in that core's cache: its loads, the copy of v^{n−½}, the stepper's

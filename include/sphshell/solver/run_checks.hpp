@@ -9,7 +9,7 @@
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/types.hpp>
 #include <sphshell/shell/model.hpp>
-#include <sphshell/solver/local_spacing.hpp>
+#include <sphshell/shell/local_spacing.hpp>
 #include <sphshell/solver/options.hpp>
 #include <algorithm>
 #include <sstream>

@@ -24,7 +24,7 @@
 #include <sphshell/core/types.hpp>
 #include <sphshell/shell/kinematics.hpp>
 #include <sphshell/shell/model.hpp>
-#include <sphshell/solver/section_group.hpp>
+#include <sphshell/thickness/section_group.hpp>
 #include <sphshell/thickness/section.hpp>
 
 #include <algorithm>
@@ -55,7 +55,7 @@ class SectionStates {
  public:
   using Section = thickness::Section<Rule, Law>;
   using State = typename Section::State;
-  using Group = SectionGroup<Rule, Law>;
+  using Group = thickness::SectionGroup<Rule, Law>;
   // Whether the law states are stored in lanes, by blocks of G points.
   static constexpr bool in_lanes = Group::across_points;
   using Block = typename Group::Block;

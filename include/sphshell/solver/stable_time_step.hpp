@@ -20,7 +20,7 @@
 #include <sphshell/approx/neighbour_search.hpp>
 #include <sphshell/shell/model.hpp>
 #include <sphshell/solver/integration_points.hpp>
-#include <sphshell/solver/local_spacing.hpp>
+#include <sphshell/shell/local_spacing.hpp>
 #include <sphshell/solver/options.hpp>
 #include <sphshell/solver/section_states.hpp>
 
@@ -40,7 +40,7 @@ inline constexpr double highest_mode_factor = 9.0;
 // (the corners of a spherical cap) it is shorter than the square root of the
 // cell area. Pairs a cut separates (the coincident faces of a slit) do not count.
 // Each particle's nearest neighbour is sought within two of its local
-// spacings (solver/local_spacing.hpp); infinity when none lies that close.
+// spacings (shell/local_spacing.hpp); infinity when none lies that close.
 inline double nearest_particle_distance(const ShellModel& model, const shell::CutVisibility& cuts) {
   const std::vector<double>& local = local_spacing(model).particle;
   std::vector<double> reach(local.size());

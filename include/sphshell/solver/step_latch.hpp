@@ -1,10 +1,9 @@
 #pragma once
-// The failure latch of a solver's step, shared by Solver and
-// mpi::DistributedSolver. A step that stops part-way (an instability Error,
-// or running out of memory) leaves a half-updated state: the latch keeps the
-// error, and every later step refuses with it instead of going on from that
-// state. Checkpoints keep the message, so a restart from a file written after
-// a failure refuses too.
+// The failure latch of a Solver's step, on one process or many. A step that
+// stops part-way (an instability Error, or running out of memory) leaves a
+// half-updated state: the latch keeps the error, and every later step
+// refuses with it instead of going on from that state. Checkpoints keep the
+// message, so a restart from a file written after a failure refuses too.
 
 #include <sphshell/core/error.hpp>
 

@@ -4,7 +4,7 @@
 // process, to the last bit:
 //
 //  - sums over the degrees of freedom (norms, the damping's products) are
-//    exact sums (mpi/exact_sum.hpp: the correctly rounded total, the same for
+//    exact sums (core/exact_sum.hpp: the correctly rounded total, the same for
 //    any split), rounded once after the reduction;
 //  - each process relaxes its owned particles; the ghosts take their owners'
 //    positions, directors and free directions by the halo exchange;
@@ -17,7 +17,7 @@
 // exact sum, every order the global one.
 
 #include <sphshell/core/types.hpp>
-#include <sphshell/mpi/exact_sum.hpp>
+#include <sphshell/core/exact_sum.hpp>
 
 #include <Eigen/Core>
 
@@ -35,10 +35,10 @@ namespace sphshell::statics::detail {
 // (collective in a distributed run).
 template <class Domain>
 double global_dot(const Domain& domain, const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-  mpi::ExactSum sum;
+  sphshell::ExactSum sum;
   for (Eigen::Index k = 0; k < a.size(); ++k) sum.add(a[k] * b[k]);
   if constexpr (Domain::is_distributed)
-    return domain.totals(std::array<const mpi::ExactSum*, 1>{&sum})[0];
+    return domain.totals(std::array<const sphshell::ExactSum*, 1>{&sum})[0];
   else
     return sum.value();
 }

@@ -5,7 +5,7 @@
 // is the umbrella header's check (tests/downstream/main.cpp).
 #include <sphshell/mpi/communicator.hpp>
 #include <sphshell/mpi/error_agreement.hpp>
-#include <sphshell/mpi/exact_sum.hpp>
+#include <sphshell/core/exact_sum.hpp>
 #include <sphshell/mpi/reductions.hpp>
 
 #include <iostream>
@@ -14,10 +14,10 @@ int main(int argc, char** argv) {
   sphshell::mpi::Environment environment(argc, argv);
   const sphshell::mpi::Communicator comm;
   // 0.1 on every rank: the sum is the correctly rounded P × 0.1 of the doubles.
-  sphshell::mpi::ExactSum mine;
+  sphshell::ExactSum mine;
   mine.add(0.1);
   const double total = sphshell::mpi::sum(comm, mine);
-  sphshell::mpi::ExactSum expected;
+  sphshell::ExactSum expected;
   for (int r = 0; r < comm.size(); ++r) expected.add(0.1);
   if (total != expected.value()) return 1;
   try {

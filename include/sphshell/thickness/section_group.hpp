@@ -12,7 +12,7 @@
 // wide enough to fill the vector registers of every instruction set even for
 // thin rules (Gauss<2>: 16 lanes with G = 8).
 //
-// Across points, the law states are not moved: SectionStates (section_states.hpp)
+// Across points, the law states are not moved: solver::SectionStates (solver/section_states.hpp)
 // stores them in this layout, a block of G consecutive points of a point group
 // per Lanes object, and the group updates a block in place. The block's lanes
 // of points that are not in the group (inactive points, rows outside the run,
@@ -51,7 +51,7 @@
 #define SPHSHELL_LANES_ACROSS_POINTS SPHSHELL_BATCHED_SECTIONS
 #endif
 
-namespace sphshell::solver {
+namespace sphshell::thickness {
 
 // The layout a SectionGroup asks for: the law states in lanes across points
 // (taken where the law and section allow it, see SectionGroup::across_points)
@@ -78,7 +78,7 @@ inline constexpr bool layered_section_v =
 
 template <class Rule, class Law, int G = points_per_group, StateLayout Layout = default_state_layout>
 class SectionGroup {
-  static_assert(G >= 1, "sphshell::solver::SectionGroup<Rule, Law, G>: G must be at least 1");
+  static_assert(G >= 1, "sphshell::thickness::SectionGroup<Rule, Law, G>: G must be at least 1");
 
   template <bool, int L>
   struct LanesOf {
@@ -306,4 +306,4 @@ class SectionGroup {
   std::array<std::exception_ptr, std::size_t(G)> failure_;
 };
 
-}  // namespace sphshell::solver
+}  // namespace sphshell::thickness

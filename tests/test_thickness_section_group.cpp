@@ -1,4 +1,4 @@
-// The grouped material update (solver/section_group.hpp) against the section of
+// The grouped material update (thickness/section_group.hpp) against the section of
 // one point alone (thickness::Section::update): the same states and resultants
 // for full and partial groups, points of two thicknesses, elastic and yielding
 // integral points, and a failing point that leaves the others of its group as
@@ -12,7 +12,7 @@
 #include <sphshell/io/binary_stream.hpp>
 #include <sphshell/material/all.hpp>
 #include <sphshell/shell/model.hpp>
-#include <sphshell/solver/section_group.hpp>
+#include <sphshell/thickness/section_group.hpp>
 #include <sphshell/solver/section_states.hpp>
 #include <sphshell/thickness/all.hpp>
 
@@ -32,8 +32,8 @@ using sphshell::StrainVoigt;
 using sphshell::StressVoigt;
 namespace material = sphshell::material;
 namespace thickness = sphshell::thickness;
-using sphshell::solver::points_per_group;
-using sphshell::solver::SectionGroup;
+using sphshell::thickness::points_per_group;
+using sphshell::thickness::SectionGroup;
 
 constexpr double E = 210e9, nu = 0.3, sigma_y0 = 235e6, Ep = 2e9;
 // Agreement to round-off: the group runs the same operations in vector
@@ -125,7 +125,7 @@ TEST_CASE("section group: J2 through Gauss<5>, a full group and a partial one, a
   STATIC_REQUIRE(SectionGroup<thickness::Gauss<5>, material::J2Plasticity>::across_points);
   // Asked for point by point, the same group keeps the states per point.
   STATIC_REQUIRE(!SectionGroup<thickness::Gauss<5>, material::J2Plasticity, points_per_group,
-                               sphshell::solver::StateLayout::point_by_point>::across_points);
+                               sphshell::thickness::StateLayout::point_by_point>::across_points);
   CHECK(compare_over_steps<thickness::Gauss<5>>(law, points_per_group, 12) > 20);
   CHECK(compare_over_steps<thickness::Gauss<5>>(law, points_per_group - 1, 12) > 20);
   CHECK(compare_over_steps<thickness::Gauss<5>>(law, 3, 12) > 5);

@@ -41,7 +41,7 @@
 #include <cstddef>
 #include <vector>
 
-namespace sphshell::solver {
+namespace sphshell {
 
 // A particle takes the spacing of every particle j whose own spacing √A_j
 // reaches it within this many spacings: on a grid the diagonal neighbour lies
@@ -95,4 +95,4 @@ inline LocalSpacing local_spacing(const ShellModel& model) {
   return spacing;
 }
 
-}  // namespace sphshell::solver
+}  // namespace sphshell

@@ -23,7 +23,7 @@
 #include <cstring>
 #include <limits>
 
-namespace sphshell::mpi {
+namespace sphshell {
 
 class ExactSum {
  public:
@@ -172,4 +172,4 @@ class ExactSum {
   std::int64_t pending_ = 0;
 };
 
-}  // namespace sphshell::mpi
+}  // namespace sphshell
