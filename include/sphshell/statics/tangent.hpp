@@ -160,7 +160,8 @@ template <class Solver>
 class TangentAssembly {
   static_assert(is_static_analysable_v<Solver>,
                 "statics: the solver must be a serial sphshell::Solver (set_configuration and the internal forces); "
-                "solve a distributed model on one process and load its state");
+                "a distributed model relaxes with Solver::solve_static and StaticMass::particle_bound (the default), "
+                "or solve it on one process and load its state");
 
  public:
   TangentAssembly(Solver& solver, Conditions conditions, TangentSteps steps = {})
