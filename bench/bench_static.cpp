@@ -7,7 +7,12 @@
 //    tests/test_solver_shells.cpp (L = 0.5 m, 0.1 m wide, d = 0.02 m, nu = 0,
 //    21 x 5 particles, Gauss<3>, nonlinear), the argument PL^2/EI = 1 or 2,
 //    against the elastica's tip deflection w/L = 0.30172 and 0.49346
-//    (Bisshopp & Drucker 1945; Mattiasson 1981), the values the test uses.
+//    (Bisshopp & Drucker 1945; Mattiasson 1981), the values the test uses;
+//  - plate_101_*: the clamped plate at 101 x 101 particles, Newton
+//    (StaticMass::tangent) against the relaxation (the default), and what a
+//    Newton iteration is made of there: one tangent assembly (the one
+//    solve_static and sphshell::statics run) in force evaluations, counted and
+//    in CPU time, and the sparse LDLT factorisation of it (time, entries of L).
 // *_damped is the test's explicit run exactly (mass-proportional damping,
 // run_until the test's end time); *_static is Solver::solve_static with the
 // parameters named below. The time is the wall time of run_until /
@@ -19,7 +24,8 @@
 // After the run the program prints, per case, the median wall and CPU times
 // of both over the repetitions, their ratio (damped / static), and the
 // difference of the static deflection from the damped one.
-// Each benchmark runs its solve once per repetition; with
+// plate_101_static / plate_101_tangent (not in the summary below) report
+// their counters alone. Each benchmark runs its solve once per repetition; with
 //   OMP_NUM_THREADS=1 ./bench_static --benchmark_repetitions=3
 //   --benchmark_enable_random_interleaving=true
 // (one command line) the repetitions of all of them interleave, so a change
@@ -29,6 +35,7 @@
 #include <sphshell/kernel/all.hpp>
 #include <sphshell/material/all.hpp>
 #include <sphshell/solver.hpp>
+#include <sphshell/statics/tangent.hpp>
 #include <sphshell/thickness/all.hpp>
 
 #include <benchmark/benchmark.h>
@@ -43,6 +50,7 @@
 #include <limits>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <time.h>
@@ -147,7 +155,7 @@ constexpr int plate_periods = 6;
 
 // The test's set-up: damped options for the explicit run, plain ones for the static solve
 // (the static answer depends on neither density nor damping).
-PlateSolver clamped_plate(bool damped) {
+PlateSolver clamped_plate(bool damped, int particles_per_side = 21) {
   SolverOptions options;
   options.nonlinear = false;
   options.density = plate_rho;
@@ -155,7 +163,8 @@ PlateSolver clamped_plate(bool damped) {
     options.damping = 2 * plate_omega;
     options.rotary_inertia_scale = std::max(3.0, 3.0 * (plate_slenderness / 50.0) * (plate_slenderness / 50.0));
   }
-  PlateSolver solver(ShellModel::rectangular_plate(plate_L, plate_L, 21, 21, plate_d), {plate_E, plate_nu}, options);
+  PlateSolver solver(ShellModel::rectangular_plate(plate_L, plate_L, particles_per_side, particles_per_side, plate_d),
+                     {plate_E, plate_nu}, options);
   solver.clamp(solver.model().set("boundary"));
   solver.add_uniform_pressure(solver.model().all_particles(), plate_q, time_function::Step{},
                               PressureDirection::fixed);
@@ -184,6 +193,93 @@ void clamped_plate_static(benchmark::State& state) {
     solver::StaticParameters parameters;
     parameters.mass = solver::StaticMass::tangent;
     measure_static(state, "plate", solver, parameters, plate_coefficient, "wDqL4", mindlin_50);
+  }
+}
+
+// ---------------------------------------------------------------- the plate at 101 x 101
+
+// solve_static at 101 x 101, ||r|| <= 1e-6 ||f||: Newton (argument 0) or the
+// relaxation (argument 1, its automatic budget). The counters are the solve's
+// own (force evaluations, iterations, factorisations), its CPU time, the
+// deflection and its error against Mindlin's value for the continuum.
+void plate_101_static(benchmark::State& state) {
+  const bool newton = state.range(0) == 0;
+  for (auto _ : state) {
+    PlateSolver solver = clamped_plate(false, 101);
+    solver::StaticParameters parameters;
+    if (newton) parameters.mass = solver::StaticMass::tangent;
+    const auto start = Clock::now();
+    const double cpu_start = cpu_seconds();
+    const solver::StaticResult result = solver.solve_static(parameters);
+    state.SetIterationTime(seconds_since(start));
+    state.counters["cpu_s"] = cpu_seconds() - cpu_start;
+    state.counters["force_evaluations"] = double(result.force_evaluations);
+    state.counters["iterations"] = double(result.iterations);
+    state.counters["factorisations"] = double(result.factorisations);
+    state.counters["residual"] = result.residual;
+    state.counters["wDqL4"] = plate_coefficient(solver);
+    state.counters["error_pct"] = 100.0 * (plate_coefficient(solver) / mindlin_50 - 1.0);
+  }
+}
+
+// One tangent assembly of the 101 x 101 plate (statics::TangentAssembly, the
+// clamped edge held) against one force evaluation (the configuration set
+// again, which recomputes the internal forces), and the LDLT factorisation of
+// the symmetrised tangent that Newton's step solves with (Eigen's
+// SimplicialLDLT, AMD ordering, as solve_static's): of the tangent as
+// assembled (every entry the differences give, as the path following keeps
+// them) and without the entries at most 1e-12 of their column's largest (the
+// differences' round-off, which solve_static leaves out). The counters:
+// assembly_force_evaluations (the count: two per colour and degree of
+// freedom, and one to restore the configuration), assembly_in_force_evaluations
+// (its CPU time over one evaluation's), and for both factorisations the CPU
+// time, the entries of the factor L and their memory (12 bytes an entry,
+// value and row index).
+void plate_101_tangent(benchmark::State& state) {
+  for (auto _ : state) {
+    PlateSolver solver = clamped_plate(false, 101);
+    statics::Conditions conditions(solver.model().particle_count());
+    conditions.clamp(solver.model().set("boundary"));
+    const std::vector<Vector3> x = solver.positions(), d = solver.directors();
+    constexpr int evaluations = 20;
+    double cpu = cpu_seconds();
+    for (int k = 0; k < evaluations; ++k) solver.set_configuration(x, d);
+    const double evaluation_cpu = (cpu_seconds() - cpu) / evaluations;
+    statics::TangentAssembly<PlateSolver> assembly(solver, conditions);
+    const statics::DegreesOfFreedom dofs = assembly.degrees_of_freedom();
+    const auto start = Clock::now();
+    cpu = cpu_seconds();
+    const statics::SparseMatrix k = assembly.tangent(dofs);
+    const double assembly_cpu = cpu_seconds() - cpu;
+    // Column by column, the entries above 1e-12 of the column's largest.
+    statics::SparseMatrix pruned = k;
+    for (Eigen::Index column = 0; column < pruned.outerSize(); ++column) {
+      double largest = 0.0;
+      for (statics::SparseMatrix::InnerIterator it(pruned, column); it; ++it)
+        largest = std::max(largest, std::abs(it.value()));
+      for (statics::SparseMatrix::InnerIterator it(pruned, column); it; ++it)
+        if (!(std::abs(it.value()) > statics::detail::negligible_tangent_entry * largest)) it.valueRef() = 0.0;
+    }
+    pruned.prune(0.0, 0.0);
+    for (const auto& [name, matrix] : {std::pair<const char*, const statics::SparseMatrix*>{"", &k},
+                                       std::pair<const char*, const statics::SparseMatrix*>{"pruned_", &pruned}}) {
+      cpu = cpu_seconds();
+      const Eigen::SimplicialLDLT<statics::SparseMatrix> ldlt(statics::symmetrised(*matrix));
+      const double factorisation_cpu = cpu_seconds() - cpu;
+      if (ldlt.info() != Eigen::Success) state.SkipWithError("the LDLT factorisation failed");
+      const double factor_entries = double(ldlt.matrixL().nestedExpression().nonZeros());
+      state.counters[std::string(name) + "tangent_entries"] = double(matrix->nonZeros());
+      state.counters[std::string(name) + "factorisation_s"] = factorisation_cpu;
+      state.counters[std::string(name) + "factor_entries"] = factor_entries;
+      state.counters[std::string(name) + "factor_MB"] = 12.0 * factor_entries / 1e6;
+    }
+    state.SetIterationTime(seconds_since(start));
+    state.counters["dofs"] = double(dofs.count());
+    state.counters["colours"] = double(assembly.colour_count());
+    state.counters["force_evaluation_ms"] = 1e3 * evaluation_cpu;
+    state.counters["assembly_force_evaluations"] = double(assembly.report().force_evaluations);
+    state.counters["assembly_s"] = assembly_cpu;
+    state.counters["assembly_in_force_evaluations"] = assembly_cpu / evaluation_cpu;
   }
 }
 
@@ -260,6 +356,8 @@ BENCHMARK(clamped_plate_damped)->UseManualTime()->Iterations(1)->Unit(benchmark:
 BENCHMARK(clamped_plate_static)->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(cantilever_damped)->Arg(1)->Arg(2)->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(cantilever_static)->Arg(1)->Arg(2)->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(plate_101_static)->Arg(0)->Arg(1)->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(plate_101_tangent)->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);
 
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);

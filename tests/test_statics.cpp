@@ -128,6 +128,50 @@ TEST_CASE("Statics: bad input is an Error naming it, and the solver is left as i
   CHECK(path.load_factor() == 0.5);
 }
 
+TEST_CASE("Statics: a step that cannot converge is an Error naming its number, the residual reached and the "
+          "iteration, and the solver stays at the last converged state",
+          "[statics]") {
+  // The strip bent by a tip force to about a third of its length: one small
+  // load step converges within the budget of four iterations; the next one,
+  // to the whole load without halvings, needs more than four (full Newton
+  // takes 15 for two steps of half the load to 1e-8).
+  Strip strip(11, 3);
+  strip.conditions.add_force(strip.model.set("x_max"), Vector3(0.0, 0.0, 1.0 / 3.0));
+  NonlinearSolver solver(strip.model, {Strip::E, 0.0});
+  statics::NewtonOptions options;
+  options.max_iterations = 4;
+  options.max_halvings = 0;
+  statics::PathFollower<NonlinearSolver> path(solver, strip.conditions, options);
+  path.solve_to(0.02, 0.02);
+  REQUIRE(path.report().load_steps == 1);
+  const std::vector<Vector3> x1 = solver.positions(), d1 = solver.directors();
+  std::string message;
+  try {
+    path.solve_to(1.0, 1.0);
+  } catch (const Error& e) {
+    message = e.what();
+  }
+  std::printf("A step that cannot converge: %s\n", message.c_str());
+  CHECK_THAT(message, Catch::Contains("at load factor 1") && Catch::Contains("at load step 2 (counted from 1)") &&
+                          Catch::Contains("NewtonOptions::max_halvings = 0") &&
+                          Catch::Contains("lowest relative residual |r|/|lambda f_ext| = ") &&
+                          Catch::Contains("was reached at iteration ") &&
+                          Catch::Contains("NewtonOptions::max_iterations = 4") &&
+                          Catch::Contains("last converged state, load factor 0.02"));
+  // The residual named lies above the tolerance, at an iteration of the budget.
+  const std::size_t at = message.find("= ", message.find("lowest relative residual"));
+  REQUIRE(at != std::string::npos);
+  CHECK(std::stod(message.substr(at + 2)) > options.tolerance);
+  const std::size_t iteration = message.find("at iteration ");
+  REQUIRE(iteration != std::string::npos);
+  const int reached = std::stoi(message.substr(iteration + 13));
+  CHECK(reached >= 0);
+  CHECK(reached < options.max_iterations);
+  CHECK(same_configuration(solver, x1, d1));
+  CHECK(path.load_factor() == 0.02);
+  CHECK(path.report().load_steps == 1);
+}
+
 TEST_CASE("Statics: linear buckling of an Euler strip", "[validation][statics]") {
   // The cantilever strip under an axial tip load: P_cr = π² EI / (4 L²)
   // (Mindlin's shear lowers it by P_cr / (κ G A), 5·10⁻⁵ here). The

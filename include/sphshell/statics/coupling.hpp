@@ -3,7 +3,8 @@
 // Jacobian of its forces over a colouring of that graph: the one tangent
 // assembly of the static solvers (statics::TangentAssembly for the path
 // following and buckling, Solver::solve_static for its Newton steps and the
-// relaxation's masses).
+// relaxation's masses), and the one product of that Jacobian with a vector
+// (difference_product, the GMRES Newton steps of both).
 //
 // Two particles are coupled when both sit in the row of one integration
 // point: the forces on one change when the other moves. A distance-2
@@ -22,6 +23,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 namespace sphshell::statics {
@@ -185,6 +187,26 @@ SparseMatrix difference_tangent(const Coupling& coupling, const std::vector<int>
   k.setFromTriplets(entries.begin(), entries.end());
   k.makeCompressed();
   return k;
+}
+
+// The same Jacobian applied to a vector, (∂F/∂q) v, without assembling it: one
+// central difference of the forces along v (two evaluations), the product of
+// the GMRES Newton steps (statics/krylov.hpp) of both static solvers.
+// step(k) is the difference step of degree of freedom k; the step along v is
+// h = min_k step(k) / |v_k|, so no degree of freedom moves further than its
+// own step of the assembly, whose truncation and round-off these steps
+// balance. forces(u) sets the configuration to the caller's base one moved by
+// the update u (+h v, then −h v) and returns F there; the caller restores its
+// base configuration afterwards. A zero v gives zero without an evaluation.
+template <class Step, class Forces>
+Eigen::VectorXd difference_product(const Eigen::VectorXd& v, Step&& step, Forces&& forces) {
+  double h = std::numeric_limits<double>::infinity();
+  for (Eigen::Index k = 0; k < v.size(); ++k)
+    if (v[k] != 0.0) h = std::min(h, step(k) / std::abs(v[k]));
+  if (!std::isfinite(h)) return Eigen::VectorXd::Zero(v.size());
+  const Eigen::VectorXd forward = forces(Eigen::VectorXd(h * v));
+  const Eigen::VectorXd backward = forces(Eigen::VectorXd(-h * v));
+  return (forward - backward) / (2.0 * h);
 }
 
 }  // namespace sphshell::statics

@@ -1,8 +1,9 @@
 #pragma once
 // GMRES (Saad & Schultz, SIAM J. Sci. Stat. Comput. 7 (1986) 856–869) with
-// right preconditioning, for the Newton steps of statics::PathFollower: the
-// current tangent is applied without being assembled (a central difference
-// of the forces along a direction, TangentAssembly::tangent_product) and an
+// right preconditioning, for the Newton steps of statics::PathFollower and
+// Solver::solve_static: the current tangent is applied without being
+// assembled (a central difference of the forces along a direction,
+// difference_product of statics/coupling.hpp) and an
 // older factorisation of it is the preconditioner, so a Newton iteration
 // costs a few force evaluations and back substitutions instead of an
 // assembly and a factorisation (docs/method.md, §11 "Path following").

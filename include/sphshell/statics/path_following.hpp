@@ -22,8 +22,11 @@
 //
 // Failures: bad input (a non-positive step or arc length, a control that is
 // held, a mechanism at the start) is an Error before anything moves; a step
-// that still fails to converge after its halvings is an Error naming the step,
-// and the solver is left at the last converged state.
+// that still fails to converge after its halvings is an Error naming the step
+// (its number, counted from 1, and its target), the lowest relative residual
+// of its last attempt and the iteration that reached it (the state after that
+// many Newton updates, 0 the attempt's start), and the solver is left at the
+// last converged state.
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/statics/conditions.hpp>
@@ -37,6 +40,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -339,6 +343,7 @@ class PathFollower {
   bool converge_displacement(const Control& control, double target) {
     double smallest = std::numeric_limits<double>::infinity();
     last_relative_ = std::numeric_limits<double>::infinity();
+    lowest_ = {};
     assembly_.discard_kept_factorisation();  // a step starts on a fresh tangent
     for (int iteration = 0; iteration < options_.max_iterations; ++iteration) {
       const DegreesOfFreedom dofs = assembly_.degrees_of_freedom();
@@ -355,6 +360,7 @@ class PathFollower {
       // load to measure the residual against: iterate.
       if (reference > 0.0) {
         const double relative = r.norm() / reference;
+        note_residual(iteration, relative);
         if (relative > detail::control_divergence * smallest) return false;
         smallest = std::min(smallest, relative);
         if (relative <= options_.tolerance && std::abs(gap) <= options_.tolerance * std::abs(target)) return true;
@@ -396,9 +402,17 @@ class PathFollower {
     return dofs;
   }
 
+  // The lowest relative residual of the current attempt and its iteration
+  // (the state after that many updates, 0 the attempt's start), for the
+  // Error when a step fails.
+  void note_residual(int iteration, double relative) {
+    if (relative < lowest_.relative) lowest_ = {relative, iteration};
+  }
+
   // Load control's Newton iteration at λ.
   bool converge(double lambda) {
     last_relative_ = std::numeric_limits<double>::infinity();
+    lowest_ = {};
     // A step starts on a fresh tangent, or with GMRES on the kept one as the preconditioner.
     if (options_.krylov_iterations == 0) assembly_.discard_kept_factorisation();
     for (int iteration = 0; iteration < options_.max_iterations; ++iteration) {
@@ -408,6 +422,7 @@ class PathFollower {
       const double relative = r.norm() / reference;
       if (iteration == 0) assembly_.report().load_step_start_residual = relative;
       if (!std::isfinite(relative)) return false;
+      note_residual(iteration, relative);
       if (relative <= options_.tolerance) return true;
       if (options_.trace)
         std::fprintf(stderr, "  iteration %d: load factor %.8g, relative residual %.3e\n", iteration, lambda, relative);
@@ -517,11 +532,20 @@ class PathFollower {
       lambda_ = lambda0;
       // The halved step starts on a fresh tangent.
       assembly_.discard_kept_factorisation();
-      if (halvings + 1 > options_.max_halvings)
-        throw Error("sphshell: " + failure(increment) + " after NewtonOptions::max_halvings = " +
-                    std::to_string(options_.max_halvings) + " halvings (relative tolerance " +
-                    std::to_string(options_.tolerance) + "); the solver is at the last converged state, load factor " +
-                    std::to_string(lambda_));
+      if (halvings + 1 > options_.max_halvings) {
+        std::ostringstream text;
+        text.precision(4);
+        text << "sphshell: " << failure(increment) << " at load step " << assembly_.report().load_steps + 1
+             << " (counted from 1) after NewtonOptions::max_halvings = " << options_.max_halvings
+             << " halvings: its last attempt's lowest relative residual |r|/|lambda f_ext| ";
+        if (lowest_.iteration >= 0)
+          text << "= " << lowest_.relative << " was reached at iteration " << lowest_.iteration;
+        else
+          text << "was never measured (no load)";
+        text << " (tolerance " << options_.tolerance << ", NewtonOptions::max_iterations = " << options_.max_iterations
+             << "); the solver is at the last converged state, load factor " << lambda_;
+        throw Error(text.str());
+      }
       increment *= 0.5;
     }
   }
@@ -532,6 +556,10 @@ class PathFollower {
   bool start_checked_ = false;
   // The relative residual of the iteration before (tangent_for).
   double last_relative_ = std::numeric_limits<double>::infinity();
+  struct Lowest {
+    double relative = std::numeric_limits<double>::infinity();
+    int iteration = -1;
+  } lowest_;  // of the current attempt (note_residual)
   struct Converged {
     std::vector<Vector3> x, d;
     double lambda = 0.0;

@@ -15,8 +15,9 @@
 //    Known limit: on the cantilever strip (free edges) its Newton steps stall
 //    even under small load steps; the clamped plates converge in 1–2 steps.
 //    With StaticParameters::krylov_iterations the steps are solved by GMRES on
-//    the current tangent (products by differences of the forces),
-//    preconditioned by a kept factorisation of an earlier one.
+//    the current tangent (its products by difference_product of
+//    statics/coupling.hpp, as in the path following), preconditioned by a
+//    kept factorisation of an earlier one.
 //  - StaticMass::particle_bound (the default): adaptive dynamic relaxation (Underwood 1983)
 //    with a diagonal fictitious mass per degree of freedom from the
 //    Gershgorin bound of the tangent's rows, m_a = (h²/4) Σ_b |K_ab| with the
@@ -580,30 +581,29 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
   };
 
   // The Newton update K dq = r of StaticMass::tangent at the current state:
-  // by GMRES on the current tangent, applied by central differences of the
-  // residual along the vector (the configuration moved by ±h v as `move`
-  // moves it, h taking v's largest component to the difference step of the
-  // tangent), preconditioned by the kept factorisation; without one that
-  // fits, or when GMRES needs more than krylov_iterations products, by a
-  // fresh tangent's factorisation, which is kept. The configuration is left
-  // as it was (its residual in r only when no product was taken).
+  // by GMRES on the current tangent, applied by difference_product
+  // (statics/coupling.hpp, the path following's product too) with the
+  // configuration moved by ±h v as `move` moves it, preconditioned by the
+  // kept factorisation; without one that fits, or when GMRES needs more than
+  // krylov_iterations products, by a fresh tangent's factorisation, which is
+  // kept. The configuration is left as it was (its residual in r only when no
+  // product was taken).
   std::unique_ptr<NewtonFactorisation<SparseMatrix>> kept;
   auto newton_update = [&](const Eigen::VectorXd& r0, double lambda, int load_step) {
     if (parameters.krylov_iterations > 0 && kept && kept->size() == basis.size) {
       const std::vector<Vector3> x0 = particles.position, d0 = particles.director;
+      // Every unknown's difference step is the tangent's: the rotation
+      // unknowns are ℓ θ, so their step ℓ × step_rotation is step_translation.
       auto product = [&](const Eigen::VectorXd& v) {
-        const double largest = v.cwiseAbs().maxCoeff();
-        if (!(largest > 0.0)) return Eigen::VectorXd(Eigen::VectorXd::Zero(v.size()));
-        const double h = step_translation / largest;
-        Eigen::VectorXd response[2];
-        for (int side = 0; side < 2; ++side) {
-          particles.position = x0;
-          particles.director = d0;
-          move((side == 0 ? h : -h) * v);
-          residual(lambda);
-          response[side] = r;
-        }
-        return Eigen::VectorXd((response[1] - response[0]) / (2.0 * h));
+        return difference_product(
+            v, [&](Eigen::Index) { return step_translation; },
+            [&](const Eigen::VectorXd& update) {
+              particles.position = x0;
+              particles.director = d0;
+              move(update);
+              residual(lambda);
+              return Eigen::VectorXd(-r);
+            });
       };
       Eigen::VectorXd dq;
       const KrylovSolve krylov =

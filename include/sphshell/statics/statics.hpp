@@ -6,10 +6,12 @@
 // Contract: a solver usable here moves its particles and directors to a given
 // configuration at once (set_configuration) and exposes the internal forces
 // and director forces of it, its model, options, material and approximation
-// type, on one process (no static solver runs over a domain's processes yet:
-// solve on one process and load its state). Solver::solve_static runs the
-// same tangent assembly (statics/coupling.hpp) on the solver's own supports
-// and loads (statics/static_solve.hpp).
+// type, on one process (a distributed solver fails to compile here, its
+// message naming the alternatives: Solver::solve_static's dynamic relaxation,
+// StaticMass::particle_bound, runs over a domain's processes; or solve on one
+// process and load its state). Solver::solve_static runs the same tangent
+// assembly (statics/coupling.hpp) on the solver's own supports and loads
+// (statics/static_solve.hpp).
 
 #include <sphshell/core/types.hpp>
 

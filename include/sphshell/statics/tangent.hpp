@@ -160,7 +160,8 @@ template <class Solver>
 class TangentAssembly {
   static_assert(is_static_analysable_v<Solver>,
                 "statics: the solver must be a serial sphshell::Solver (set_configuration and the internal forces); "
-                "solve a distributed model on one process and load its state");
+                "a distributed model relaxes with Solver::solve_static and StaticMass::particle_bound (the default), "
+                "or solve it on one process and load its state");
 
  public:
   TangentAssembly(Solver& solver, Conditions conditions, TangentSteps steps = {})
@@ -336,28 +337,21 @@ class TangentAssembly {
   }
 
   // The tangent stiffness at the configuration (x0, d0) applied to v, K v
-  // with K = −∂r/∂q in `dofs`, by a central difference of the forces along v
-  // (two force evaluations): the configuration moved by ±h v as apply_update
-  // moves it, h taking the largest translation of v to the tangent's
-  // translation step and its largest rotation to the rotation step, the
-  // steps whose round-off and truncation the assembled tangent balances.
-  // The solver is left in a moved configuration: the caller sets the one it
-  // wants afterwards.
+  // with K = −∂r/∂q in `dofs`: difference_product (statics/coupling.hpp,
+  // two force evaluations) with the steps of the assembled tangent, the
+  // configuration moved by ±h v as apply_update moves it. The solver is left
+  // in a moved configuration: the caller sets the one it wants afterwards.
   Eigen::VectorXd tangent_product(const DegreesOfFreedom& dofs, const std::vector<Vector3>& x0,
                                   const std::vector<Vector3>& d0, const Eigen::VectorXd& v) {
-    double h = std::numeric_limits<double>::infinity();
-    for (Eigen::Index k = 0; k < v.size(); ++k)
-      if (v[k] != 0.0) h = std::min(h, step_of(dofs, static_cast<int>(k)) / std::abs(v[k]));
-    if (!std::isfinite(h)) return Eigen::VectorXd::Zero(v.size());
-    Eigen::VectorXd response[2];
-    for (int side = 0; side < 2; ++side) {
-      std::vector<Vector3> x = x0, d = d0;
-      moved(dofs, (side == 0 ? h : -h) * v, x, d);
-      solver_.set_configuration(std::move(x), std::move(d));
-      ++report_.force_evaluations;
-      response[side] = residual(dofs, 0.0);
-    }
-    return (response[1] - response[0]) / (2.0 * h);
+    return difference_product(
+        v, [&](Eigen::Index k) { return step_of(dofs, static_cast<int>(k)); },
+        [&](const Eigen::VectorXd& update) {
+          std::vector<Vector3> x = x0, d = d0;
+          moved(dofs, update, x, d);
+          solver_.set_configuration(std::move(x), std::move(d));
+          ++report_.force_evaluations;
+          return Eigen::VectorXd(-residual(dofs, 0.0));
+        });
   }
 
   // Each particle's translation and director rotation in a vector of the
