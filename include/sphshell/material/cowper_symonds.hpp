@@ -16,9 +16,9 @@
 //   law (r ≤ (2⁻⁵³)^q ⇔ x ≤ 2⁻⁵³, the largest x with 1 + x == 1), so a step
 //   pays no root r^(1/q) unless that bound is the tighter bracket end.
 // - An integer q (mild steel's 5, aluminium's 4) raises x to it by repeated
-//   squaring instead of std::pow: the Newton iterations then cost J2's plus a
-//   few multiplications.
-// - Otherwise Newton runs on x = (Δε̄p/(DΔt))^(1/q), Δε̄p = DΔt xᵠ
+//   squaring instead of std::pow: the iterations then cost J2's plus a few
+//   multiplications.
+// - Otherwise the return iterates on x = (Δε̄p/(DΔt))^(1/q), Δε̄p = DΔt xᵠ
 //   (flow_stress_return.hpp): in Δε̄p the rate factor rises with an infinite
 //   slope at 0 (q > 1), in x it is linear, and a typical explicit step's root
 //   lies at Δε̄p ~ 1e-15 where Newton in Δε̄p would bisect for dozens of steps.
@@ -146,7 +146,7 @@ struct CowperSymonds {
     // κᵢ (the weights of eq. B.5), i.e. x = r − c xᵠ with c = (κ̂ + Ep(1 + x))DΔt/σs,n.
     // One step of that fixed point from x = r lands within ρ·c rᵠ of its root,
     // ρ = q c rᵠ⁻¹ the map's contraction; it is taken where ρ ≤ ¼. Otherwise
-    // Newton starts from the last step's x, σy/σs − 1 (in steady flow the root
+    // the iteration starts from the last step's x, σy/σs − 1 (in steady flow the root
     // hardly moves), or from the upper end; the safeguard keeps it inside the bracket.
     const double equibiaxial = 0.25 * (trial.x() + trial.y()) * (trial.x() + trial.y());
     const double difference = trial.x() - trial.y();

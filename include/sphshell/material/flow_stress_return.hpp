@@ -35,13 +35,16 @@
 
 namespace sphshell::material::detail {
 
+[[noreturn]] [[gnu::noinline, gnu::cold]] inline void throw_bad_time_step(double time_step) {
+  sphshell::detail::invalid_parameter(
+      "time_step", time_step,
+      "must be > 0 (+inf: quasi-static) for a rate-dependent law; the solver passes its step through "
+      "InternalForceAssembler::set_time_step");
+}
+
 // The time step a rate-dependent law forms its strain rate with (UpdateContext).
 inline void require_time_step(double time_step) {
-  if (!(time_step > 0.0))
-    sphshell::detail::invalid_parameter(
-        "time_step", time_step,
-        "must be > 0 (+inf: quasi-static) for a rate-dependent law; the solver passes its step through "
-        "InternalForceAssembler::set_time_step");
+  if (!(time_step > 0.0)) throw_bad_time_step(time_step);
 }
 
 }  // namespace sphshell::material::detail
@@ -80,10 +83,13 @@ namespace detail {
 // Halley's correction −2hh′/(2h′² − hh″) converges cubically, so the
 // curvature of a rate term (ln ε̇*, a root of ε̇) costs no extra corrections;
 // it takes one division and no square root.
+// Its members are forced inline into the law's update (as closed_form_lane
+// is): called, the kernel lives in memory and each evaluation waits on its
+// stores and loads.
 template <class FlowStress>
 class FlowStressKernel {
  public:
-  FlowStressKernel(const ClosedFormConstants& constants, const StressVoigt& trial, double inverse_scale,
+  [[gnu::always_inline]] FlowStressKernel(const ClosedFormConstants& constants, const StressVoigt& trial, double inverse_scale,
                    const FlowStress& flow)
       : sum_(trial.x() + trial.y()),
         diff_(trial.x() - trial.y()),
@@ -103,7 +109,7 @@ class FlowStressKernel {
            (kappa_1_ * equibiaxial_part_ + kappa_2_ * deviatoric_part_);
   }
 
-  void evaluate(double v) {
+  [[gnu::always_inline]] void evaluate(double v) {
     value_ = flow_(v);
     const double f = value_.flow_stress * inverse_scale_, df = value_.flow_slope * inverse_scale_,
                  ddf = value_.flow_curvature * inverse_scale_;
@@ -133,7 +139,7 @@ class FlowStressKernel {
 
   // Halley's correction; where hh″ ≥ h′² (far from the root, where Halley
   // would more than double Newton's step or reverse it) Newton's, −h/h′.
-  double correction() const {
+  [[gnu::always_inline]] double correction() const {
     const double slope_squared = dh_ * dh_;
     const double curvature_term = h_ * ddh_;
     const double denominator = curvature_term < slope_squared ? 2.0 * slope_squared - curvature_term
@@ -142,7 +148,7 @@ class FlowStressKernel {
   }
 
   // σ = L⁻¹σ*: each eigen-component scaled by σs/uᵢ (= f/ũᵢ).
-  StressVoigt stress() const {
+  [[gnu::always_inline]] StressVoigt stress() const {
     const double f = value_.flow_stress * inverse_scale_;
     const double inverse_product = f / (u1_ * u2_);
     const double returned_sum = sum_ * u2_ * inverse_product;
@@ -170,7 +176,7 @@ class FlowStressKernel {
 // same tolerance, the same stop when the bracket collapses to round-off and
 // the same limit of max_iterations. The kernel arrives evaluated at v.
 template <class Kernel>
-int solve_bracketed(Kernel& kernel, double& v, double lower, double upper) {
+[[gnu::always_inline]] inline int solve_bracketed(Kernel& kernel, double& v, double lower, double upper) {
   int iterations = 0;
   bool distrust = false;
   while (!kernel.converged()) {
@@ -197,7 +203,7 @@ int solve_bracketed(Kernel& kernel, double& v, double lower, double upper) {
 // the bracket [lower, upper] of the iteration variable, where g(lower) > 0 ≥
 // g(upper) (the caller's bounds; see the laws).
 template <class FlowStress>
-FlowStressSolution solve_flow_stress(const ClosedFormConstants& constants, const StressVoigt& trial,
+[[gnu::always_inline]] inline FlowStressSolution solve_flow_stress(const ClosedFormConstants& constants, const StressVoigt& trial,
                                      double inverse_scale, const FlowStress& flow, double start, double lower,
                                      double upper) {
   detail::FlowStressKernel<FlowStress> kernel(constants, trial, inverse_scale, flow);
@@ -214,7 +220,7 @@ FlowStressSolution solve_flow_stress(const ClosedFormConstants& constants, const
 // law passes the last step's Δε̄p at the same rate: in steady flow the root
 // hardly moves), else the perfectly plastic return (eq. B.8 with Ep = 0).
 template <class FlowStress>
-FlowStressSolution solve_flow_stress(const ClosedFormConstants& constants, const StressVoigt& trial,
+[[gnu::always_inline]] inline FlowStressSolution solve_flow_stress(const ClosedFormConstants& constants, const StressVoigt& trial,
                                      double inverse_scale, const FlowStress& flow, double excess,
                                      double guess = 0.0) {
   detail::FlowStressKernel<FlowStress> kernel(constants, trial, inverse_scale, flow);

@@ -10,7 +10,7 @@
 // Choices, and why:
 // - The rate is the plastic one of the step itself, ε̄̇p = Δε̄p/Δt (backward
 //   Euler), and it enters the consistency condition: the return solves
-//   σ̄(Δε̄p) = σy(ε̄p,n + Δε̄p, Δε̄p/Δt) by Newton (flow_stress_return.hpp), the
+//   σ̄(Δε̄p) = σy(ε̄p,n + Δε̄p, Δε̄p/Δt) by Halley iteration (flow_stress_return.hpp), the
 //   consistent form, not the rate of the previous step.
 // - ln ε̇* is taken as 0 for ε̇* < 1, as in common practice (the rate factor
 //   never softens; the fit is made for ε̇* ≥ 1). With no plastic flow the rate
@@ -145,7 +145,7 @@ struct JohnsonCook {
     // which is the one it returns: the hardening of the next elastic limit and
     // the damage's rate term reuse them instead of a second pow() and log().
     double hardening_at_return = parameters_.A, log_rate_at_return = 0.0;
-    // The Newton iterates after the first move by a small fraction of ε̄p and
+    // The iterates after the first move by a small fraction of ε̄p and
     // of Δε̄p: ε̄pⁿ and ln ε̇* follow by short series from their values at the
     // last iterate evaluated exactly (nearby_power, nearby_log) instead of
     // another pow() and log(); each value is within round-off of theirs.
@@ -269,7 +269,7 @@ struct JohnsonCook {
     double value = 0.0;
   };
   // A function's value at x and 1/x (the derivatives' factor), the latter
-  // within δ⁴ ≤ 1e-12 of itself: only the Newton corrections use it.
+  // within δ⁴ ≤ 1e-12 of itself: only the corrections use it.
   struct NearbyValue {
     double value;
     double inverse;
