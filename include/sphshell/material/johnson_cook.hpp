@@ -107,7 +107,8 @@ struct JohnsonCook {
         inverse_temperature_range_(1.0 / (parameters.melting_temperature - parameters.reference_temperature)),
         heating_(parameters.taylor_quinney > 0.0
                      ? parameters.taylor_quinney / (parameters.density * parameters.specific_heat)
-                     : 0.0) {}
+                     : 0.0),
+        power_series_(parameters.n) {}
 
   State initial_state() const {
     const double thermal = thermal_factor(homologous_temperature(parameters_.initial_temperature));
@@ -150,7 +151,14 @@ struct JohnsonCook {
     // last iterate evaluated exactly (nearby_power, nearby_log) instead of
     // another pow() and log(); each value is within round-off of theirs.
     NearbyPoint power_anchor, log_anchor;
-    const auto flow = [&](double increment) {
+    // ε̄p,nⁿ is in the state, yield_stress = (A + Bε̄p,nⁿ)(1 − T*ᵐ) at ε̄p,n and
+    // T_n: the power's first anchor, within a few units in the last place of
+    // A + Bε̄p,nⁿ, instead of a pow() at the first iterate.
+    if (eps_p_n > 0.0 && parameters_.B > 0.0)
+      power_anchor = {eps_p_n, 1.0 / eps_p_n, (state.yield_stress / thermal - parameters_.A) / parameters_.B};
+    // Forced inline (its pow() and log() branches keep GCC from it): called, its
+    // six results go through memory at each iterate.
+    const auto flow = [&](double increment) __attribute__((always_inline)) {
       const double eps_p = eps_p_n + increment;
       const NearbyValue power = nearby_power(power_anchor, eps_p);
       const double hardening = parameters_.A + parameters_.B * power.value;
@@ -274,29 +282,46 @@ struct JohnsonCook {
     double value;
     double inverse;
   };
-  // Relative distance from the anchor below which the series replace pow()
-  // and log(): their first omitted terms, |C(n,5)|δ⁵ and δ⁶/6, are then below
-  // 1e-16 of the value for 0 < n ≤ max_series_exponent.
+  // Relative distance from the anchor below which the series of ln(1 + δ)
+  // to δ⁵ replaces log(): its first omitted term, δ⁶/6, is then below 1e-19.
   static constexpr double series_reach = 1e-3;
-  static constexpr double max_series_exponent = 6.0;
+
+  // The binomial series of (1 + δ)ⁿ to δ⁶: its coefficients C(n, k) and its
+  // reach, the largest |δ| (at most 1e-2) with |C(n, 7)δ⁷| ≤ 2⁻⁵⁴ and each
+  // further term below half the one before (|(n − k)δ/(k + 1)| ≤ ½ for k ≥ 7).
+  struct PowerSeries {
+    explicit PowerSeries(double n) {
+      double c = 1.0;
+      for (int k = 0; k < 7; ++k) {
+        coefficients[k] = c;
+        c *= (n - k) / (k + 1);
+      }
+      reach = std::min(1e-2, 4.0 / std::max(std::abs(n - 7.0), 1.0));
+      if (c != 0.0) reach = std::min(reach, std::pow(0.25 * std::numeric_limits<double>::epsilon() / std::abs(c), 1.0 / 7.0));
+    }
+    double coefficients[7];
+    double reach;
+  };
 
   // 1/x from the anchor's reciprocal, 1/(a(1 + δ)) = (1/a)(1 − δ + δ² − δ³).
   static double nearby_inverse(const NearbyPoint& anchor, double delta) {
     return anchor.inverse * (1.0 - delta * (1.0 - delta * (1.0 - delta)));
   }
-  // xⁿ, from the anchor's value by the binomial series of (1 + δ)ⁿ to δ⁴ when
-  // x is within series_reach of it, else by std::pow (and x becomes the anchor).
+  // xⁿ, from the anchor's value by the binomial series (PowerSeries, in
+  // Estrin's grouping) when x is within its reach, else by std::pow (and x
+  // becomes the anchor).
   NearbyValue nearby_power(NearbyPoint& anchor, double x) const {
-    const double n = parameters_.n;
-    if (anchor.argument > 0.0 && n <= max_series_exponent) {
+    if (anchor.argument > 0.0) {
       const double delta = x * anchor.inverse - 1.0;
-      if (std::abs(delta) <= series_reach) {
-        const double series =
-            1.0 + n * delta * (1.0 + (n - 1.0) * delta / 2.0 * (1.0 + (n - 2.0) * delta / 3.0 * (1.0 + (n - 3.0) * delta / 4.0)));
+      if (std::abs(delta) <= power_series_.reach) {
+        const double* c = power_series_.coefficients;
+        const double delta_2 = delta * delta, delta_4 = delta_2 * delta_2;
+        const double series = (1.0 + c[1] * delta) + delta_2 * (c[2] + c[3] * delta) +
+                              delta_4 * ((c[4] + c[5] * delta) + delta_2 * c[6]);
         return {anchor.value * series, nearby_inverse(anchor, delta)};
       }
     }
-    anchor = {x, 1.0 / x, std::pow(x, n)};
+    anchor = {x, 1.0 / x, std::pow(x, parameters_.n)};
     return {anchor.value, anchor.inverse};
   }
   // ln x, from the anchor's by the series of ln(1 + δ) to δ⁵ when x is within
@@ -368,6 +393,7 @@ struct JohnsonCook {
   return_map::ClosedFormConstants constants_;  // κᵢ of ΓΞ (Ep unused)
   double inverse_temperature_range_;          // 1/(Tm − Tr)
   double heating_;                             // β/(ρ cp), 0 without heating
+  PowerSeries power_series_;                   // of ε̄pⁿ near an anchor
 };
 
 }  // namespace sphshell::material
