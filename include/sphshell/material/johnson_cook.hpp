@@ -151,11 +151,6 @@ struct JohnsonCook {
     // last iterate evaluated exactly (nearby_power, nearby_log) instead of
     // another pow() and log(); each value is within round-off of theirs.
     NearbyPoint power_anchor, log_anchor;
-    // ε̄p,nⁿ is in the state, yield_stress = (A + Bε̄p,nⁿ)(1 − T*ᵐ) at ε̄p,n and
-    // T_n: the power's first anchor, within a few units in the last place of
-    // A + Bε̄p,nⁿ, instead of a pow() at the first iterate.
-    if (eps_p_n > 0.0 && parameters_.B > 0.0)
-      power_anchor = {eps_p_n, 1.0 / eps_p_n, (state.yield_stress / thermal - parameters_.A) / parameters_.B};
     // Forced inline (its pow() and log() branches keep GCC from it): called, its
     // six results go through memory at each iterate.
     const auto flow = [&](double increment) __attribute__((always_inline)) {
