@@ -278,7 +278,7 @@ struct JohnsonCook {
     double inverse;
   };
   // Relative distance from the anchor below which the series of ln(1 + δ)
-  // to δ⁵ replaces log(): its first omitted term, δ⁶/6, is then below 1e-19.
+  // to δ⁵ replaces log(): its first omitted term, δ⁶/6, is then below 2e-19.
   static constexpr double series_reach = 1e-3;
 
   // The binomial series of (1 + δ)ⁿ to δ⁶: its coefficients C(n, k) and its
