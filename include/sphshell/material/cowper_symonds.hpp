@@ -16,9 +16,9 @@
 //   law (r ≤ (2⁻⁵³)^q ⇔ x ≤ 2⁻⁵³, the largest x with 1 + x == 1), so a step
 //   pays no root r^(1/q) unless that bound is the tighter bracket end.
 // - An integer q (mild steel's 5, aluminium's 4) raises x to it by repeated
-//   squaring instead of std::pow: the Newton iterations then cost J2's plus a
-//   few multiplications.
-// - Otherwise Newton runs on x = (Δε̄p/(DΔt))^(1/q), Δε̄p = DΔt xᵠ
+//   squaring instead of std::pow: the iterations then cost J2's plus a few
+//   multiplications.
+// - Otherwise the return iterates on x = (Δε̄p/(DΔt))^(1/q), Δε̄p = DΔt xᵠ
 //   (flow_stress_return.hpp): in Δε̄p the rate factor rises with an infinite
 //   slope at 0 (q > 1), in x it is linear, and a typical explicit step's root
 //   lies at Δε̄p ~ 1e-15 where Newton in Δε̄p would bisect for dozens of steps.
@@ -97,6 +97,7 @@ struct CowperSymonds {
       return {false, 0};
     }
     detail::require_time_step(context.time_step);
+    const double inverse_yield = 1.0 / state.sigma_y;  // the return's stress scale (flow_stress_return.hpp)
     const double trial_equivalent = std::sqrt(von_mises_squared(trial));
     const double sigma_y_n = state.sigma_y, plastic_modulus = parameters_.Ep, q = parameters_.q;
     const double rate_time = parameters_.D * context.time_step;  // DΔt: Δε̄p/(DΔt) = ε̄̇p/D
@@ -117,24 +118,50 @@ struct CowperSymonds {
       return {true, quasi_static.iterations};
     }
     const auto flow = [&](double x) {
-      const double increment = rate_time * power(x);
-      // dΔε̄p/dx = q Δε̄p/x; at x = 0: +inf (q < 1), DΔt (q = 1) or 0.
-      const double increment_slope = x > 0.0 ? q * increment / x : q * rate_time * std::pow(x, q - 1.0);
+      // Δε̄p = DΔt xᵠ, dΔε̄p/dx = q DΔt xᵠ⁻¹, d²Δε̄p/dx² = q(q − 1) DΔt xᵠ⁻²; at
+      // x = 0 the slope is +inf (q < 1), DΔt (q = 1) or 0.
+      const Powers p = powers(x);
+      const double increment = rate_time * p.q;
+      const double increment_slope = q * rate_time * p.q_minus_1;
+      const double increment_curvature = q * (q - 1.0) * rate_time * p.q_minus_2;
       const double quasi_static_flow = sigma_y_n + plastic_modulus * increment;
-      return return_map::FlowStressValue{increment, increment_slope, quasi_static_flow * (1.0 + x),
-                                         plastic_modulus * increment_slope * (1.0 + x) + quasi_static_flow};
+      return return_map::FlowStressValue{
+          increment,
+          increment_slope,
+          increment_curvature,
+          quasi_static_flow * (1.0 + x),
+          plastic_modulus * increment_slope * (1.0 + x) + quasi_static_flow,
+          plastic_modulus * (increment_curvature * (1.0 + x) + 2.0 * increment_slope)};
     };
     // Bracket in x: 0 (g > 0: the trial lies outside σs,n) and the smaller of
-    // bound_x and excess/σs,n; at x = excess/σs,n already σy ≥ σs,n(1 + x) = σ̄*
-    // and uᵢ > σy, so g ≤ 0. Newton starts from the last step's x, σy/σs − 1
-    // (in steady flow the root hardly moves), or from the upper end; the
-    // safeguard keeps it inside the bracket.
-    const double relative_excess = excess / sigma_y_n;
-    const double upper = bound_ratio < power(relative_excess) ? std::pow(bound_ratio, inverse_exponent_) : relative_excess;
+    // bound_x and r = excess/σs,n; at x = r already σy ≥ σs,n(1 + x) = σ̄*
+    // and uᵢ > σy, so g ≤ 0.
+    const double relative_excess = excess * inverse_yield;
+    const double excess_power = power(relative_excess);
+    const bool bound_tighter = bound_ratio < excess_power;
+    const double upper = bound_tighter ? std::pow(bound_ratio, inverse_exponent_) : relative_excess;
+    // The start. Where the overstress carries the excess (the usual impact
+    // regime: κΔε̄p ≪ σs,n x), the surface σ̄ = σy, to first order in κᵢΔε̄p/σy,
+    // is σ̄* − κ̂Δε̄p = σy with κ̂ = (κ₁A + κ₂B)/(A + B) the trial's mean of the
+    // κᵢ (the weights of eq. B.5), i.e. x = r − c xᵠ with c = (κ̂ + Ep(1 + x))DΔt/σs,n.
+    // One step of that fixed point from x = r lands within ρ·c rᵠ of its root,
+    // ρ = q c rᵠ⁻¹ the map's contraction; it is taken where ρ ≤ ¼. Otherwise
+    // the iteration starts from the last step's x, σy/σs − 1 (in steady flow the root
+    // hardly moves), or from the upper end; the safeguard keeps it inside the bracket.
+    const double equibiaxial = 0.25 * (trial.x() + trial.y()) * (trial.x() + trial.y());
+    const double difference = trial.x() - trial.y();
+    const double deviatoric = 0.75 * difference * difference + 3.0 * trial.z() * trial.z();
+    const double mean_stiffness = (constants_.kappa_1 * equibiaxial + constants_.kappa_2 * deviatoric) /
+                                  (equibiaxial + deviatoric);
+    const double overstress_drop =
+        (mean_stiffness + plastic_modulus * (1.0 + relative_excess)) * rate_time * inverse_yield * excess_power;
+    const double predicted = relative_excess - overstress_drop;
     const double last_x = state.flow_stress / state.sigma_y - 1.0;
-    const double start = last_x > 0.0 && last_x < upper ? last_x : upper;
+    const double start = !bound_tighter && q * overstress_drop <= 0.25 * relative_excess && predicted > 0.0
+                             ? predicted
+                             : (last_x > 0.0 && last_x < upper ? last_x : upper);
     const return_map::FlowStressSolution solution =
-        return_map::solve_flow_stress(constants_, trial, flow, start, 0.0, upper);
+        return_map::solve_flow_stress(constants_, trial, inverse_yield, flow, start, 0.0, upper);
     const double increment = solution.plastic_strain_increment;
     state.stress = solution.stress;
     state.eps_p += increment;
@@ -176,12 +203,32 @@ struct CowperSymonds {
   // xᵠ: by repeated squaring for an integer q, else std::pow.
   double power(double x) const {
     if (integer_exponent_ == 0) return std::pow(x, parameters_.q);
+    return integer_power(x, integer_exponent_);
+  }
+  static double integer_power(double x, int exponent) {
     double result = 1.0, square = x;
-    for (int e = integer_exponent_; e > 0; e >>= 1) {
+    for (int e = exponent; e > 0; e >>= 1) {
       if (e & 1) result *= square;
       square *= square;
     }
     return result;
+  }
+  struct Powers {
+    double q, q_minus_1, q_minus_2;  // xᵠ, xᵠ⁻¹, xᵠ⁻²
+  };
+  // xᵠ with the two powers below it: for an integer q ≥ 2 xᵠ⁻² by squaring
+  // and two products, else std::pow and divisions by x (x > 0; at x = 0
+  // std::pow's limits of xᵠ⁻¹ and xᵠ⁻²).
+  Powers powers(double x) const {
+    if (integer_exponent_ >= 2) {
+      const double lowest = integer_power(x, integer_exponent_ - 2);
+      return {lowest * (x * x), lowest * x, lowest};
+    }
+    const double q = parameters_.q;
+    const double top = power(x);
+    if (!(x > 0.0)) return {top, std::pow(x, q - 1.0), std::pow(x, q - 2.0)};
+    const double inverse_x = 1.0 / x;
+    return {top, top * inverse_x, top * inverse_x * inverse_x};
   }
 
   // The largest x with 1 + x == 1 in double (ties round to even): 2⁻⁵³.

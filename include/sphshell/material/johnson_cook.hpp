@@ -10,7 +10,7 @@
 // Choices, and why:
 // - The rate is the plastic one of the step itself, ε̄̇p = Δε̄p/Δt (backward
 //   Euler), and it enters the consistency condition: the return solves
-//   σ̄(Δε̄p) = σy(ε̄p,n + Δε̄p, Δε̄p/Δt) by Newton (flow_stress_return.hpp), the
+//   σ̄(Δε̄p) = σy(ε̄p,n + Δε̄p, Δε̄p/Δt) by Halley iteration (flow_stress_return.hpp), the
 //   consistent form, not the rate of the previous step.
 // - ln ε̇* is taken as 0 for ε̇* < 1, as in common practice (the rate factor
 //   never softens; the fit is made for ε̇* ≥ 1). With no plastic flow the rate
@@ -107,7 +107,8 @@ struct JohnsonCook {
         inverse_temperature_range_(1.0 / (parameters.melting_temperature - parameters.reference_temperature)),
         heating_(parameters.taylor_quinney > 0.0
                      ? parameters.taylor_quinney / (parameters.density * parameters.specific_heat)
-                     : 0.0) {}
+                     : 0.0),
+        power_series_(parameters.n) {}
 
   State initial_state() const {
     const double thermal = thermal_factor(homologous_temperature(parameters_.initial_temperature));
@@ -145,34 +146,46 @@ struct JohnsonCook {
     // which is the one it returns: the hardening of the next elastic limit and
     // the damage's rate term reuse them instead of a second pow() and log().
     double hardening_at_return = parameters_.A, log_rate_at_return = 0.0;
-    // The Newton iterates after the first move by a small fraction of ε̄p and
+    // The iterates after the first move by a small fraction of ε̄p and
     // of Δε̄p: ε̄pⁿ and ln ε̇* follow by short series from their values at the
     // last iterate evaluated exactly (nearby_power, nearby_log) instead of
     // another pow() and log(); each value is within round-off of theirs.
     NearbyPoint power_anchor, log_anchor;
-    const auto flow = [&](double increment) {
+    // Forced inline (its pow() and log() branches keep GCC from it): called, its
+    // six results go through memory at each iterate.
+    const auto flow = [&](double increment) __attribute__((always_inline)) {
       const double eps_p = eps_p_n + increment;
-      const double power = nearby_power(power_anchor, eps_p);
-      const double hardening = parameters_.A + parameters_.B * power;
-      // d(Bε̄pⁿ)/dε̄p; at ε̄p = 0 it is +inf (n < 1), B (n = 1) or 0.
-      const double hardening_slope = eps_p > 0.0 ? parameters_.n * parameters_.B * power / eps_p
+      const NearbyValue power = nearby_power(power_anchor, eps_p);
+      const double hardening = parameters_.A + parameters_.B * power.value;
+      // d(Bε̄pⁿ)/dε̄p and its derivative, (n − 1)/ε̄p times it; at ε̄p = 0 the
+      // slope is +inf (n < 1), B (n = 1) or 0.
+      const double hardening_slope = eps_p > 0.0 ? parameters_.n * parameters_.B * power.value * power.inverse
                                                  : parameters_.n * parameters_.B * std::pow(eps_p, parameters_.n - 1.0);
+      const double hardening_curvature = (parameters_.n - 1.0) * hardening_slope * power.inverse;
       const double rate = increment * rate_per_increment;
       const bool rate_active = rate > 1.0;  // ln ε̇* taken as 0 below ε̇* = 1
-      const double log_rate = rate_active ? nearby_log(log_anchor, rate) : 0.0;
-      const double rate_factor = rate_active ? 1.0 + parameters_.C * log_rate : 1.0;
-      const double rate_slope = rate_active ? parameters_.C / increment : 0.0;
+      const NearbyValue log_rate = rate_active ? nearby_log(log_anchor, rate) : NearbyValue{0.0, 0.0};
+      const double rate_factor = 1.0 + parameters_.C * log_rate.value;
+      // d(1 + C ln ε̇*)/dΔε̄p = C/Δε̄p and its derivative −C/Δε̄p² (1/Δε̄p from 1/ε̇*).
+      const double inverse_increment = rate_per_increment * log_rate.inverse;
+      const double rate_slope = parameters_.C * inverse_increment;
+      const double rate_curvature = -rate_slope * inverse_increment;
       hardening_at_return = hardening;
-      log_rate_at_return = log_rate;
+      log_rate_at_return = log_rate.value;
       return return_map::FlowStressValue{
-          increment, 1.0, hardening * rate_factor * thermal,
-          (hardening_slope * rate_factor + hardening * rate_slope) * thermal};
+          increment,
+          1.0,
+          0.0,
+          hardening * rate_factor * thermal,
+          (hardening_slope * rate_factor + hardening * rate_slope) * thermal,
+          (hardening_curvature * rate_factor + 2.0 * hardening_slope * rate_slope + hardening * rate_curvature) *
+              thermal};
     };
     // Started from the last step's Δε̄p at the same rate (0 after an elastic step or
     // in the quasi-static limit: then from the perfectly plastic return).
     const double guess = state.strain_rate * context.time_step;
-    const return_map::FlowStressSolution solution =
-        return_map::solve_flow_stress(constants_, trial, flow, std::sqrt(trial_squared) - quasi_static, guess);
+    const return_map::FlowStressSolution solution = return_map::solve_flow_stress(
+        constants_, trial, 1.0 / quasi_static, flow, std::sqrt(trial_squared) - quasi_static, guess);
     const double increment = solution.plastic_strain_increment;
 
     state.eps_p = eps_p_n + increment;
@@ -251,43 +264,72 @@ struct JohnsonCook {
   }
 
  private:
-  // A point where a function was evaluated exactly (argument 0: none yet).
+  // A point where a function was evaluated exactly (argument 0: none yet),
+  // with the reciprocal of its argument.
   struct NearbyPoint {
     double argument = 0.0;
+    double inverse = 0.0;
     double value = 0.0;
   };
-  // Relative distance from the anchor below which the series replace pow()
-  // and log(): their first omitted terms, |C(n,5)|δ⁵ and δ⁶/6, are then below
-  // 1e-16 of the value for 0 < n ≤ max_series_exponent.
+  // A function's value at x and 1/x (the derivatives' factor), the latter
+  // within δ⁴ ≤ 1e-12 of itself: only the corrections use it.
+  struct NearbyValue {
+    double value;
+    double inverse;
+  };
+  // Relative distance from the anchor below which the series of ln(1 + δ)
+  // to δ⁵ replaces log(): its first omitted term, δ⁶/6, is then below 2e-19.
   static constexpr double series_reach = 1e-3;
-  static constexpr double max_series_exponent = 6.0;
 
-  // xⁿ, from the anchor's value by the binomial series of (1 + δ)ⁿ to δ⁴ when
-  // x is within series_reach of it, else by std::pow (and x becomes the anchor).
-  double nearby_power(NearbyPoint& anchor, double x) const {
-    const double n = parameters_.n;
-    if (anchor.argument > 0.0 && n <= max_series_exponent) {
-      const double delta = (x - anchor.argument) / anchor.argument;
-      if (std::abs(delta) <= series_reach) {
-        const double series =
-            1.0 + n * delta * (1.0 + (n - 1.0) * delta / 2.0 * (1.0 + (n - 2.0) * delta / 3.0 * (1.0 + (n - 3.0) * delta / 4.0)));
-        return anchor.value * series;
+  // The binomial series of (1 + δ)ⁿ to δ⁶: its coefficients C(n, k) and its
+  // reach, the largest |δ| (at most 1e-2) with |C(n, 7)δ⁷| ≤ 2⁻⁵⁴ and each
+  // further term below half the one before (|(n − k)δ/(k + 1)| ≤ ½ for k ≥ 7).
+  struct PowerSeries {
+    explicit PowerSeries(double n) {
+      double c = 1.0;
+      for (int k = 0; k < 7; ++k) {
+        coefficients[k] = c;
+        c *= (n - k) / (k + 1);
+      }
+      reach = std::min(1e-2, 4.0 / std::max(std::abs(n - 7.0), 1.0));
+      if (c != 0.0) reach = std::min(reach, std::pow(0.25 * std::numeric_limits<double>::epsilon() / std::abs(c), 1.0 / 7.0));
+    }
+    double coefficients[7];
+    double reach;
+  };
+
+  // 1/x from the anchor's reciprocal, 1/(a(1 + δ)) = (1/a)(1 − δ + δ² − δ³).
+  static double nearby_inverse(const NearbyPoint& anchor, double delta) {
+    return anchor.inverse * (1.0 - delta * (1.0 - delta * (1.0 - delta)));
+  }
+  // xⁿ, from the anchor's value by the binomial series (PowerSeries, in
+  // Estrin's grouping) when x is within its reach, else by std::pow (and x
+  // becomes the anchor).
+  NearbyValue nearby_power(NearbyPoint& anchor, double x) const {
+    if (anchor.argument > 0.0) {
+      const double delta = x * anchor.inverse - 1.0;
+      if (std::abs(delta) <= power_series_.reach) {
+        const double* c = power_series_.coefficients;
+        const double delta_2 = delta * delta, delta_4 = delta_2 * delta_2;
+        const double series = (1.0 + c[1] * delta) + delta_2 * (c[2] + c[3] * delta) +
+                              delta_4 * ((c[4] + c[5] * delta) + delta_2 * c[6]);
+        return {anchor.value * series, nearby_inverse(anchor, delta)};
       }
     }
-    anchor = {x, std::pow(x, n)};
-    return anchor.value;
+    anchor = {x, 1.0 / x, std::pow(x, parameters_.n)};
+    return {anchor.value, anchor.inverse};
   }
   // ln x, from the anchor's by the series of ln(1 + δ) to δ⁵ when x is within
   // series_reach of it, else by std::log (and x becomes the anchor).
-  static double nearby_log(NearbyPoint& anchor, double x) {
+  static NearbyValue nearby_log(NearbyPoint& anchor, double x) {
     if (anchor.argument > 0.0) {
-      const double delta = (x - anchor.argument) / anchor.argument;
+      const double delta = x * anchor.inverse - 1.0;
       if (std::abs(delta) <= series_reach)
-        return anchor.value +
-               delta * (1.0 - delta * (0.5 - delta * (1.0 / 3.0 - delta * (0.25 - delta * 0.2))));
+        return {anchor.value + delta * (1.0 - delta * (0.5 - delta * (1.0 / 3.0 - delta * (0.25 - delta * 0.2)))),
+                nearby_inverse(anchor, delta)};
     }
-    anchor = {x, std::log(x)};
-    return anchor.value;
+    anchor = {x, 1.0 / x, std::log(x)};
+    return {anchor.value, anchor.inverse};
   }
 
   static void validate(const Parameters& p) {
@@ -346,6 +388,7 @@ struct JohnsonCook {
   return_map::ClosedFormConstants constants_;  // κᵢ of ΓΞ (Ep unused)
   double inverse_temperature_range_;          // 1/(Tm − Tr)
   double heating_;                             // β/(ρ cp), 0 without heating
+  PowerSeries power_series_;                   // of ε̄pⁿ near an anchor
 };
 
 }  // namespace sphshell::material
