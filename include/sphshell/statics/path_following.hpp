@@ -338,7 +338,9 @@ class PathFollower {
 
   // Hands every converged step's PathPoint to `observer` (an empty function:
   // none), with the stability when asked. The first point with the
-  // stability has no event (nothing to compare with).
+  // stability has no event (nothing to compare with). The observer is called
+  // at the converged state, which it must leave as it is; what it throws
+  // reaches the caller with the solver at that state.
   void observe(std::function<void(const PathPoint&)> observer, PathStability stability = PathStability::skip) {
     observer_ = std::move(observer);
     observed_stability_ = stability;
