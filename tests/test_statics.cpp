@@ -810,7 +810,7 @@ TEST_CASE("Statics: the hinged roof's snap-through is flagged as a limit point w
     }
     std::printf("Hinged roof 9 x 9: load factors with and without the observer differ by %.2e at most (relative)\n",
                 largest);
-    CHECK(largest < 1e-9);
+    CHECK(largest < 1e-12);  // measured 4.6e-14
   }
   std::size_t flagged = 0, highest = 0;
   for (std::size_t k = 0; k < points.size(); ++k) {
