@@ -11,8 +11,10 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -683,5 +685,238 @@ TEST_CASE("Statics: the tangent's product by differences equals the assembled ta
     const Eigen::VectorXd expected = k * unit;
     const Eigen::VectorXd along = assembly.tangent_product(dofs, x0, d0, unit);
     CHECK((along - expected).norm() <= 1e-6 * expected.norm());
+  }
+}
+
+TEST_CASE("Statics: the observer sees each converged point in order, and a bifurcation where the compressed strip "
+          "passes Euler's load",
+          "[statics]") {
+  // The strip under an axial tip load of 1 N, followed by load control in
+  // steps of 0.6 N: the observer's points must be numbered from 1, one per
+  // converged step, with the follower's load factor, residual and Newton
+  // updates. Along the straight path the tangent has one negative eigenvalue
+  // above Euler's load P_cr = π²EI/(4L²) = 2.467 N and none below (the
+  // points at 2.4 and 3.0 N lie 2.7 % below and 22 % above it); the change is
+  // a bifurcation: the buckling mode is transverse, no work on the axial load.
+  Strip strip(21, 3);
+  strip.compress_tip(1.0);
+  const double P_cr = pi * pi * strip.EI() / (4.0 * Strip::L * Strip::L);
+  NonlinearSolver solver(strip.model, {Strip::E, 0.0});
+  statics::PathFollower<NonlinearSolver> path(solver, strip.conditions);
+  std::vector<statics::PathPoint> points;
+  path.observe([&points](const statics::PathPoint& point) { points.push_back(point); },
+               statics::PathStability::compute);
+  for (int k = 1; k <= 5; ++k) {
+    path.solve_to(0.6 * k, 0.6);
+    REQUIRE(points.size() == static_cast<std::size_t>(k));
+    const statics::PathPoint& point = points.back();
+    std::printf("Compressed strip, step %d: P = %.3f N, %d negative eigenvalues, load share %.3e, event %d\n",
+                point.step, point.load_factor, point.negative_eigenvalues, point.load_share,
+                static_cast<int>(point.event));
+    CHECK(point.step == k);
+    CHECK(path.steps_taken() == k);
+    CHECK(point.load_factor == path.load_factor());
+    CHECK(point.control == statics::PathControl::load);
+    CHECK(std::isnan(point.control_value));
+    CHECK(point.relative_residual <= statics::NewtonOptions{}.tolerance);
+    CHECK(point.relative_residual == path.last_relative_residual());
+    CHECK(point.iterations == path.last_iterations());
+    CHECK(point.negative_eigenvalues == (point.load_factor > P_cr ? 1 : 0));
+    CHECK(point.event == (k == 5 ? statics::PathEvent::bifurcation : statics::PathEvent::none));
+  }
+  // Without the stability the points carry none.
+  path.observe([&points](const statics::PathPoint& point) { points.push_back(point); });
+  path.solve_to(3.3, 0.3);
+  REQUIRE(points.size() == 6);
+  CHECK(points.back().step == 6);
+  CHECK(points.back().negative_eigenvalues == -1);
+  CHECK(std::isnan(points.back().load_share));
+  CHECK(points.back().event == statics::PathEvent::none);
+}
+
+TEST_CASE("Statics: the hinged roof's snap-through is flagged as a limit point where the load factor turns, and "
+          "the path's CSV reads back as the observed points",
+          "[statics]") {
+  // One quarter of the hinged cylindrical roof of Sze, Liu & Lo (2004, §3.8,
+  // t = 12.7; R = 2540, an opening of 0.1 rad either side of the crown, 2L =
+  // 508, straight edges hinged, curved edges free, E = 3102.75, ν = 0.3),
+  // 9 × 9 particles, P/4 = 750 on the centre particle, the centre's inward
+  // deflection prescribed in steps of 1 to 14, past the load's maximum. The
+  // count of negative eigenvalues must change once, from 0 to 1, flagged as
+  // a limit point at the first point past the maximum of the load factor, as
+  // the test finds it independently: the slope of the path dλ/dw at each
+  // point, 1 / (g · K⁻¹ f) with K the tangent (solved by LU), f the load and
+  // g the control's gradient, must change sign there and only there; and the
+  // vertex of the parabola through the highest point and its two neighbours
+  // must lie between the flagged point and the one before it.
+  const double R = 2540.0, half_length = 254.0, theta = 0.1, t = 12.7, P = 3000.0, step = 1.0;
+  const int n = 9;
+  const ShellModel model = ShellModel::cylindrical_panel(R, half_length, theta, n, n, t);
+  REQUIRE((model.particle_position[0] - Vector3(R, 0.0, 0.0)).norm() < 1e-9 * R);
+  statics::Conditions conditions(model.particle_count());
+  conditions.symmetry_plane(model.set("theta_min"), Vector3::UnitY());
+  conditions.symmetry_plane(model.set("z_min"), Vector3::UnitZ());
+  for (const Vector3& direction : {Vector3(Vector3::UnitX()), Vector3(Vector3::UnitY()), Vector3(Vector3::UnitZ())})
+    conditions.hold_translation(model.set("theta_max"), direction);
+  conditions.add_force({0}, Vector3(-P / 4.0, 0.0, 0.0));
+  NonlinearSolver solver(model, {3102.75, 0.3});
+  statics::PathFollower<NonlinearSolver> path(solver, conditions);
+  const statics::ControlDisplacement centre{{{0, 1.0}}, -Vector3::UnitX()};
+  const std::filesystem::path file = std::filesystem::temp_directory_path() / "sphshell_statics_roof_path.csv";
+  std::vector<statics::PathPoint> points;
+  statics::PathCsv csv(file.string());
+  path.observe(
+      [&points, csv](const statics::PathPoint& point) mutable {
+        points.push_back(point);
+        csv(point);
+      },
+      statics::PathStability::compute);
+  // The slope dλ/dw of the path at the current point.
+  auto slope = [&path, &centre]() {
+    statics::TangentAssembly<NonlinearSolver>& assembly = path.assembly();
+    const statics::DegreesOfFreedom dofs = assembly.degrees_of_freedom();
+    statics::SparseMatrix K = assembly.tangent(dofs);
+    K.makeCompressed();
+    Eigen::SparseLU<statics::SparseMatrix> lu(K);
+    REQUIRE(lu.info() == Eigen::Success);
+    const Eigen::VectorXd response = lu.solve(assembly.external_load(dofs));
+    double along_control = 0.0;
+    for (const auto& [particle, weight] : centre.weights)
+      for (int k = dofs.first[particle]; k < dofs.first[particle + 1]; ++k)
+        if (!dofs.is_rotation[k]) along_control += weight * centre.direction.dot(dofs.direction[k]) * response[k];
+    return 1.0 / along_control;
+  };
+  std::vector<double> slopes;
+  for (int k = 1; k <= 14; ++k) {
+    path.solve_to_displacement(centre, step * k, step);
+    REQUIRE(points.size() == static_cast<std::size_t>(k));  // one step a call: a slope for every point
+    slopes.push_back(slope());
+    CHECK(points.back().load_factor == path.load_factor());
+    CHECK(points.back().control == statics::PathControl::displacement);
+    CHECK(points.back().control_value == path.displacement_of(centre));
+  }
+  // Observing (the stability at each point, and the slopes above) leaves the
+  // path as it is, to round-off: the same steps without them reach the same
+  // load factors. (Not bit for bit: each tangent assembly puts the
+  // configuration back through Solver::set_configuration, which normalises
+  // the directors again, an ulp's change.)
+  {
+    NonlinearSolver unobserved_solver(model, {3102.75, 0.3});
+    statics::PathFollower<NonlinearSolver> unobserved(unobserved_solver, conditions);
+    double largest = 0.0;
+    for (int k = 1; k <= 14; ++k) {
+      unobserved.solve_to_displacement(centre, step * k, step);
+      largest = std::max(largest, std::abs(unobserved.load_factor() / points[k - 1].load_factor - 1.0));
+    }
+    std::printf("Hinged roof 9 x 9: load factors with and without the observer differ by %.2e at most (relative)\n",
+                largest);
+    CHECK(largest < 1e-12);  // measured 4.6e-14
+  }
+  std::size_t flagged = 0, highest = 0;
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const statics::PathPoint& point = points[k];
+    std::printf("Hinged roof 9 x 9, step %d: -W_C = %.3f, P/P_max = %.5f, slope %+.4e, %d negative eigenvalues, "
+                "load share %.3e, event %d\n",
+                point.step, point.control_value, point.load_factor, slopes[k], point.negative_eigenvalues,
+                point.load_share, static_cast<int>(point.event));
+    CHECK(point.step == static_cast<int>(k) + 1);
+    if (point.event != statics::PathEvent::none && flagged == 0) flagged = k;
+  }
+  while (highest + 1 < points.size() && points[highest + 1].load_factor > points[highest].load_factor) ++highest;
+  REQUIRE(highest > 0);
+  REQUIRE(highest + 1 < points.size());  // the path went past its maximum
+  REQUIRE(flagged > 0);
+  CHECK(points[flagged].event == statics::PathEvent::limit_point);
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    CHECK(points[k].negative_eigenvalues == (k < flagged ? 0 : 1));
+    CHECK((slopes[k] > 0.0) == (k < flagged));
+  }
+  // The parabola through the highest point and its neighbours.
+  const double s0 = points[highest - 1].control_value, s1 = points[highest].control_value,
+               s2 = points[highest + 1].control_value;
+  const double l0 = points[highest - 1].load_factor, l1 = points[highest].load_factor,
+               l2 = points[highest + 1].load_factor;
+  const double d01 = (l1 - l0) / (s1 - s0), d12 = (l2 - l1) / (s2 - s1), curvature = (d12 - d01) / (s2 - s0);
+  const double vertex = 0.5 * (s0 + s1) - d01 / (2.0 * curvature);
+  std::printf("Hinged roof 9 x 9: the load's maximum near -W_C = %.3f (parabola), flagged at step %d\n", vertex,
+              points[flagged].step);
+  REQUIRE(curvature < 0.0);
+  CHECK(points[flagged - 1].control_value < vertex);
+  CHECK(vertex < points[flagged].control_value);
+
+  // The CSV, read while its writer is still open (each row is flushed).
+  std::ifstream in(file);
+  std::string line;
+  REQUIRE(std::getline(in, line));
+  std::string header;
+  for (const std::string& column : statics::PathCsv::columns()) header += (header.empty() ? "" : ",") + column;
+  CHECK(line == header);
+  std::size_t rows = 0;
+  while (std::getline(in, line)) {
+    REQUIRE(rows < points.size());
+    std::vector<double> values;
+    std::size_t begin = 0;
+    for (std::size_t comma; (comma = line.find(',', begin)) != std::string::npos; begin = comma + 1)
+      values.push_back(std::strtod(line.substr(begin, comma - begin).c_str(), nullptr));
+    values.push_back(std::strtod(line.substr(begin).c_str(), nullptr));
+    REQUIRE(values.size() == 10);
+    const statics::PathPoint& point = points[rows++];
+    CHECK(values[0] == point.step);
+    CHECK(values[1] == point.load_factor);
+    CHECK(values[2] == static_cast<int>(point.control));
+    CHECK(values[3] == point.control_value);
+    CHECK(values[4] == point.relative_residual);
+    CHECK(values[5] == point.iterations);
+    CHECK(values[6] == point.negative_eigenvalues);
+    CHECK(values[7] == point.eigenvalue_nearest_zero);
+    CHECK(values[8] == point.load_share);
+    CHECK(values[9] == static_cast<int>(point.event));
+  }
+  CHECK(rows == points.size());
+  CHECK_THROWS_WITH(statics::PathCsv((file / "no_such_directory" / "path.csv").string()),
+                    Catch::Contains("no_such_directory"));
+}
+
+TEST_CASE("Statics: the automatic arc length follows l sqrt(target / used) within its bounds", "[statics]") {
+  using statics::ArcLengthAdaptation;
+  using statics::adapted_arc_length;
+  // The rule on exact figures: √(4/16) = 1/2, √(4/1) = 2, √(1/9) = 1/3.
+  CHECK(adapted_arc_length(1.0, 16, {0.1, 2.0, 4}) == 0.5);
+  CHECK(adapted_arc_length(1.0, 1, {0.1, 3.0, 4}) == 2.0);
+  CHECK(adapted_arc_length(1.0, 0, {0.1, 3.0, 4}) == 2.0);  // no update counts as one
+  CHECK(adapted_arc_length(0.3, 9, {0.01, 1.0, 1}) == Approx(0.1).epsilon(1e-15));
+  CHECK(adapted_arc_length(1.0, 1, {0.1, 1.5, 4}) == 1.5);    // the upper bound
+  CHECK(adapted_arc_length(1.0, 400, {0.2, 2.0, 4}) == 0.2);  // the lower bound (0.1 before it)
+  CHECK_THROWS_WITH(adapted_arc_length(1.0, 4, {0.0, 1.0, 4}), Catch::Contains("ArcLengthAdaptation::min_length = 0"));
+  CHECK_THROWS_WITH(adapted_arc_length(1.0, 4, {0.5, 0.25, 4}),
+                    Catch::Contains("ArcLengthAdaptation::max_length = 0.25") && Catch::Contains("min_length"));
+  CHECK_THROWS_WITH(adapted_arc_length(1.0, 4, {0.5, std::numeric_limits<double>::infinity(), 4}),
+                    Catch::Contains("ArcLengthAdaptation::max_length = inf"));
+  CHECK_THROWS_WITH(adapted_arc_length(1.0, 4, {0.5, 1.0, 0}),
+                    Catch::Contains("ArcLengthAdaptation::target_iterations = 0"));
+  // On the strip under a tip force: each next length from the last step's
+  // length and the Newton updates the observer saw it take.
+  Strip strip(11, 3);
+  strip.conditions.add_force(strip.model.set("x_max"), Vector3(0.0, 0.0, 1.0 / 3.0));
+  NonlinearSolver solver(strip.model, {Strip::E, 0.0});
+  statics::PathFollower<NonlinearSolver> path(solver, strip.conditions);
+  CHECK_THROWS_WITH(path.next_arc_length({0.05, 1.0, 4}), Catch::Contains("needs an arc-length step"));
+  std::vector<statics::PathPoint> points;
+  path.observe([&points](const statics::PathPoint& point) { points.push_back(point); });
+  const ArcLengthAdaptation rule{0.05, 0.6, 3};
+  double length = 0.3, travelled = 0.0;
+  for (int k = 1; k <= 4; ++k) {
+    const double taken = path.arc_length_step(length);
+    travelled += taken;
+    REQUIRE(points.size() == static_cast<std::size_t>(k));
+    CHECK(points.back().control == statics::PathControl::arc_length);
+    CHECK(points.back().control_value == Approx(travelled).epsilon(1e-14));
+    const int used = std::max(1, points.back().iterations);
+    const double expected = std::min(0.6, std::max(0.05, taken * std::sqrt(3.0 / used)));
+    const double next = path.next_arc_length(rule);
+    std::printf("Strip, arc-length step %d of %.4f took %d updates: next %.4f\n", k, taken,
+                points.back().iterations, next);
+    CHECK(next == Approx(expected).epsilon(1e-15));
+    length = next;
   }
 }

@@ -27,6 +27,13 @@
 // of its last attempt and the iteration that reached it (the state after that
 // many Newton updates, 0 the attempt's start), and the solver is left at the
 // last converged state.
+//
+// An observer (PathFollower::observe) receives a PathPoint after each
+// converged step: its number, the load factor, the control, the residual
+// reached, the iterations taken and, when asked, the stability with the
+// limit and bifurcation points flagged. PathCsv (statics/path_csv.hpp) writes
+// the points as CSV. adapted_arc_length chooses the next arc length from the
+// iterations the last step took.
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/statics/conditions.hpp>
@@ -39,6 +46,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -87,7 +95,78 @@ struct NewtonOptions {
   bool trace = false;
 };
 
+// The control of a path's step.
+enum class PathControl {
+  load,          // solve_to: the load factor prescribed
+  displacement,  // solve_to_displacement: a ControlDisplacement prescribed
+  arc_length     // arc_length_step
+};
+
+// A change of the number of negative eigenvalues of the tangent between two
+// converged points: the path crossed a critical point between them, told apart
+// by the mode of the eigenvalue nearest zero at the later point
+// (Stability::load_share, |φ·f|/(‖φ‖‖f‖)): at a limit point of the load the
+// critical mode does work on the load (φ·f ≠ 0), at a bifurcation it does not
+// (φ·f = 0; Riks, IJSS 15 (1979) 529–551, §3). A share below
+// detail::bifurcation_load_share is a bifurcation.
+enum class PathEvent { none, limit_point, bifurcation };
+
+// Whether the observer's points carry the stability (each costs an assembly
+// and an LDLᵀ factorisation of the tangent, and the inverse iteration of
+// statics::stability).
+enum class PathStability { skip, compute };
+
+// A converged point of the path, as the observer receives it.
+struct PathPoint {
+  int step = 0;             // this follower's converged steps, counted from 1
+  double load_factor = 0.0;
+  PathControl control = PathControl::load;
+  // m: the control displacement (PathControl::displacement), or the arc
+  // length travelled, the sum of this follower's arc-length steps (their
+  // root-mean-square motions; PathControl::arc_length); NaN under load control.
+  double control_value = std::numeric_limits<double>::quiet_NaN();
+  double relative_residual = 0.0;  // ‖r‖ / ‖λ f_ext‖ at the point
+  int iterations = 0;              // Newton updates of the step's converged attempt
+  // With PathStability::compute (else -1 and NaN): statics::stability at the point.
+  int negative_eigenvalues = -1;
+  double eigenvalue_nearest_zero = std::numeric_limits<double>::quiet_NaN();
+  double load_share = std::numeric_limits<double>::quiet_NaN();
+  // Against the observed point before (none at the first one computed).
+  PathEvent event = PathEvent::none;
+};
+
+// The bounds of the automatic arc length (adapted_arc_length).
+struct ArcLengthAdaptation {
+  double min_length = 0.0;     // m, finite and > 0
+  double max_length = 0.0;     // m, finite and >= min_length
+  int target_iterations = 4;   // Newton updates a step should take, >= 1
+};
+
+// The next arc length from the last one, `length`, and the Newton updates
+// its step took, `iterations_used` (Crisfield, Comput. Struct. 13 (1981)
+// 55–62): ℓ_next = ℓ · √(target / used), used counted as at least 1, then
+// bounded to [min_length, max_length]. Bad bounds are an Error naming them.
+inline double adapted_arc_length(double length, int iterations_used, const ArcLengthAdaptation& rule) {
+  sphshell::detail::require_positive("ArcLengthAdaptation::min_length", rule.min_length);
+  if (!(std::isfinite(rule.max_length) && rule.max_length >= rule.min_length))
+    sphshell::detail::invalid_parameter("ArcLengthAdaptation::max_length", rule.max_length,
+                                        "must be finite and >= ArcLengthAdaptation::min_length = " +
+                                            std::to_string(rule.min_length));
+  if (rule.target_iterations < 1)
+    sphshell::detail::invalid_parameter("ArcLengthAdaptation::target_iterations", rule.target_iterations,
+                                        "must be >= 1");
+  sphshell::detail::require_positive("arc length", length);
+  if (iterations_used < 0)
+    sphshell::detail::invalid_parameter("iterations used", iterations_used, "must be >= 0");
+  const double used = std::max(1, iterations_used);
+  return std::clamp(length * std::sqrt(rule.target_iterations / used), rule.min_length, rule.max_length);
+}
+
 namespace detail {
+
+// A critical point whose mode's load share (Stability::load_share) is below
+// this is a bifurcation, else a limit point (PathEvent).
+inline constexpr double bifurcation_load_share = 1e-3;
 
 // A relative residual this much above a displacement-control step's smallest
 // so far means the iteration left the path's basin (a wrong branch, a wild
@@ -152,6 +231,7 @@ class PathFollower {
             return true;
           },
           [&](double) { return "Newton did not converge at load factor " + std::to_string(target); });
+      converged_step(PathControl::load, std::numeric_limits<double>::quiet_NaN());
       increment = std::min(step, detail::step_growth * taken);
     }
   }
@@ -187,6 +267,7 @@ class PathFollower {
                    std::to_string(lambda_) + ")";
           });
       value = next;
+      converged_step(PathControl::displacement, displacement_of(control));
       increment = std::min(step, detail::step_growth * taken);
     }
   }
@@ -227,7 +308,7 @@ class PathFollower {
     const double last_length = previous_.x.empty() ? 0.0 : norm / particles;
     // The control is 0 where the step begins (direction.start).
     direction.start = displacement_of(direction);
-    return step_with_halving(
+    const double taken = step_with_halving(
         length, 0.0,
         [&](double trial) {
           if (last_length > 0.0) {
@@ -240,7 +321,37 @@ class PathFollower {
           return "Newton did not converge on an arc-length step of " + std::to_string(trial) + " (load factor " +
                  std::to_string(lambda_) + ")";
         });
+    last_arc_length_ = taken;
+    arc_length_travelled_ += taken;
+    converged_step(PathControl::arc_length, arc_length_travelled_);
+    return taken;
   }
+
+  // The arc length for the next step by adapted_arc_length from the last
+  // arc-length step's length and its Newton updates (an Error before any).
+  double next_arc_length(const ArcLengthAdaptation& rule) const {
+    if (!(last_arc_length_ > 0.0))
+      sphshell::detail::invalid_parameter("arc length of the last step", last_arc_length_,
+                                          "next_arc_length needs an arc-length step before it");
+    return adapted_arc_length(last_arc_length_, last_converged_.iterations, rule);
+  }
+
+  // Hands every converged step's PathPoint to `observer` (an empty function:
+  // none), with the stability when asked. The first point with the
+  // stability has no event (nothing to compare with). The observer is called
+  // at the converged state, which it must leave as it is; what it throws
+  // reaches the caller with the solver at that state.
+  void observe(std::function<void(const PathPoint&)> observer, PathStability stability = PathStability::skip) {
+    observer_ = std::move(observer);
+    observed_stability_ = stability;
+    previous_negative_eigenvalues_ = -1;
+  }
+
+  // The last converged step's number (counted from 1; 0 before any), its
+  // relative residual and Newton updates.
+  int steps_taken() const { return steps_; }
+  double last_relative_residual() const { return last_converged_.relative; }
+  int last_iterations() const { return last_converged_.iterations; }
 
   // One Newton step from the current configuration at load factor lambda on
   // the symmetrised tangent (LDLᵀ): K u = λ f at the reference state, the
@@ -284,6 +395,30 @@ class PathFollower {
   TangentAssembly<Solver>& assembly() { return assembly_; }
 
  private:
+  // A step converged: counted, and its point handed to the observer.
+  void converged_step(PathControl control, double control_value) {
+    ++steps_;
+    if (!observer_) return;
+    PathPoint point;
+    point.step = steps_;
+    point.load_factor = lambda_;
+    point.control = control;
+    point.control_value = control_value;
+    point.relative_residual = last_converged_.relative;
+    point.iterations = last_converged_.iterations;
+    if (observed_stability_ == PathStability::compute) {
+      const Stability state = stability();
+      point.negative_eigenvalues = state.negative_eigenvalues;
+      point.eigenvalue_nearest_zero = state.eigenvalue_nearest_zero;
+      point.load_share = state.load_share;
+      if (previous_negative_eigenvalues_ >= 0 && state.negative_eigenvalues != previous_negative_eigenvalues_)
+        point.event = state.load_share < detail::bifurcation_load_share ? PathEvent::bifurcation
+                                                                         : PathEvent::limit_point;
+      previous_negative_eigenvalues_ = state.negative_eigenvalues;
+    }
+    observer_(point);
+  }
+
   // At the unloaded start a mechanism (a free rigid-body motion) makes every
   // method fail; it is named before anything moves.
   bool at_start() const { return previous_.x.empty() && lambda_ == 0.0; }
@@ -363,7 +498,10 @@ class PathFollower {
         note_residual(iteration, relative);
         if (relative > detail::control_divergence * smallest) return false;
         smallest = std::min(smallest, relative);
-        if (relative <= options_.tolerance && std::abs(gap) <= options_.tolerance * std::abs(target)) return true;
+        if (relative <= options_.tolerance && std::abs(gap) <= options_.tolerance * std::abs(target)) {
+          last_converged_ = {relative, iteration};
+          return true;
+        }
       }
       // The kept factorisation's degrees of freedom (they follow the
       // directors, so they may lag the current ones by its age).
@@ -423,7 +561,10 @@ class PathFollower {
       if (iteration == 0) assembly_.report().load_step_start_residual = relative;
       if (!std::isfinite(relative)) return false;
       note_residual(iteration, relative);
-      if (relative <= options_.tolerance) return true;
+      if (relative <= options_.tolerance) {
+        last_converged_ = {relative, iteration};
+        return true;
+      }
       if (options_.trace)
         std::fprintf(stderr, "  iteration %d: load factor %.8g, relative residual %.3e\n", iteration, lambda, relative);
       if (relative > detail::load_divergence) return false;
@@ -565,6 +706,15 @@ class PathFollower {
     double lambda = 0.0;
     double control = 0.0;  // the control displacement (displacement control)
   } previous_;  // the converged state before the current one
+  struct LastConverged {
+    double relative = std::numeric_limits<double>::quiet_NaN();
+    int iterations = 0;
+  } last_converged_;  // the last converged attempt's relative residual and Newton updates
+  int steps_ = 0;     // converged steps
+  double last_arc_length_ = 0.0, arc_length_travelled_ = 0.0;
+  std::function<void(const PathPoint&)> observer_;
+  PathStability observed_stability_ = PathStability::skip;
+  int previous_negative_eigenvalues_ = -1;  // at the last observed point with the stability
 };
 
 }  // namespace sphshell::statics
