@@ -555,12 +555,7 @@ TEST_CASE("tube crush: a thin tube (D/t = 40) folds stably, its mean crush force
   // the flanks of its folds close onto each other (the self contact's sides,
   // edge shares and patch cover, docs/method.md §12), where thin tubes' runs
   // went unstable.
-  TubeCrush tube;
-  tube.thickness = 1.25e-3;
-  tube.length = 0.04;
-  tube.spacing = 4e-3;
-  tube.crush = 0.02;
-  check_tube_crush(tube);
+  check_tube_crush({/*thickness*/ 1.25e-3, /*length*/ 0.04, /*spacing*/ 4e-3, /*crush*/ 0.02});
 }
 
 TEST_CASE("tube crush: a thin tube (D/t = 50) folds axisymmetrically, its mean crush force within 15 % of Guillow's",
@@ -568,12 +563,7 @@ TEST_CASE("tube crush: a thin tube (D/t = 50) folds axisymmetrically, its mean c
   // t 1 mm, 30 mm long, 2 mm spacing (79 × 16 particles), crushed 15 mm: a
   // spacing of two thicknesses (at 3 mm, three, the run stops unstable,
   // docs/validation.md).
-  TubeCrush tube;
-  tube.thickness = 1e-3;
-  tube.length = 0.03;
-  tube.spacing = 2e-3;
-  tube.crush = 0.015;
-  check_tube_crush(tube);
+  check_tube_crush({/*thickness*/ 1e-3, /*length*/ 0.03, /*spacing*/ 2e-3, /*crush*/ 0.015});
 }
 
 namespace {
