@@ -332,6 +332,148 @@ TEST_CASE("Johnson-Cook: the damage increment uses the step's rate and temperatu
   CHECK(state.D > 0.01);
 }
 
+namespace {
+
+// The plane-stress return of a trial stress σ* for the Johnson–Cook flow stress
+// at T = Tr, independently of the law's eigen-decomposition and iteration: the
+// literal matrices of eq. (2.32–2.33), σ(Δε̄p) = (I + (Δε̄p/σs) Γ Ξ)⁻¹ σ*
+// (engineering shear, Ξ the von Mises matrix), solved by Cramer's rule in long
+// double, and the root of σ̄(σ(Δε̄p))/σs(Δε̄p) − 1 found by bisection on ln Δε̄p.
+struct ReferenceReturn {
+  long double increment;    // Δε̄p
+  long double flow_stress;  // σs(ε̄p,n + Δε̄p, Δε̄p/Δt)
+  long double stress[3];
+  long double sensitivity;  // d(σ̄/σs)/d ln Δε̄p at the root
+};
+
+long double jc_flow_stress_long(const JohnsonCook::Parameters& p, long double eps_p_n, long double increment,
+                                double time_step) {
+  const long double rate = increment / (static_cast<long double>(time_step) * p.reference_strain_rate);
+  const long double rate_factor = rate > 1.0L ? 1.0L + p.C * std::log(rate) : 1.0L;
+  return (p.A + p.B * std::pow(eps_p_n + increment, static_cast<long double>(p.n))) * rate_factor;
+}
+
+long double determinant(const long double m[3][3]) {
+  return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+         m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+}
+
+// σ̄(σ(Δε̄p))/σs(Δε̄p) − 1, and σ(Δε̄p) in `stress`.
+long double relative_overstress(const JohnsonCook::Parameters& p, const long double trial[3], long double eps_p_n,
+                                long double increment, double time_step, long double stress[3]) {
+  const long double flow = jc_flow_stress_long(p, eps_p_n, increment, time_step);
+  const long double c = increment / flow;
+  const long double nu = p.nu, biaxial = p.E / (1.0L - nu * nu);
+  const long double gamma[3][3] = {{biaxial, biaxial * nu, 0.0L}, {biaxial * nu, biaxial, 0.0L},
+                                   {0.0L, 0.0L, 0.5L * biaxial * (1.0L - nu)}};
+  const long double xi[3][3] = {{1.0L, -0.5L, 0.0L}, {-0.5L, 1.0L, 0.0L}, {0.0L, 0.0L, 3.0L}};
+  long double l[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      long double product = 0.0L;
+      for (int k = 0; k < 3; ++k) product += gamma[i][k] * xi[k][j];
+      l[i][j] = (i == j ? 1.0L : 0.0L) + c * product;
+    }
+  const long double det = determinant(l);
+  for (int column = 0; column < 3; ++column) {
+    long double replaced[3][3];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) replaced[i][j] = j == column ? trial[i] : l[i][j];
+    stress[column] = determinant(replaced) / det;
+  }
+  const long double equivalent = std::sqrt(stress[0] * stress[0] + stress[1] * stress[1] - stress[0] * stress[1] +
+                                           3.0L * stress[2] * stress[2]);
+  return equivalent / flow - 1.0L;
+}
+
+ReferenceReturn reference_return(const JohnsonCook::Parameters& p, const long double trial[3], long double eps_p_n,
+                                 double time_step) {
+  long double stress[3];
+  const auto overstress = [&](long double log_increment) {
+    return relative_overstress(p, trial, eps_p_n, std::exp(log_increment), time_step, stress);
+  };
+  // ln Δε̄p from −11000 (Δε̄p ≈ 1e-4777, far below any root here) to 0 (Δε̄p = 1).
+  long double lower = -11000.0L, upper = 0.0L;
+  REQUIRE(overstress(lower) > 0.0L);
+  REQUIRE(overstress(upper) < 0.0L);
+  for (int iteration = 0; iteration < 200; ++iteration) {
+    const long double middle = 0.5L * (lower + upper);
+    (overstress(middle) > 0.0L ? lower : upper) = middle;
+  }
+  const long double root = 0.5L * (lower + upper);
+  const long double step = 1e-6L;
+  const long double sensitivity = (overstress(root + step) - overstress(root - step)) / (2.0L * step);
+  ReferenceReturn result{};
+  overstress(root);
+  result.increment = std::exp(root);
+  result.flow_stress = jc_flow_stress_long(p, eps_p_n, result.increment, time_step);
+  for (int i = 0; i < 3; ++i) result.stress[i] = stress[i];
+  result.sensitivity = sensitivity;
+  return result;
+}
+
+}  // namespace
+
+TEST_CASE("Johnson-Cook: a small hardening exponent returns from eps_p = 0 onto the surface",
+          "[material][rate]") {
+  // σ̄* − A = 0.01 B from ε̄p = 0: the root Δε̄p is near 0.01^(1/n), 1e-40 for
+  // n = 0.05 and 1e-200 for n = 0.01, tens of powers of two below the
+  // perfectly plastic start; a second step adds another 0.01 B from there.
+  // Time steps: quasi-static, 1 µs (for n < 1 ε̇* < 1 at the root: no rate
+  // term) and one for which ε̇* = Δε̄p/(ε̇0Δt) exceeds 1 at the root (the rate
+  // term active). n = 1 returns as before (the iteration in Δε̄p).
+  for (const double n : {0.05, 0.01, 1.0}) {
+    JohnsonCook::Parameters p = steel_4340();
+    p.n = n;
+    const JohnsonCook law(p);
+    const PlaneStressElasticity elasticity(p.E, p.nu);
+    const double rate_active_step = 1e-3 * std::pow(0.01, 1.0 / n) / p.reference_strain_rate;
+    for (const double time_step : {infinite_time_step, 1e-6, rate_active_step}) {
+      for (const StrainVoigt& direction : {StrainVoigt(1.0, -p.nu, 0.0), StrainVoigt(1.0, 0.5, 0.3)}) {
+        // Each step's strain increment raises σ̄ by 0.01 B elastically (the
+        // first from zero stress to A + 0.01 B).
+        const double unit_equivalent = von_mises(elasticity.stress_increment(direction));
+        JohnsonCook::State state = law.initial_state();
+        for (int step = 0; step < 2; ++step) {
+          const double target = step == 0 ? p.A + 0.01 * p.B : 0.01 * p.B;
+          const StrainVoigt d_eps = direction * (target / unit_equivalent);
+          const StressVoigt increment_stress = elasticity.stress_increment(d_eps);
+          const long double trial[3] = {
+              static_cast<long double>(state.stress.x()) + increment_stress.x(),
+              static_cast<long double>(state.stress.y()) + increment_stress.y(),
+              static_cast<long double>(state.stress.z()) + increment_stress.z()};
+          const JohnsonCook::State before = state;
+          INFO("n = " << n << ", time step " << time_step << " s, direction (" << direction.transpose()
+                      << "), step " << step);
+          JohnsonCook::UpdateResult result{};
+          REQUIRE_NOTHROW(result = law.update(state, d_eps, UpdateContext{time_step}));
+          REQUIRE(result.plastic);
+          CHECK(result.iterations <= 10);
+          const ReferenceReturn reference = reference_return(p, trial, before.eps_p, time_step);
+          const double increment = state.eps_p - before.eps_p;
+          INFO("reference Δε̄p " << static_cast<double>(reference.increment) << ", law's " << increment
+                                << ", sensitivity " << static_cast<double>(reference.sensitivity));
+          // The law stops at |S² − 1| ≤ 1e-12, |σ̄/σs − 1| ≤ 5e-13, which
+          // moves ln Δε̄p by at most 5e-13/sensitivity; twice that, and the
+          // round-off of the difference of ε̄p.
+          const double tolerance = 1e-12 / std::abs(static_cast<double>(reference.sensitivity)) +
+                                   4e-16 * state.eps_p / static_cast<double>(reference.increment);
+          CHECK(std::abs(increment / static_cast<double>(reference.increment) - 1.0) <= tolerance);
+          if (step == 0 && n < 1.0) CHECK(increment < 1e-30);  // the steep start
+          const double flow = static_cast<double>(reference.flow_stress);
+          for (int i = 0; i < 3; ++i)
+            CHECK(std::abs(state.stress[i] - static_cast<double>(reference.stress[i])) <= 1e-12 * flow);
+          // On the surface of the flow stress at the law's ε̄p and rate.
+          const double surface = jc_flow_stress(p, state.eps_p, state.strain_rate, p.initial_temperature);
+          CHECK(std::abs(von_mises(state.stress) / surface - 1.0) <= 1e-12);
+          CHECK(state.sigma_y == Approx(surface).epsilon(1e-12));
+          if (time_step == rate_active_step) CHECK(state.strain_rate > p.reference_strain_rate);
+        }
+      }
+    }
+  }
+}
+
 TEST_CASE("Cowper-Symonds: uniaxial flow stress at constant strain rates is the CS formula", "[material][rate]") {
   // Mild steel, D = 40.4 /s, q = 5 (Jones, Structural Impact, 2012, Table 8.2);
   // the paper's σs0 = 235 MPa and a plastic modulus of 1 GPa. q = 4.3 takes

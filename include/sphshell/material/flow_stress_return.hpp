@@ -15,8 +15,8 @@
 // The iteration runs on h = −p₁p₂(S² − 1) (FlowStressKernel below), a
 // polynomial in the uᵢ, by Halley's method, in an iteration variable v of the
 // flow stress' choosing: Δε̄p(v) may be a power of v when σs grows like a root
-// of Δε̄p (Cowper–Symonds), where an iteration in Δε̄p would start with an
-// infinite slope. The flow stress gives, at v,
+// of Δε̄p (Cowper–Symonds; Johnson–Cook from ε̄p ≈ 0 with a small n, in
+// v = ε̄pⁿ), where an iteration in Δε̄p would start with an infinite slope. The flow stress gives, at v,
 //   FlowStressValue{Δε̄p, dΔε̄p/dv, d²Δε̄p/dv², σs, dσs/dv, d²σs/dv²},
 // and duᵢ/dv = dσs/dv + κᵢ dΔε̄p/dv (likewise the second derivatives). A rate
 // term curves σs strongly (C ln ε̇* has d²/dΔε̄p² = −C/Δε̄p²): Newton's

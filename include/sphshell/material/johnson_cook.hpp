@@ -31,6 +31,15 @@
 //   failed: it keeps zero stress for ever, and failed(state) reports it to
 //   the crack handler (a stress point whose integral points have all failed
 //   is damaged, thickness/section.hpp).
+// - The steep start. For n < 1 the hardening Bε̄pⁿ rises with an infinite
+//   slope at ε̄p = 0, and from ε̄p,n = 0 (or a tiny ε̄p,n) a small exponent puts
+//   the root far below the return's start: n = 0.05 and σ̄* − A = 0.01B give
+//   Δε̄p = 0.01²⁰ = 1e-40, where the iteration in Δε̄p would bisect down by
+//   more halvings than the iteration limit. Where both ε̄p,n and the root lie
+//   below 2⁻⁶⁴ of the return's bound on Δε̄p, the return iterates instead in
+//   v = ε̄pⁿ (flow_stress_return.hpp's iteration variable; steep_return), in
+//   which A + Bv is linear. Elsewhere (the ε̄p of a step from ε̄p = 0 with
+//   n ≈ 0.26 and a usual excess) the iteration in Δε̄p is unchanged.
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/core/types.hpp>
@@ -184,8 +193,20 @@ struct JohnsonCook {
     // Started from the last step's Δε̄p at the same rate (0 after an elastic step or
     // in the quasi-static limit: then from the perfectly plastic return).
     const double guess = state.strain_rate * context.time_step;
-    const return_map::FlowStressSolution solution = return_map::solve_flow_stress(
-        constants_, trial, 1.0 / quasi_static, flow, std::sqrt(trial_squared) - quasi_static, guess);
+    const double trial_equivalent = std::sqrt(trial_squared);
+    const double excess = trial_equivalent - quasi_static;
+    // The steep start (see the top of the file): ε̄p,n and the root both lie
+    // below steep_fraction of the return's bound on Δε̄p. The root lies below
+    // the Δε̄p at which A + Bε̄pⁿ alone reaches σ̄*/θ, where ε̄pⁿ = hardening_limit:
+    // the rate factor is ≥ 1 and uᵢ ≥ σs. Only a step from (nearly) ε̄p = 0
+    // pays the test's pow().
+    const double steep_reach = steep_fraction * excess / std::min(constants_.kappa_1, constants_.kappa_2);
+    const bool steep = parameters_.n < 1.0 && parameters_.B > 0.0 && eps_p_n < steep_reach &&
+                       hardening_limit(trial_equivalent, thermal) < std::pow(eps_p_n + steep_reach, parameters_.n);
+    const return_map::FlowStressSolution solution =
+        steep ? steep_return(trial, quasi_static, trial_equivalent, eps_p_n, thermal, rate_per_increment,
+                             hardening_at_return, log_rate_at_return)
+              : return_map::solve_flow_stress(constants_, trial, 1.0 / quasi_static, flow, excess, guess);
     const double increment = solution.plastic_strain_increment;
 
     state.eps_p = eps_p_n + increment;
@@ -330,6 +351,58 @@ struct JohnsonCook {
     }
     anchor = {x, 1.0 / x, std::log(x)};
     return {anchor.value, anchor.inverse};
+  }
+
+  // 2⁻⁶⁴ of the return's bound on Δε̄p: below it, the iteration in Δε̄p would
+  // bisect from its start (at least min κᵢ/max κᵢ of the bound) down to the
+  // larger of ε̄p,n and the root, some 64 halvings of the 100 corrections it may take.
+  static constexpr double steep_fraction = 0x1p-64;
+
+  // ε̄pⁿ at which (A + Bε̄pⁿ)θ = σ̄* (B > 0).
+  double hardening_limit(double trial_equivalent, double thermal) const {
+    return (trial_equivalent / thermal - parameters_.A) / parameters_.B;
+  }
+
+  // The return in v = ε̄pⁿ = (ε̄p,n + Δε̄p)ⁿ (the steep start, top of the file):
+  // A + Bv is linear in v, Δε̄p = v^(1/n) − ε̄p,n has the slope
+  // dΔε̄p/dv = ε̄p/(nv) and the curvature (1/n − 1)/v · dΔε̄p/dv (both 0 at
+  // v = 0 for n < 1), and the rate factor 1 + C ln ε̇* (ε̇* ∝ Δε̄p) has the
+  // slope C (ln Δε̄p)′ and the curvature C (ln Δε̄p)″, (ln Δε̄p)′ = Δε̄p′/Δε̄p,
+  // (ln Δε̄p)″ = Δε̄p″/Δε̄p − (ln Δε̄p)′². The bracket is [ε̄p,nⁿ, hardening
+  // limit] (g > 0 at Δε̄p = 0; at the limit σs ≥ σ̄* and uᵢ ≥ σs, so g ≤ 0),
+  // started at the limit: without the rate term the root lies within κᵢΔε̄p/σ̄*
+  // (< 2⁻⁶³ of the excess over σ̄*) of it, so the start meets the tolerance.
+  // Sets the hardening A + Bv and ln ε̇* of the returned v, as the update's flow does.
+  return_map::FlowStressSolution steep_return(const StressVoigt& trial, double quasi_static, double trial_equivalent,
+                                              double eps_p_n, double thermal, double rate_per_increment,
+                                              double& hardening_at_return, double& log_rate_at_return) const {
+    const Parameters& p = parameters_;
+    const double inverse_n = 1.0 / p.n;
+    const auto flow = [&](double v) {
+      const double eps_p = std::pow(v, inverse_n);
+      const double increment = std::max(eps_p - eps_p_n, 0.0);
+      const double increment_slope = v > 0.0 ? inverse_n * eps_p / v : 0.0;
+      const double increment_curvature = v > 0.0 ? (inverse_n - 1.0) * increment_slope / v : 0.0;
+      const double hardening = p.A + p.B * v;
+      const double rate = increment * rate_per_increment;
+      const bool rate_active = rate > 1.0;  // ln ε̇* taken as 0 below ε̇* = 1
+      const double log_rate = rate_active ? std::log(rate) : 0.0;
+      const double rate_factor = 1.0 + p.C * log_rate;
+      const double log_slope = rate_active ? increment_slope / increment : 0.0;
+      const double log_curvature = rate_active ? increment_curvature / increment - log_slope * log_slope : 0.0;
+      const double rate_slope = p.C * log_slope, rate_curvature = p.C * log_curvature;
+      hardening_at_return = hardening;
+      log_rate_at_return = log_rate;
+      return return_map::FlowStressValue{increment,
+                                         increment_slope,
+                                         increment_curvature,
+                                         hardening * rate_factor * thermal,
+                                         (p.B * rate_factor + hardening * rate_slope) * thermal,
+                                         (2.0 * p.B * rate_slope + hardening * rate_curvature) * thermal};
+    };
+    const double upper = hardening_limit(trial_equivalent, thermal);
+    const double lower = std::pow(eps_p_n, p.n);
+    return return_map::solve_flow_stress(constants_, trial, 1.0 / quasi_static, flow, upper, lower, upper);
   }
 
   static void validate(const Parameters& p) {
