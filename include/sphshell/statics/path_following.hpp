@@ -30,9 +30,9 @@
 // many Newton updates, 0 the attempt's start), and the solver is left at the
 // last converged state.
 //
-// Every Newton update may be shortened by a backtracking line search
-// (NewtonOptions::line_search) on the slope of the potential energy along
-// it.
+// A Newton update that overshoots may be shortened by a line search
+// (NewtonOptions::line_search) to where the potential energy along it stops
+// falling.
 //
 // An observer (PathFollower::observe) receives a PathPoint after each
 // converged step: its number, the load factor, the control, the residual
@@ -191,10 +191,6 @@ struct ArcLengthAdaptation {
   int target_iterations = 4;   // Newton updates a step should take, >= 1
 };
 
-// The next arc length from the last one, `length`, and the Newton updates
-// its step took, `iterations_used` (Crisfield, Comput. Struct. 13 (1981)
-// 55–62): ℓ_next = ℓ · √(target / used), used counted as at least 1, then
-// bounded to [min_length, max_length]. Bad bounds are an Error naming them.
 namespace detail {
 
 // The rule both adaptations share: ℓ · √(target / max(1, used)) within
@@ -229,6 +225,10 @@ inline constexpr AdaptationNames step_names{"StepAdaptation::min_step", "StepAda
 
 }  // namespace detail
 
+// The next arc length from the last one, `length`, and the Newton updates
+// its step took, `iterations_used` (Crisfield, Comput. Struct. 13 (1981)
+// 55–62): ℓ_next = ℓ · √(target / used), used counted as at least 1, then
+// bounded to [min_length, max_length]. Bad bounds are an Error naming them.
 inline double adapted_arc_length(double length, int iterations_used, const ArcLengthAdaptation& rule) {
   return detail::adapted_increment(length, iterations_used, rule.min_length, rule.max_length, rule.target_iterations,
                                    detail::arc_length_names);
@@ -706,10 +706,11 @@ class PathFollower {
       return slack(here, assembly_.residual(here, lambda), translation, rotation);
     };
     const double slack1 = slack_here();
-    if (slack1 >= -accepted) return;  // no overshoot (a non-finite slack is one)
+    if (slack1 >= -accepted) return;  // no overshoot (a NaN slack fails the test: searched)
     // Regula falsi on s(α) between (low, s_low) with s > 0 and (high, s_high) with s < 0.
     double low = 0.0, s_low = slack0, high = 1.0, s_high = std::isfinite(slack1) ? slack1 : -slack0;
-    int kept_side = 0;  // the side kept by the last trial (Illinois: its value halved when kept twice)
+    // Illinois: an end kept by two trials in a row has its slack halved (1: high kept, -1: low kept).
+    int kept_side = 0;
     double alpha = 1.0, s_alpha = slack1;
     for (int trial = 0; trial < options_.max_line_search_trials; ++trial) {
       alpha = (low * s_high - high * s_low) / (s_high - s_low);
