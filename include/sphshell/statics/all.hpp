@@ -8,6 +8,7 @@
 #include <sphshell/statics/coupling.hpp>
 #include <sphshell/statics/krylov.hpp>
 #include <sphshell/statics/path_csv.hpp>
+#include <sphshell/statics/path_frames.hpp>
 #include <sphshell/statics/path_following.hpp>
 #include <sphshell/statics/stability.hpp>
 #include <sphshell/statics/static_solve.hpp>

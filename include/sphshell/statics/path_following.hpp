@@ -6,7 +6,9 @@
 // - linear_solve: one Newton step from the reference state, K u = λ f, the
 //   linear theory's answer (the whole solution of a linear solver).
 // - solve_to (load control): load steps, a Newton iteration per step, a step
-//   halved when its iteration diverges. The tangent is assembled and
+//   halved when its iteration diverges; the steps grow by a fixed factor after
+//   a step taken whole, or (given a StepAdaptation) follow the Newton
+//   updates the last step took. The tangent is assembled and
 //   factorised afresh at each iteration until the residual is small; from
 //   there one factorisation serves while the residual keeps falling fast
 //   (NewtonOptions::tangent_reuse_contraction; the factorisation dominates
@@ -28,12 +30,18 @@
 // many Newton updates, 0 the attempt's start), and the solver is left at the
 // last converged state.
 //
+// A Newton update that overshoots may be shortened by a line search
+// (NewtonOptions::line_search) to where the potential energy along it stops
+// falling.
+//
 // An observer (PathFollower::observe) receives a PathPoint after each
 // converged step: its number, the load factor, the control, the residual
 // reached, the iterations taken and, when asked, the stability with the
-// limit and bifurcation points flagged. PathCsv (statics/path_csv.hpp) writes
-// the points as CSV. adapted_arc_length chooses the next arc length from the
-// iterations the last step took.
+// limit and bifurcation points flagged (the first point against the state
+// the observation started from). PathCsv (statics/path_csv.hpp) writes the
+// points as CSV, PathFrames (statics/path_frames.hpp) as ParaView frames.
+// adapted_arc_length chooses the next arc length, and a StepAdaptation the
+// next load or displacement step, from the iterations the last step took.
 
 #include <sphshell/core/error.hpp>
 #include <sphshell/statics/conditions.hpp>
@@ -59,6 +67,12 @@ namespace sphshell::statics {
 enum class LoadPredictor {
   extrapolated,  // the last two converged states extrapolated linearly in the load factor
   last_state     // the last converged state (where a strongly nonlinear path makes the extrapolation overshoot)
+};
+
+// How a Newton update is taken (NewtonOptions::line_search).
+enum class LineSearch {
+  none,   // whole
+  energy  // shortened to where the potential energy along it stops falling, when the whole update overshoots
 };
 
 struct NewtonOptions {
@@ -89,6 +103,31 @@ struct NewtonOptions {
   // a path creeping in tiny steps (where the control cannot pass) stops with
   // an Error.
   int max_substeps = 64;
+  // The line search of every Newton update, all three controls (Matthies &
+  // Strang, IJNME 14 (1979) 1613–1626): along the update, configuration
+  // q(α) = q₀ + α δ at the update's load factor λ₁ (load control: the
+  // step's; displacement and arc-length control: λ₀ + δλ, the load factor
+  // taken whole), the slope of the potential energy is −s(α) with the slack
+  // s(α) = δ · r(q(α), λ₁) (forces times translations, moments times
+  // rotations: work). Newton's update has K δ = r(q₀, λ₁) (under the
+  // controls too: K δu_r = r, K δu_f = f, δ = δu_r + δλ δu_f), so s(0) =
+  // δᵀKδ, > 0 where the tangent is positive along δ. The whole update is
+  // taken unless it overshoots the energy's minimum along it, s(1) <
+  // −line_search_tolerance · s(0); then α is the zero of s found by
+  // regula falsi (the Illinois variant) between 0 and 1, to |s(α)| ≤
+  // line_search_tolerance · s(0) or max_line_search_trials trials (the last
+  // one kept). Taken whole (no search): s(0) ≤ 0 (no descent of the energy
+  // along δ, e.g. past a critical point), and relative residuals below
+  // detail::smallest_searched_residual (Newton converges quadratically
+  // there, and the residual nears the noise of the difference tangent). An
+  // update taken whole costs no force evaluation more (its forces are those
+  // the next iteration needs); each trial of a search costs one
+  // (NewtonReport::line_search_trials). The displacement control's gap
+  // after a shortened update is (1 − α) times the one before; the next
+  // iteration closes it.
+  LineSearch line_search = LineSearch::none;
+  double line_search_tolerance = 0.5;  // in (0, 1)
+  int max_line_search_trials = 8;      // >= 1
   // Print every iteration (load factor, relative residual, for
   // displacement control the control gap; whether the tangent was fresh) to
   // standard error.
@@ -135,6 +174,16 @@ struct PathPoint {
   PathEvent event = PathEvent::none;
 };
 
+// The bounds of the automatic load or displacement step
+// (PathFollower::solve_to and solve_to_displacement with a StepAdaptation,
+// adapted_step): in the load factor's unit (1) for load control, in metres
+// of the control displacement for displacement control.
+struct StepAdaptation {
+  double min_step = 0.0;      // finite and > 0
+  double max_step = 0.0;      // finite and >= min_step
+  int target_iterations = 4;  // Newton updates a step should take, >= 1
+};
+
 // The bounds of the automatic arc length (adapted_arc_length).
 struct ArcLengthAdaptation {
   double min_length = 0.0;     // m, finite and > 0
@@ -142,24 +191,55 @@ struct ArcLengthAdaptation {
   int target_iterations = 4;   // Newton updates a step should take, >= 1
 };
 
+namespace detail {
+
+// The rule both adaptations share: ℓ · √(target / max(1, used)) within
+// [smallest, largest]; `names` gives the parameters' names for the Error.
+struct AdaptationNames {
+  const char* smallest;
+  const char* largest;
+  const char* target;
+  const char* increment;
+};
+inline void check_adaptation(double smallest, double largest, int target, const AdaptationNames& names) {
+  sphshell::detail::require_positive(names.smallest, smallest);
+  if (!(std::isfinite(largest) && largest >= smallest))
+    sphshell::detail::invalid_parameter(names.largest, largest,
+                                        std::string("must be finite and >= ") + names.smallest + " = " +
+                                            std::to_string(smallest));
+  if (target < 1) sphshell::detail::invalid_parameter(names.target, target, "must be >= 1");
+}
+inline double adapted_increment(double increment, int iterations_used, double smallest, double largest, int target,
+                                const AdaptationNames& names) {
+  check_adaptation(smallest, largest, target, names);
+  sphshell::detail::require_positive(names.increment, increment);
+  if (iterations_used < 0)
+    sphshell::detail::invalid_parameter("iterations used", iterations_used, "must be >= 0");
+  const double used = std::max(1, iterations_used);
+  return std::clamp(increment * std::sqrt(target / used), smallest, largest);
+}
+inline constexpr AdaptationNames arc_length_names{"ArcLengthAdaptation::min_length", "ArcLengthAdaptation::max_length",
+                                                  "ArcLengthAdaptation::target_iterations", "arc length"};
+inline constexpr AdaptationNames step_names{"StepAdaptation::min_step", "StepAdaptation::max_step",
+                                            "StepAdaptation::target_iterations", "step"};
+
+}  // namespace detail
+
 // The next arc length from the last one, `length`, and the Newton updates
 // its step took, `iterations_used` (Crisfield, Comput. Struct. 13 (1981)
 // 55–62): ℓ_next = ℓ · √(target / used), used counted as at least 1, then
 // bounded to [min_length, max_length]. Bad bounds are an Error naming them.
 inline double adapted_arc_length(double length, int iterations_used, const ArcLengthAdaptation& rule) {
-  sphshell::detail::require_positive("ArcLengthAdaptation::min_length", rule.min_length);
-  if (!(std::isfinite(rule.max_length) && rule.max_length >= rule.min_length))
-    sphshell::detail::invalid_parameter("ArcLengthAdaptation::max_length", rule.max_length,
-                                        "must be finite and >= ArcLengthAdaptation::min_length = " +
-                                            std::to_string(rule.min_length));
-  if (rule.target_iterations < 1)
-    sphshell::detail::invalid_parameter("ArcLengthAdaptation::target_iterations", rule.target_iterations,
-                                        "must be >= 1");
-  sphshell::detail::require_positive("arc length", length);
-  if (iterations_used < 0)
-    sphshell::detail::invalid_parameter("iterations used", iterations_used, "must be >= 0");
-  const double used = std::max(1, iterations_used);
-  return std::clamp(length * std::sqrt(rule.target_iterations / used), rule.min_length, rule.max_length);
+  return detail::adapted_increment(length, iterations_used, rule.min_length, rule.max_length, rule.target_iterations,
+                                   detail::arc_length_names);
+}
+
+// The next load or displacement step from the last one, `step`, and the
+// Newton updates it took: the rule of adapted_arc_length, step · √(target /
+// used) within [min_step, max_step]. Bad bounds are an Error naming them.
+inline double adapted_step(double step, int iterations_used, const StepAdaptation& rule) {
+  return detail::adapted_increment(step, iterations_used, rule.min_step, rule.max_step, rule.target_iterations,
+                                   detail::step_names);
 }
 
 namespace detail {
@@ -186,6 +266,8 @@ inline constexpr double step_growth = 1.5;
 inline constexpr double largest_reused_residual = 1e-2;
 // A rotation angle below this (rad) has no axis to extrapolate along.
 inline constexpr double smallest_extrapolated_rotation = 1e-14;
+// Below this relative residual a Newton update is taken whole (NewtonOptions::line_search).
+inline constexpr double smallest_searched_residual = 1e-4;
 
 inline void check(const NewtonOptions& options) {
   sphshell::detail::require_open_interval("NewtonOptions::tolerance", options.tolerance, 0.0, 1.0);
@@ -199,6 +281,14 @@ inline void check(const NewtonOptions& options) {
     sphshell::detail::invalid_parameter("NewtonOptions::krylov_iterations", options.krylov_iterations,
                                         "must be >= 0 (0: no GMRES)");
   sphshell::detail::require_open_interval("NewtonOptions::krylov_tolerance", options.krylov_tolerance, 0.0, 1.0);
+  if (options.line_search != LineSearch::none && options.line_search != LineSearch::energy)
+    sphshell::detail::invalid_parameter("NewtonOptions::line_search", static_cast<int>(options.line_search),
+                                        "must be none or energy");
+  sphshell::detail::require_open_interval("NewtonOptions::line_search_tolerance", options.line_search_tolerance, 0.0,
+                                          1.0);
+  if (options.max_line_search_trials < 1)
+    sphshell::detail::invalid_parameter("NewtonOptions::max_line_search_trials", options.max_line_search_trials,
+                                        "must be >= 1");
   if (!(options.tangent_reuse_contraction >= 0.0 && options.tangent_reuse_contraction < 1.0))
     sphshell::detail::invalid_parameter("NewtonOptions::tangent_reuse_contraction", options.tangent_reuse_contraction,
                                         "must lie in [0, 1) (0: a fresh tangent at every iteration)");
@@ -213,11 +303,60 @@ class PathFollower {
       : assembly_(solver, std::move(conditions), (detail::check(options), options.steps)), options_(options) {}
 
   // Equilibrium at the load factor `lambda`, reached from the current state
-  // in load steps of at most `step` (halved when an iteration diverges).
-  void solve_to(double lambda, double step) {
+  // in load steps of at most `step` (halved when an iteration diverges; after
+  // a step taken whole the next is detail::step_growth times longer, up to
+  // `step`).
+  void solve_to(double lambda, double step) { solve_to(lambda, step, nullptr); }
+
+  // The same with the automatic step: `first_step` first, then each next step
+  // adapted_step(last step, its Newton updates, adaptation), within
+  // [min_step, max_step] (a step that fails is still halved, below min_step
+  // if need be; the last step ends at `lambda`). `first_step` must lie
+  // within the bounds.
+  void solve_to(double lambda, double first_step, const StepAdaptation& adaptation) {
+    check_first_step("load step", first_step, adaptation);
+    solve_to(lambda, first_step, &adaptation);
+  }
+
+  // Equilibrium with the control displacement at `target`, reached from the
+  // current state in increments of at most `step` of it (halved when an
+  // iteration diverges); the load factor is solved for with the displacement.
+  void solve_to_displacement(const ControlDisplacement& control, double target, double step) {
+    solve_to_displacement(control, target, step, nullptr);
+  }
+
+  // The same with the automatic step, as solve_to with a StepAdaptation
+  // (its bounds in metres of the control displacement).
+  void solve_to_displacement(const ControlDisplacement& control, double target, double first_step,
+                             const StepAdaptation& adaptation) {
+    check_first_step("displacement step", first_step, adaptation);
+    solve_to_displacement(control, target, first_step, &adaptation);
+  }
+
+ private:
+  void check_first_step(const char* name, double first_step, const StepAdaptation& adaptation) const {
+    detail::check_adaptation(adaptation.min_step, adaptation.max_step, adaptation.target_iterations,
+                             detail::step_names);
+    if (!(first_step >= adaptation.min_step && first_step <= adaptation.max_step))
+      sphshell::detail::invalid_parameter(std::string("first ") + name, first_step,
+                                          "must lie within [StepAdaptation::min_step, StepAdaptation::max_step] = [" +
+                                              std::to_string(adaptation.min_step) + ", " +
+                                              std::to_string(adaptation.max_step) + "]");
+  }
+
+  // The next increment after one of `taken` that converged: with
+  // `adaptation` by adapted_step from the Newton updates it took, else grown
+  // by detail::step_growth up to `step`.
+  double next_increment(double taken, double step, const StepAdaptation* adaptation) const {
+    if (adaptation) return adapted_step(taken, last_converged_.iterations, *adaptation);
+    return std::min(step, detail::step_growth * taken);
+  }
+
+  void solve_to(double lambda, double step, const StepAdaptation* adaptation) {
     sphshell::detail::require_positive("load step", step);
     sphshell::detail::require_finite("load factor", lambda);
     check_start();
+    note_start_stability();
     double increment = std::min(step, lambda - lambda_);
     while (lambda_ < lambda - detail::target_reached * std::abs(lambda)) {
       double target = lambda;
@@ -232,18 +371,17 @@ class PathFollower {
           },
           [&](double) { return "Newton did not converge at load factor " + std::to_string(target); });
       converged_step(PathControl::load, std::numeric_limits<double>::quiet_NaN());
-      increment = std::min(step, detail::step_growth * taken);
+      increment = next_increment(taken, step, adaptation);
     }
   }
 
-  // Equilibrium with the control displacement at `target`, reached from the
-  // current state in increments of at most `step` of it (halved when an
-  // iteration diverges); the load factor is solved for with the displacement.
-  void solve_to_displacement(const ControlDisplacement& control, double target, double step) {
+  void solve_to_displacement(const ControlDisplacement& control, double target, double step,
+                             const StepAdaptation* adaptation) {
     sphshell::detail::require_positive("displacement step", step);
     sphshell::detail::require_finite("target displacement", target);
     check_control(control);
     check_start();
+    note_start_stability();
     double value = displacement_of(control);
     double increment = step;
     int substeps = 0;
@@ -268,9 +406,11 @@ class PathFollower {
           });
       value = next;
       converged_step(PathControl::displacement, displacement_of(control));
-      increment = std::min(step, detail::step_growth * taken);
+      increment = next_increment(taken, step, adaptation);
     }
   }
+
+ public:
 
   // One arc-length step: the particles move a root-mean-square `length` (m)
   // along the path's direction, on the hyperplane normal to it, with the load
@@ -280,6 +420,7 @@ class PathFollower {
   double arc_length_step(double length) {
     sphshell::detail::require_positive("arc length", length);
     check_start();
+    note_start_stability();
     Solver& solver = assembly_.solver();
     const std::vector<Vector3> x0 = solver.positions();
     PathDirection direction;
@@ -337,8 +478,11 @@ class PathFollower {
   }
 
   // Hands every converged step's PathPoint to `observer` (an empty function:
-  // none), with the stability when asked. The first point with the
-  // stability has no event (nothing to compare with). The observer is called
+  // none), with the stability when asked. With the stability, the state the
+  // next step starts from (the first after this call) is factorised too, so
+  // that a critical point between it and the first observed point is flagged
+  // on that point like any other (the count of negative eigenvalues compared
+  // with the start's). The observer is called
   // at the converged state, which it must leave as it is; what it throws
   // reaches the caller with the solver at that state.
   void observe(std::function<void(const PathPoint&)> observer, PathStability stability = PathStability::skip) {
@@ -395,6 +539,15 @@ class PathFollower {
   TangentAssembly<Solver>& assembly() { return assembly_; }
 
  private:
+  // The count of negative eigenvalues where the observed path starts (the
+  // first step after observe() with PathStability::compute), for the first
+  // point's event. It is taken after check_start, so a mechanism at the
+  // unloaded start is that Error, not a zero pivot here.
+  void note_start_stability() {
+    if (!observer_ || observed_stability_ != PathStability::compute || previous_negative_eigenvalues_ >= 0) return;
+    previous_negative_eigenvalues_ = stability().negative_eigenvalues;
+  }
+
   // A step converged: counted, and its point handed to the observer.
   void converged_step(PathControl control, double control_value) {
     ++steps_;
@@ -515,9 +668,82 @@ class PathFollower {
       if (!(std::abs(along_load) > 0.0)) return false;
       const double d_lambda = (gap - g.dot(solution.col(0))) / along_load;
       lambda_ += d_lambda;
-      assembly_.apply_update(basis, solution.col(0) + d_lambda * solution.col(1));
+      // The slack's start: the residual where the update starts, at the update's load factor.
+      take_update(basis, solution.col(0) + d_lambda * solution.col(1), lambda_, dofs, r + d_lambda * f,
+                  reference > 0.0 ? r.norm() / reference : 0.0);
     }
     return false;
+  }
+
+  // Takes a Newton update from the current state: the configuration moved by
+  // α `update` (in `basis`), α by the line search (NewtonOptions::line_search)
+  // at the load factor `lambda`; `residual` is r(q₀, lambda) in `dofs`, the
+  // current state's degrees of freedom, `relative` the current relative
+  // residual (0: none to measure, no search).
+  void take_update(const DegreesOfFreedom& basis, const Eigen::VectorXd& update, double lambda,
+                   const DegreesOfFreedom& dofs, const Eigen::VectorXd& residual, double relative) {
+    // Copies: the trials replace the solver's configuration.
+    const std::vector<Vector3> x0 = assembly_.solver().positions(), d0 = assembly_.solver().directors();
+    take_update(basis, x0, d0, update, lambda, dofs, residual, relative);
+  }
+  // The same from the configuration (x0, d0).
+  void take_update(const DegreesOfFreedom& basis, const std::vector<Vector3>& x0, const std::vector<Vector3>& d0,
+                   const Eigen::VectorXd& update, double lambda, const DegreesOfFreedom& dofs,
+                   const Eigen::VectorXd& residual, double relative) {
+    const bool search = options_.line_search == LineSearch::energy &&
+                        relative > detail::smallest_searched_residual && std::isfinite(relative);
+    std::vector<Vector3> translation, rotation;  // of the whole update, per particle
+    double slack0 = 0.0;
+    if (search) {
+      assembly_.split(basis, update, translation, rotation);
+      slack0 = slack(dofs, residual, translation, rotation);
+    }
+    assembly_.apply_update(basis, x0, d0, update);
+    if (!search || !(slack0 > 0.0)) return;
+    const double accepted = options_.line_search_tolerance * slack0;
+    auto slack_here = [&] {
+      const DegreesOfFreedom here = assembly_.degrees_of_freedom();
+      return slack(here, assembly_.residual(here, lambda), translation, rotation);
+    };
+    const double slack1 = slack_here();
+    if (slack1 >= -accepted) return;  // no overshoot (a NaN slack fails the test: searched)
+    // Regula falsi on s(α) between (low, s_low) with s > 0 and (high, s_high) with s < 0.
+    double low = 0.0, s_low = slack0, high = 1.0, s_high = std::isfinite(slack1) ? slack1 : -slack0;
+    // Illinois: an end kept by two trials in a row has its slack halved (1: high kept, -1: low kept).
+    int kept_side = 0;
+    double alpha = 1.0, s_alpha = slack1;
+    for (int trial = 0; trial < options_.max_line_search_trials; ++trial) {
+      alpha = (low * s_high - high * s_low) / (s_high - s_low);
+      assembly_.set_moved_configuration(basis, x0, d0, alpha * update);
+      ++assembly_.report().line_search_trials;
+      s_alpha = slack_here();
+      if (!std::isfinite(s_alpha)) s_alpha = -slack0;  // treated as past the minimum
+      if (std::abs(s_alpha) <= accepted) break;
+      if (s_alpha > 0.0) {
+        low = alpha, s_low = s_alpha;
+        if (kept_side == 1) s_high *= 0.5;
+        kept_side = 1;
+      } else {
+        high = alpha, s_high = s_alpha;
+        if (kept_side == -1) s_low *= 0.5;
+        kept_side = -1;
+      }
+    }
+    if (options_.trace)
+      std::fprintf(stderr, "  (line search: %.6g of the update, slack %.3e -> %.3e, whole %.3e)\n", alpha, slack0,
+                   s_alpha, slack1);
+  }
+
+  // The slack δ · r of the update (translation, rotation per particle) with
+  // the residual `residual` in `dofs`: work, the translations against the
+  // forces and the rotations against the moments.
+  double slack(const DegreesOfFreedom& dofs, const Eigen::VectorXd& residual, const std::vector<Vector3>& translation,
+               const std::vector<Vector3>& rotation) const {
+    std::vector<Vector3> force, moment;
+    assembly_.split(dofs, residual, force, moment);
+    double sum = 0.0;
+    for (std::size_t i = 0; i < force.size(); ++i) sum += force[i].dot(translation[i]) + moment[i].dot(rotation[i]);
+    return sum;
   }
 
   // Modified Newton (NewtonOptions::tangent_reuse_contraction): keeps the
@@ -569,12 +795,12 @@ class PathFollower {
         std::fprintf(stderr, "  iteration %d: load factor %.8g, relative residual %.3e\n", iteration, lambda, relative);
       if (relative > detail::load_divergence) return false;
       if (options_.krylov_iterations > 0) {
-        krylov_update(dofs, r);
+        krylov_update(dofs, r, lambda, relative);
         continue;
       }
       const DegreesOfFreedom& basis = tangent_for(dofs, relative);
       const Eigen::VectorXd rhs = &basis == &dofs ? r : assembly_.residual(basis, lambda);
-      assembly_.apply_update(basis, assembly_.solve_kept(rhs).col(0));
+      take_update(basis, assembly_.solve_kept(rhs).col(0), lambda, dofs, r, relative);
     }
     return false;
   }
@@ -583,7 +809,8 @@ class PathFollower {
   // factorisation its preconditioner (NewtonOptions::krylov_iterations);
   // without one, or when GMRES needs more products than allowed, a fresh
   // tangent is factorised at the current state and solved with directly.
-  void krylov_update(const DegreesOfFreedom& dofs, const Eigen::VectorXd& r) {
+  // The update is taken by take_update (at load factor `lambda`, `relative` the current relative residual).
+  void krylov_update(const DegreesOfFreedom& dofs, const Eigen::VectorXd& r, double lambda, double relative) {
     Solver& solver = assembly_.solver();
     const std::vector<Vector3> x0 = solver.positions(), d0 = solver.directors();
     if (assembly_.has_kept_factorisation() && assembly_.kept_degrees_of_freedom().count() == dofs.count()) {
@@ -597,14 +824,14 @@ class PathFollower {
         std::fprintf(stderr, "  (GMRES: %d products, relative residual %.3e)\n", krylov.iterations,
                      krylov.relative_residual);
       if (krylov.converged) {
-        assembly_.apply_update(dofs, x0, d0, update);
+        take_update(dofs, x0, d0, update, lambda, dofs, r, relative);
         return;
       }
       assembly_.set_configuration(x0, d0);
     }
     if (options_.trace) std::fprintf(stderr, "  (a fresh tangent)\n");
     assembly_.factorise(dofs, "on the path");
-    assembly_.apply_update(dofs, assembly_.solve_kept(r).col(0));
+    take_update(dofs, x0, d0, assembly_.solve_kept(r).col(0), lambda, dofs, r, relative);
   }
 
   // The start of a displacement step: the last two converged states (and

@@ -41,6 +41,9 @@ struct NewtonReport {
   long force_evaluations = 0;  // internal-force computations in all
   int factorisations = 0;      // tangents assembled and factorised for Newton steps
   long krylov_iterations = 0;  // tangent products of the GMRES Newton steps (NewtonOptions::krylov_iterations)
+  // Shortened trials of the line search (NewtonOptions::line_search): force
+  // evaluations at a fraction of a Newton update, the final one included.
+  long line_search_trials = 0;
   // The relative residual ‖r‖ / ‖λ f_ext‖ where the last step's Newton
   // iteration started, at its predictor (load control: NewtonOptions::predictor;
   // displacement control and arc length: the last two converged states and load
@@ -330,10 +333,17 @@ class TangentAssembly {
   // The same from the configuration (x0, d0) instead of the current one.
   void apply_update(const DegreesOfFreedom& dofs, std::vector<Vector3> x0, std::vector<Vector3> d0,
                     const Eigen::VectorXd& update) {
+    set_moved_configuration(dofs, std::move(x0), std::move(d0), update);
+    ++report_.iterations;
+  }
+  // The configuration (x0, d0) moved by `update` as apply_update moves it,
+  // counted as a force evaluation but not as a Newton update (a line
+  // search's shortened trial).
+  void set_moved_configuration(const DegreesOfFreedom& dofs, std::vector<Vector3> x0, std::vector<Vector3> d0,
+                               const Eigen::VectorXd& update) {
     moved(dofs, update, x0, d0);
     solver_.set_configuration(std::move(x0), std::move(d0));
     ++report_.force_evaluations;
-    ++report_.iterations;
   }
 
   // The tangent stiffness at the configuration (x0, d0) applied to v, K v
