@@ -275,9 +275,24 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
   // Moves the particles and directors to a new configuration at once (a
   // kinematic jump, used e.g. to probe the discrete stiffness): the strain
   // change goes through the material law like a step's, and the internal
-  // forces are recomputed. Velocities are kept. One process only.
+  // forces are recomputed. Velocities are kept. One process only. The
+  // directors are normalised.
   void set_configuration(std::vector<Vector3> positions, std::vector<Vector3> directors) {
+    move_to_configuration(std::move(positions), std::move(directors), DirectorLength::normalise);
+  }
+  // The same for a configuration this solver held before (its positions()
+  // and directors()), put back bit for bit: normalising a unit director again
+  // may move it by a rounding unit. The directors must be of unit length to
+  // round-off (within 1e-12).
+  void restore_configuration(std::vector<Vector3> positions, std::vector<Vector3> directors) {
+    move_to_configuration(std::move(positions), std::move(directors), DirectorLength::keep);
+  }
+
+ private:
+  enum class DirectorLength { normalise, keep };
+  void move_to_configuration(std::vector<Vector3> positions, std::vector<Vector3> directors, DirectorLength rule) {
     static_assert(!distributed, "set_configuration: a distributed run sets no configuration");
+    constexpr double unit_length_tolerance = 1e-12;
     if (positions.size() != particles_.size() || directors.size() != particles_.size())
       detail::invalid_parameter("configuration size", positions.size(), "must equal the particle count");
     for (std::size_t i = 0; i < positions.size(); ++i) {
@@ -286,13 +301,18 @@ class Solver : public solver::ConditionsAndLoads<Solver<Approx, Rule, Material, 
       const double length = directors[i].norm();
       if (!(length > 0.0) || !std::isfinite(length))
         detail::invalid_parameter("director length of particle " + std::to_string(i), length, "must be finite and non-zero");
-      directors[i] /= length;
+      if (rule == DirectorLength::normalise)
+        directors[i] /= length;
+      else if (!(std::abs(length - 1.0) <= unit_length_tolerance))
+        detail::invalid_parameter("director length of particle " + std::to_string(i) + " (restore_configuration)",
+                                  length, "must be 1 to within 1e-12: restore a configuration the solver held");
     }
     particles_.position = std::move(positions);
     particles_.director = std::move(directors);
     compute_internal_forces();
   }
 
+ public:
   // The energy books over all processes (collective).
   EnergyReport energy() const {
     if constexpr (distributed) {

@@ -887,7 +887,7 @@ class PathFollower {
       try {
         converged = attempt(increment);
       } catch (...) {
-        assembly_.set_configuration(x0, d0);
+        assembly_.restore_configuration(x0, d0);
         lambda_ = lambda0;
         throw;
       }
@@ -896,7 +896,7 @@ class PathFollower {
         ++assembly_.report().load_steps;
         return increment;
       }
-      assembly_.set_configuration(x0, d0);
+      assembly_.restore_configuration(x0, d0);
       lambda_ = lambda0;
       // The halved step starts on a fresh tangent.
       assembly_.discard_kept_factorisation();

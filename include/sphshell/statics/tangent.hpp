@@ -380,6 +380,12 @@ class TangentAssembly {
     solver_.set_configuration(std::move(x), std::move(d));
     ++report_.force_evaluations;
   }
+  // A configuration the solver held (its positions() and directors()), put
+  // back bit for bit (Solver::restore_configuration).
+  void restore_configuration(std::vector<Vector3> x, std::vector<Vector3> d) {
+    solver_.restore_configuration(std::move(x), std::move(d));
+    ++report_.force_evaluations;
+  }
 
  private:
   double step_of(const DegreesOfFreedom& dofs, int k) const {
