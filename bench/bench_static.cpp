@@ -8,11 +8,12 @@
 //    21 x 5 particles, Gauss<3>, nonlinear), the argument PL^2/EI = 1 or 2,
 //    against the elastica's tip deflection w/L = 0.30172 and 0.49346
 //    (Bisshopp & Drucker 1945; Mattiasson 1981), the values the test uses;
-//  - plate_101_*: the clamped plate at 101 x 101 particles, Newton
-//    (StaticMass::tangent) against the relaxation (the default), and what a
-//    Newton iteration is made of there: one tangent assembly (the one
-//    solve_static and sphshell::statics run) in force evaluations, counted and
-//    in CPU time, and the sparse LDLT factorisation of it (time, entries of L).
+//  - plate_101_static: the clamped plate at 101 x 101 particles, Newton
+//    (StaticMass::tangent) against the relaxation (the default); plate_tangent:
+//    what a Newton iteration is made of at 101 x 101 and 201 x 201: one tangent
+//    assembly (the one solve_static and sphshell::statics run) in force
+//    evaluations, counted and in CPU time, and the sparse factorisations of it
+//    (time, entries of L, memory).
 // *_damped is the test's explicit run exactly (mass-proportional damping,
 // run_until the test's end time); *_static is Solver::solve_static with the
 // parameters named below. The time is the wall time of run_until /
@@ -24,7 +25,7 @@
 // After the run the program prints, per case, the median wall and CPU times
 // of both over the repetitions, their ratio (damped / static), and the
 // difference of the static deflection from the damped one.
-// plate_101_static / plate_101_tangent (not in the summary below) report
+// plate_101_static / plate_tangent (not in the summary below) report
 // their counters alone. Each benchmark runs its solve once per repetition; with
 //   OMP_NUM_THREADS=1 ./bench_static --benchmark_repetitions=3
 //   --benchmark_enable_random_interleaving=true
@@ -35,6 +36,7 @@
 #include <sphshell/kernel/all.hpp>
 #include <sphshell/material/all.hpp>
 #include <sphshell/solver.hpp>
+#include <sphshell/statics/sparse_factorisation.hpp>
 #include <sphshell/statics/tangent.hpp>
 #include <sphshell/thickness/all.hpp>
 
@@ -222,7 +224,8 @@ void plate_101_static(benchmark::State& state) {
   }
 }
 
-// One tangent assembly of the 101 x 101 plate (statics::TangentAssembly, the
+// One tangent assembly of the plate of 101 x 101 or 201 x 201 particles (the
+// argument; statics::TangentAssembly, the
 // clamped edge held) against one force evaluation (the configuration set
 // again, which recomputes the internal forces), and the LDLT factorisation of
 // the symmetrised tangent that Newton's step solves with (Eigen's
@@ -234,10 +237,14 @@ void plate_101_static(benchmark::State& state) {
 // freedom, and one to restore the configuration), assembly_in_force_evaluations
 // (its CPU time over one evaluation's), and for both factorisations the CPU
 // time, the entries of the factor L and their memory (12 bytes an entry,
-// value and row index).
-void plate_101_tangent(benchmark::State& state) {
+// value and row index); then newton_factorisation_s, the CPU time of the
+// factorisation solve_static's Newton steps use (statics::SparseFactorisation,
+// of the pruned tangent: CHOLMOD's supernodal Cholesky where the build has it,
+// newton_factorisation_is_cholmod = 1, with its factor's entries and memory in
+// use, cholmod_factor_entries and cholmod_memory_MB).
+void plate_tangent(benchmark::State& state) {
   for (auto _ : state) {
-    PlateSolver solver = clamped_plate(false, 101);
+    PlateSolver solver = clamped_plate(false, static_cast<int>(state.range(0)));
     statics::Conditions conditions(solver.model().particle_count());
     conditions.clamp(solver.model().set("boundary"));
     const std::vector<Vector3> x = solver.positions(), d = solver.directors();
@@ -263,6 +270,8 @@ void plate_101_tangent(benchmark::State& state) {
     pruned.prune(0.0, 0.0);
     for (const auto& [name, matrix] : {std::pair<const char*, const statics::SparseMatrix*>{"", &k},
                                        std::pair<const char*, const statics::SparseMatrix*>{"pruned_", &pruned}}) {
+      // At 201 x 201 the tangent as assembled would take gigabytes of L: the pruned one only.
+      if (matrix == &k && state.range(0) > 101) continue;
       cpu = cpu_seconds();
       const Eigen::SimplicialLDLT<statics::SparseMatrix> ldlt(statics::symmetrised(*matrix));
       const double factorisation_cpu = cpu_seconds() - cpu;
@@ -273,6 +282,24 @@ void plate_101_tangent(benchmark::State& state) {
       state.counters[std::string(name) + "factor_entries"] = factor_entries;
       state.counters[std::string(name) + "factor_MB"] = 12.0 * factor_entries / 1e6;
     }
+    // The factorisation Newton's steps use (statics::SparseFactorisation: CHOLMOD's
+    // supernodal Cholesky where the build has it, else the LDLT above), of the
+    // pruned tangent; with CHOLMOD also its factor's entries and its memory in use.
+    statics::SparseFactorisation<statics::SparseMatrix> newton;
+    cpu = cpu_seconds();
+    if (!newton.factorise_symmetric(statics::symmetrised(pruned))) state.SkipWithError("the factorisation failed");
+    state.counters["newton_factorisation_s"] = cpu_seconds() - cpu;
+    state.counters["newton_factorisation_is_cholmod"] =
+        newton.method() == statics::FactorisationMethod::cholmod_cholesky ? 1.0 : 0.0;
+#if defined(SPHSHELL_HAVE_CHOLMOD)
+    {
+      Eigen::CholmodSupernodalLLT<statics::SparseMatrix> cholesky;
+      cholesky.cholmod().print = 0;
+      cholesky.compute(statics::symmetrised(pruned));
+      state.counters["cholmod_factor_entries"] = cholesky.cholmod().lnz;
+      state.counters["cholmod_memory_MB"] = double(cholesky.cholmod().memory_inuse) / 1e6;
+    }
+#endif
     state.SetIterationTime(seconds_since(start));
     state.counters["dofs"] = double(dofs.count());
     state.counters["colours"] = double(assembly.colour_count());
@@ -357,7 +384,7 @@ BENCHMARK(clamped_plate_static)->UseManualTime()->Iterations(1)->Unit(benchmark:
 BENCHMARK(cantilever_damped)->Arg(1)->Arg(2)->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(cantilever_static)->Arg(1)->Arg(2)->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(plate_101_static)->Arg(0)->Arg(1)->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);
-BENCHMARK(plate_101_tangent)->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(plate_tangent)->Arg(101)->Arg(201)->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);
 
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);

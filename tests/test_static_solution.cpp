@@ -135,6 +135,9 @@ TEST_CASE("Static clamped plates: Mindlin's deflection and the independent linea
                   << independent << "; " << result.iterations << " Newton iterations, " << result.force_evaluations
                   << " force evaluations, residual " << result.residual);
     CHECK(result.residual <= 1e-6);
+    // The clamped plate's tangent is positive definite: Cholesky where the build has CHOLMOD.
+    CHECK(result.factorisation == (statics::cholmod_available ? statics::FactorisationMethod::cholmod_cholesky
+                                                              : statics::FactorisationMethod::simplicial_ldlt));
     CHECK(newton.coefficient() == Approx(mindlin).epsilon(tolerance));
     CHECK(newton.coefficient() == Approx(independent).epsilon(1e-4));
   }
@@ -453,4 +456,69 @@ TEST_CASE("Newton's steps by GMRES on a kept factorisation reach the equilibrium
   bad.krylov_iterations = 10;
   bad.krylov_tolerance = 1.0;
   CHECK_THROWS_WITH(plate.solver.solve_static(bad), Catch::Contains("StaticParameters::krylov_tolerance"));
+}
+
+// The tangent's factorisation part (statics/sparse_factorisation.hpp) on
+// matrices with closed-form solutions: the second-difference matrix
+// tridiag(−1, 2, −1) of order n, whose solution for a right-hand side of ones
+// is x_i = i (n + 1 − i)/2 (i = 1..n, the discrete parabola), positive
+// definite; the same with its first diagonal entry −1, indefinite; an upper
+// bidiagonal, unsymmetric one; and a singular one.
+TEST_CASE("The sparse factorisation solves positive definite, indefinite and general tangents",
+          "[static][factorisation]") {
+  using Matrix = statics::SparseMatrix;
+  constexpr int n = 40;
+  const auto second_difference = [&](double first_diagonal, double scale) {
+    std::vector<Eigen::Triplet<double>> entries;
+    for (int i = 0; i < n; ++i) {
+      entries.emplace_back(i, i, scale * (i == 0 ? first_diagonal : 2.0));
+      if (i + 1 < n) entries.emplace_back(i, i + 1, -scale), entries.emplace_back(i + 1, i, -scale);
+    }
+    Matrix m(n, n);
+    m.setFromTriplets(entries.begin(), entries.end());
+    return m;
+  };
+  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(n);
+  double largest_error = 0.0;
+  statics::SparseFactorisation<Matrix> factorisation;
+  // Twice with the same pattern and other values (the analysis kept), scale 1 then 3.
+  for (const double scale : {1.0, 3.0}) {
+    REQUIRE(factorisation.factorise_symmetric(second_difference(2.0, scale)));
+    CHECK(factorisation.method() == (statics::cholmod_available ? statics::FactorisationMethod::cholmod_cholesky
+                                                                : statics::FactorisationMethod::simplicial_ldlt));
+    const Eigen::VectorXd x = factorisation.solve(ones);
+    for (int i = 1; i <= n; ++i)
+      largest_error = std::max(largest_error, std::abs(x[i - 1] * scale - 0.5 * i * (n + 1 - i)) / (0.125 * n * n));
+  }
+  CHECK(largest_error < 1e-12);
+  // Indefinite: LDLT, and from then on LDLT at once; checked against the
+  // residual (the matrix is nonsingular: its determinant is 1 − 2n).
+  const Matrix indefinite = second_difference(-1.0, 1.0);
+  REQUIRE(factorisation.factorise_symmetric(indefinite));
+  CHECK(factorisation.method() == statics::FactorisationMethod::simplicial_ldlt);
+  CHECK((indefinite * factorisation.solve(ones) - ones).norm() < 1e-10 * n);
+  REQUIRE(factorisation.factorise_symmetric(second_difference(2.0, 1.0)));
+  CHECK(factorisation.method() == statics::FactorisationMethod::simplicial_ldlt);
+  const Eigen::VectorXd middle = factorisation.solve(ones);
+  CHECK(std::abs(middle[n / 2 - 1] - 0.5 * (n / 2) * (n + 1 - n / 2)) < 1e-10 * n * n);
+  // General: U = I + superdiagonal 1; U x = 1 gives x = (0 or 1) alternating from the last: x_n = 1, x_{n−1} = 0, ...
+  std::vector<Eigen::Triplet<double>> upper;
+  for (int i = 0; i < n; ++i) {
+    upper.emplace_back(i, i, 1.0);
+    if (i + 1 < n) upper.emplace_back(i, i + 1, 1.0);
+  }
+  Matrix general(n, n);
+  general.setFromTriplets(upper.begin(), upper.end());
+  REQUIRE(factorisation.factorise_general(general));
+  CHECK(factorisation.method() == statics::FactorisationMethod::lu);
+  const Eigen::VectorXd y = factorisation.solve(ones);
+  for (int i = 0; i < n; ++i) CHECK(y[i] == Approx((n - 1 - i) % 2 == 0 ? 1.0 : 0.0).margin(1e-12));
+  // Singular: the second difference with a zero first row and column.
+  Matrix singular = second_difference(2.0, 1.0);
+  singular.coeffRef(0, 0) = 0.0, singular.coeffRef(0, 1) = 0.0, singular.coeffRef(1, 0) = 0.0;
+  statics::SparseFactorisation<Matrix> fresh;
+  CHECK_FALSE(fresh.factorise_symmetric(singular));
+  CHECK_FALSE(fresh.valid());
+  CHECK_FALSE(fresh.factorise_general(singular));
+  CHECK_FALSE(fresh.valid());
 }

@@ -10,6 +10,7 @@
 #include <sphshell/statics/path_csv.hpp>
 #include <sphshell/statics/path_frames.hpp>
 #include <sphshell/statics/path_following.hpp>
+#include <sphshell/statics/sparse_factorisation.hpp>
 #include <sphshell/statics/stability.hpp>
 #include <sphshell/statics/static_solve.hpp>
 #include <sphshell/statics/tangent.hpp>

@@ -57,6 +57,7 @@
 #include <sphshell/solver/run_checks.hpp>
 #include <sphshell/statics/coupling.hpp>
 #include <sphshell/statics/krylov.hpp>
+#include <sphshell/statics/sparse_factorisation.hpp>
 #include <sphshell/statics/static_share.hpp>
 
 #include <Eigen/Eigenvalues>
@@ -147,6 +148,7 @@ struct StaticResult {
   long force_evaluations = 0;  // internal-force evaluations, the cost
   long factorisations = 0;     // tangents assembled and factorised (StaticMass::tangent)
   long krylov_iterations = 0;  // tangent products of the GMRES steps (StaticParameters::krylov_iterations)
+  FactorisationMethod factorisation = FactorisationMethod::none;  // of the last factorised tangent
   double residual = 0.0;       // ‖r‖ / ‖λ f_ext‖ of the state held
   double load_factor = 0.0;    // λ of the load step of the state held
   int load_step = 0;           // 1-based number of that load step
@@ -415,30 +417,32 @@ inline long automatic_relaxation_steps(const ShellModel& model, double tolerance
   return std::max(detail::least_relaxation_steps, static_cast<long>(std::ceil(steps)));
 }
 
-// The factorised tangent of a Newton step, K dq = r: a sparse LDLᵀ of the
-// symmetric part when the tangent is symmetric to finite-difference accuracy
-// (conservative loads on an elastic or path-dependent law), else a sparse LU;
-// an Error when the tangent is singular. Kept as the preconditioner of the
-// GMRES steps (StaticParameters::krylov_iterations). (A template for the
-// reason given above free_directions.)
+// The factorised tangent of a Newton step, K dq = r: the symmetric part
+// (Cholesky or LDLᵀ, statics/sparse_factorisation.hpp) when the tangent is
+// symmetric to finite-difference accuracy (conservative loads on an elastic
+// or path-dependent law), else a sparse LU; an Error when the tangent is
+// singular. Kept as the preconditioner of the GMRES steps
+// (StaticParameters::krylov_iterations), and across the load steps of a solve
+// so that the ordering and symbolic analysis of an unchanged pattern are
+// reused. (A template for the reason given above free_directions.)
 template <class SparseMatrix>
 class NewtonFactorisation {
  public:
-  NewtonFactorisation(const SparseMatrix& K, int load_step, double lambda) : load_step_(load_step), lambda_(lambda) {
+  void factorise(const SparseMatrix& K, int load_step, double lambda) {
+    load_step_ = load_step;
+    lambda_ = lambda;
     const SparseMatrix transpose = K.transpose();
-    if ((K - transpose).norm() <= detail::symmetric_tangent_tolerance * K.norm()) {
-      ldlt_ = std::make_unique<Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>>>(
-          SparseMatrix(0.5 * (K + transpose)));
-      if (ldlt_->info() != Eigen::Success) throw singular();
-    } else {
-      lu_ = std::make_unique<Eigen::SparseLU<SparseMatrix, Eigen::COLAMDOrdering<int>>>(K);
-      if (lu_->info() != Eigen::Success) throw singular();
-    }
+    const bool factorised = (K - transpose).norm() <= detail::symmetric_tangent_tolerance * K.norm()
+                                ? factorisation_.factorise_symmetric(SparseMatrix(0.5 * (K + transpose)))
+                                : factorisation_.factorise_general(K);
+    if (!factorised) throw singular();
   }
-  Eigen::Index size() const { return ldlt_ ? ldlt_->rows() : lu_->rows(); }
+  bool valid() const { return factorisation_.valid(); }
+  Eigen::Index size() const { return factorisation_.size(); }
+  FactorisationMethod method() const { return factorisation_.method(); }
   // K⁻¹ r, an Error when it is not finite.
   Eigen::VectorXd solve(const Eigen::VectorXd& r) const {
-    Eigen::VectorXd dq = ldlt_ ? Eigen::VectorXd(ldlt_->solve(r)) : Eigen::VectorXd(lu_->solve(r));
+    Eigen::VectorXd dq = factorisation_.solve(r);
     if (!dq.allFinite()) throw singular();
     return dq;
   }
@@ -449,10 +453,9 @@ class NewtonFactorisation {
                  std::to_string(load_step_) + " (load factor " + solver::number_text(lambda_) +
                  "): the model has a mechanism, or it buckled; add supports or take smaller load steps");
   }
-  int load_step_;
-  double lambda_;
-  std::unique_ptr<Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>>> ldlt_;
-  std::unique_ptr<Eigen::SparseLU<SparseMatrix, Eigen::COLAMDOrdering<int>>> lu_;
+  int load_step_ = 0;
+  double lambda_ = 0.0;
+  SparseFactorisation<SparseMatrix> factorisation_;
 };
 
 // The solve itself (Solver::solve_static calls it).
@@ -588,9 +591,9 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
   // krylov_iterations products, by a fresh tangent's factorisation, which is
   // kept. The configuration is left as it was (its residual in r only when no
   // product was taken).
-  std::unique_ptr<NewtonFactorisation<SparseMatrix>> kept;
+  NewtonFactorisation<SparseMatrix> kept;
   auto newton_update = [&](const Eigen::VectorXd& r0, double lambda, int load_step) {
-    if (parameters.krylov_iterations > 0 && kept && kept->size() == basis.size) {
+    if (parameters.krylov_iterations > 0 && kept.valid() && kept.size() == basis.size) {
       const std::vector<Vector3> x0 = particles.position, d0 = particles.director;
       // Every unknown's difference step is the tangent's: the rotation
       // unknowns are ℓ θ, so their step ℓ × step_rotation is step_translation.
@@ -607,7 +610,7 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
       };
       Eigen::VectorXd dq;
       const KrylovSolve krylov =
-          gmres(product, [&](const Eigen::VectorXd& v) { return kept->solve(v); }, r0, parameters.krylov_tolerance,
+          gmres(product, [&](const Eigen::VectorXd& v) { return kept.solve(v); }, r0, parameters.krylov_tolerance,
                 parameters.krylov_iterations, dq);
       result.krylov_iterations += krylov.iterations;
       particles.position = x0;
@@ -616,9 +619,10 @@ StaticResult solve_static(System& system, const StaticParameters& parameters, Ob
       if (krylov.converged) return dq;
     }
     const SparseMatrix K = tangent(lambda, negligible_tangent_entry);
-    kept = std::make_unique<NewtonFactorisation<SparseMatrix>>(K, load_step, lambda);
+    kept.factorise(K, load_step, lambda);
     ++result.factorisations;
-    return kept->solve(r0);
+    result.factorisation = kept.method();
+    return kept.solve(r0);
   };
 
   std::ostream& progress = system.progress_stream ? *system.progress_stream : std::clog;

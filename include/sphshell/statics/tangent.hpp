@@ -15,6 +15,7 @@
 #include <sphshell/solver/integration_points.hpp>
 #include <sphshell/statics/conditions.hpp>
 #include <sphshell/statics/coupling.hpp>
+#include <sphshell/statics/sparse_factorisation.hpp>
 #include <sphshell/statics/statics.hpp>
 
 #include <Eigen/Dense>
@@ -294,23 +295,10 @@ class TangentAssembly {
   // pattern alone, so they are redone only when the pattern changes (the
   // numbers are the same as a fresh analysis: the row pivoting is numeric).
   void factorise(const DegreesOfFreedom& dofs, const std::string& where) {
-    const SparseMatrix k = tangent(dofs);
     kept_.valid = false;
-    if (!kept_.lu) kept_.lu = std::make_unique<Eigen::SparseLU<SparseMatrix>>();
-    const bool same_pattern =
-        kept_.analysed && kept_.outer.size() == static_cast<std::size_t>(k.outerSize() + 1) &&
-        kept_.inner.size() == static_cast<std::size_t>(k.nonZeros()) &&
-        std::equal(kept_.outer.begin(), kept_.outer.end(), k.outerIndexPtr()) &&
-        std::equal(kept_.inner.begin(), kept_.inner.end(), k.innerIndexPtr());
-    if (!same_pattern) {
-      kept_.lu->analyzePattern(k);
-      kept_.outer.assign(k.outerIndexPtr(), k.outerIndexPtr() + k.outerSize() + 1);
-      kept_.inner.assign(k.innerIndexPtr(), k.innerIndexPtr() + k.nonZeros());
-      kept_.analysed = true;
-    }
-    kept_.lu->factorize(k);
-    if (kept_.lu->info() != Eigen::Success)
-      sphshell::detail::invalid_parameter("conditions (tangent stiffness " + where + ")", kept_.lu->lastErrorMessage(),
+    if (!kept_.factorisation.factorise_general(tangent(dofs)))
+      sphshell::detail::invalid_parameter("conditions (tangent stiffness " + where + ")",
+                                          kept_.factorisation.failure(),
                                           "the LU factorisation met a zero pivot: a mechanism or a singular point "
                                           "of the path");
     kept_.dofs = dofs;
@@ -322,7 +310,7 @@ class TangentAssembly {
   // in, its solutions, and forgetting it.
   bool has_kept_factorisation() const { return kept_.valid; }
   const DegreesOfFreedom& kept_degrees_of_freedom() const { return kept_.dofs; }
-  Eigen::MatrixXd solve_kept(const Eigen::MatrixXd& rhs) const { return kept_.lu->solve(rhs); }
+  Eigen::MatrixXd solve_kept(const Eigen::MatrixXd& rhs) const { return kept_.factorisation.solve(rhs); }
   void discard_kept_factorisation() { kept_.valid = false; }
 
   // Moves the particles by an update in the degrees of freedom (translations
@@ -436,13 +424,10 @@ class TangentAssembly {
   double translation_step_ = 0.0;
   Coupling coupling_;
   NewtonReport report_;
-  // The last LU factorisation of the tangent (see factorise); the solver is
-  // held by pointer, as Eigen's solvers cannot be copied or moved.
+  // The last LU factorisation of the tangent (see factorise).
   struct KeptFactorisation {
-    std::unique_ptr<Eigen::SparseLU<SparseMatrix>> lu;
+    SparseFactorisation<SparseMatrix> factorisation;
     DegreesOfFreedom dofs;
-    std::vector<SparseMatrix::StorageIndex> outer, inner;  // the pattern analysed
-    bool analysed = false;
     bool valid = false;
   } kept_;
 };
