@@ -233,10 +233,10 @@ class ShellContact {
     // order the searches visit them in: read side by side, not gathered from
     // all over the particle arrays for every candidate.
     patch_in_cell_.resize(count);
-    for (std::size_t slot = 0; slot < count; ++slot) {
+    parallel::for_each(std::size_t{0}, count, [&](std::size_t slot) noexcept {
       const auto b = static_cast<std::size_t>(cells.point_at(slot));
       patch_in_cell_[slot] = {particles.director[b], patch_squared_[b]};
-    }
+    });
     const std::size_t block_count = (count + pair_block_particles - 1) / pair_block_particles;
     blocks_.resize(block_count);
     std::size_t most_patches = 0;
