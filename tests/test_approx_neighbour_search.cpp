@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <utility>
 #include <vector>
 
 using namespace sphshell;
@@ -87,6 +88,45 @@ TEST_CASE("Cell list over a flat jittered sheet uses dense cells and finds the s
     CHECK(cell_list_query(cells, x, radius) == expected);
   }
   CHECK(total > 3000);
+}
+
+TEST_CASE("Cell list by slot: the same points in the same order, each slot's index and coordinates",
+          "[approx][neighbours]") {
+  // A jittered sheet (dense cells) and a cylinder's surface (hashed cells):
+  // for_each_slot_within visits what for_each_within visits, in its order,
+  // and the slots are a permutation of the points holding their coordinates.
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> jitter(-0.2, 0.2), angle(0.0, 6.283185307179586), height(0.0, 0.5);
+  std::vector<Vector3> sheet, cylinder;
+  for (int i = 0; i < 40; ++i)
+    for (int j = 0; j < 40; ++j) sheet.emplace_back(i + jitter(random), j + jitter(random), 0.1 * jitter(random));
+  for (int i = 0; i < 2000; ++i) {
+    const double t = angle(random);
+    cylinder.emplace_back(0.1 * std::cos(t), 0.1 * std::sin(t), height(random));
+  }
+  for (const auto& [points, radius] : {std::pair{sheet, 2.5}, std::pair{cylinder, 0.03}}) {
+    const CellList cells(points, radius);
+    std::vector<int> seen(points.size(), 0);
+    for (std::size_t slot = 0; slot < cells.size(); ++slot) {
+      const auto i = static_cast<std::size_t>(cells.point_at(slot));
+      REQUIRE(i < points.size());
+      ++seen[i];
+      CHECK(cells.position_at(slot) == points[i]);
+    }
+    CHECK(std::count(seen.begin(), seen.end(), 1) == static_cast<std::ptrdiff_t>(points.size()));
+    std::size_t visits = 0;
+    for (std::size_t q = 0; q < points.size(); q += 13) {
+      std::vector<std::pair<int, double>> by_index, by_slot;
+      cells.for_each_within(points[q], radius, [&](int j, double d) { by_index.emplace_back(j, d); });
+      cells.for_each_slot_within(points[q], radius, [&](std::size_t slot, double d) {
+        by_slot.emplace_back(cells.point_at(slot), d);
+        CHECK(d == (cells.position_at(slot) - points[q]).squaredNorm());
+      });
+      CHECK(by_slot == by_index);
+      visits += by_slot.size();
+    }
+    CHECK(visits > 2 * points.size() / 13);  // not vacuous: several neighbours per query
+  }
 }
 
 TEST_CASE("Cell list rejects invalid input and finds coincident points", "[approx][neighbours]") {

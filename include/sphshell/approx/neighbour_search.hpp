@@ -117,6 +117,20 @@ class CellList {
   // radius() visits more layers of cells.
   template <class Visit>
   void for_each_within(const Vector3& x, double radius, Visit&& visit) const {
+    for_each_slot_within(x, radius,
+                         [&](std::size_t slot, double distance_squared) { visit(cell_points_[slot], distance_squared); });
+  }
+
+  // The points in cell order (grouped by cell, each cell's by index): the
+  // slot-th point's index and coordinates. A caller that keeps its own
+  // per-point data in this order reads it in the order the queries visit it.
+  int point_at(std::size_t slot) const { return cell_points_[slot]; }
+  const Vector3& position_at(std::size_t slot) const { return point_in_cell_[slot]; }
+
+  // for_each_within by slot: calls visit(slot, distance_squared) for the same
+  // points in the same order (point_at(slot) is the index).
+  template <class Visit>
+  void for_each_slot_within(const Vector3& x, double radius, Visit&& visit) const {
     if (!(radius >= 0.0) || !std::isfinite(radius))
       sphshell::detail::invalid_parameter("query radius", radius, "must be finite and >= 0");
     if (cell_points_.empty()) return;
@@ -141,7 +155,7 @@ class CellList {
         for (auto k = static_cast<std::size_t>(cell_begin_[static_cast<std::size_t>(dense_index(bottom))]); k < end;
              ++k) {
           const double distance_squared = (point_in_cell_[k] - x).squaredNorm();
-          if (distance_squared < radius_squared) visit(cell_points_[k], distance_squared);
+          if (distance_squared < radius_squared) visit(k, distance_squared);
         }
       };
       const bool whole_height = first_z == 0 && last_z == cells_per_axis_[2] - 1;
@@ -164,7 +178,7 @@ class CellList {
           const std::size_t end = static_cast<std::size_t>(cell_begin_[index + 1]);
           for (std::size_t k = static_cast<std::size_t>(cell_begin_[index]); k < end; ++k) {
             const double distance_squared = (point_in_cell_[k] - x).squaredNorm();
-            if (distance_squared < radius_squared) visit(cell_points_[k], distance_squared);
+            if (distance_squared < radius_squared) visit(k, distance_squared);
           }
         }
   }

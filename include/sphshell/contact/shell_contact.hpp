@@ -31,12 +31,15 @@
 // sheet the shares sum to 1, at its edge they fade to 0 instead of a lone
 // patch of tiny weight taking the whole spring. Every particle plays both
 // parts (a symmetric contact): on two matching sheets a pair is met twice.
-// Every patch a particle lies over counts, however many: the store holds
-// initial_patch_slots per particle to start with (a sheet's patches of radius
-// 0.75 Δ overlap at most four deep, two sheets' eight) and grows, for every
-// particle, to the most that one particle met whenever a step finds more (the
-// step is then searched again); ShellContactStatistics::most_patches reports
-// the most of the last step, patch_slots() the store's size.
+// Every patch a particle lies over counts, however many: the search keeps
+// up to initial_patch_slots patches per particle to start with (a sheet's
+// patches of radius 0.75 Δ overlap at most four deep, two sheets' eight) and,
+// whenever a step finds a particle over more, raises that limit for every
+// particle to the most that one particle met and searches the step again;
+// ShellContactStatistics::most_patches reports the most of the last step,
+// patch_slots() the limit. The pair store holds only the pairs found, one
+// particle's after the other's (no room kept free per particle), so that a
+// step reads and writes little more than the pairs it has.
 //
 // Material neighbours never touch: particle a's neighbours are the particles
 // connected to it through the model's cells (corners of a common cell, step
@@ -78,6 +81,9 @@
 // from, √((2 h_max)² + (patch_spacings Δ_max)²): each particle visits the 27 cells
 // around it, so a step costs O(N). candidate_pairs() counts the pairs within
 // that reach (each ordered pair once), the work the search does per step.
+// What every candidate is tested with (position, director, patch radius) is
+// read in the cell list's order, the order the queries visit the particles
+// in, so that a large model's search reads its memory nearly in sequence.
 //
 // Energy: the spring energy E at configuration n; its work on the shell is
 // the shell's external work, booked by the body set like the rigid contacts'.
@@ -112,9 +118,14 @@ inline constexpr double default_patch_spacings = 0.75;
 // beyond the solver's default support radius (2 spacings,
 // SolverOptions::support_radius_factor).
 inline constexpr double default_exclusion_spacings = 3.0;
-// Slots per particle for the patches it lies over, to start with; the store
+// Patches a particle's pairs may hold in a search, to start with; the limit
 // grows when a particle meets more (see the header comment).
 inline constexpr std::size_t initial_patch_slots = 8;
+// Particles per block of the pair store, the unit the parallel search hands
+// out: a few kilobytes of pairs, read in one stretch, and enough blocks in a
+// model of a thousand particles for the threads to share (parallel.hpp runs a
+// loop of fewer than 16 indices serially).
+inline constexpr std::size_t pair_block_particles = 64;
 // A new pair takes its side over from a remembered patch of the same sheet
 // only when the two directors are within 60° of parallel (cos 60°): across a
 // tighter bend the sheet's sides are not told apart by the directors.
@@ -193,6 +204,11 @@ class ShellContact {
       largest_spacing = std::max(largest_spacing, spacing_[i]);
     }
     reach_ = std::hypot(2.0 * largest_thickness, options_.patch_spacings * largest_spacing);
+    patch_squared_.resize(reference_.size());
+    for (std::size_t i = 0; i < reference_.size(); ++i) {
+      const double patch = options_.patch_spacings * spacing_[i];
+      patch_squared_[i] = patch * patch;
+    }
     sheet_weight_ = regular_sheet_weight(options_.patch_spacings);
     find_material_neighbours(model);
   }
@@ -211,34 +227,47 @@ class ShellContact {
       sphshell::detail::invalid_parameter("shell contact particle count", count,
                                           "must equal the model's " + std::to_string(reference_.size()));
     // The last step's pairs are the history that keeps each pair's side.
-    previous_pairs_.swap(pairs_);
-    previous_count_.swap(pair_count_);
-    previous_slots_ = slots_;
+    previous_blocks_.swap(blocks_);
     const approx::CellList cells(particles.position, reach_);
+    // The candidates' directors and patch radii in the cell list's order, the
+    // order the searches visit them in: read side by side, not gathered from
+    // all over the particle arrays for every candidate.
+    patch_in_cell_.resize(count);
+    parallel::for_each(std::size_t{0}, count, [&](std::size_t slot) noexcept {
+      const auto b = static_cast<std::size_t>(cells.point_at(slot));
+      patch_in_cell_[slot] = {particles.director[b], patch_squared_[b]};
+    });
+    const std::size_t block_count = (count + pair_block_particles - 1) / pair_block_particles;
+    blocks_.resize(block_count);
     std::size_t most_patches = 0;
     for (;;) {
       // A particle that meets more patches than there are slots counts them
-      // all but keeps the first slots_; the store then grows to the most met
-      // and the step is searched again, so that none is left out.
-      // Every slot below a particle's count is written before it is read.
-      pairs_.resize(count * slots_);
-      pair_count_.assign(count, 0);
-      candidates_.assign(count, 0);
+      // all but keeps none; the slots then grow to the most met and the step
+      // is searched again, so that none is left out.
       std::atomic<bool> out_of_memory{false};
-      parallel::for_each_range(std::size_t{0}, count, [&](std::size_t first, std::size_t last) noexcept {
-        std::vector<PatchTerm> terms;
+      parallel::for_each_range(std::size_t{0}, block_count, [&](std::size_t first, std::size_t last) noexcept {
         try {
-          terms.resize(slots_);
+          std::vector<PatchTerm> terms(slots_);
+          for (std::size_t block = first; block < last; ++block) {
+            PairBlock& pairs = blocks_[block];
+            pairs.pair_end.clear();
+            pairs.sides.clear();
+            pairs.loads.clear();
+            pairs.candidates = 0;
+            pairs.most_patches = 0;
+            const std::size_t end = std::min(count, (block + 1) * pair_block_particles);
+            for (std::size_t a = block * pair_block_particles; a < end; ++a)
+              find_pairs(particles, cells, time_step, a, terms.data(), pairs);
+          }
         } catch (...) {
           out_of_memory.store(true);
-          return;
         }
-        for (std::size_t a = first; a < last; ++a) find_pairs(particles, cells, time_step, a, terms.data());
       });
       if (out_of_memory.load())
-        throw Error("sphshell: shell contact: no memory for the terms of " + std::to_string(slots_) +
+        throw Error("sphshell: shell contact: no memory for the pairs of " + std::to_string(slots_) +
                     " patches per particle");
-      most_patches = count == 0 ? 0 : *std::max_element(pair_count_.begin(), pair_count_.end());
+      most_patches = 0;
+      for (const PairBlock& pairs : blocks_) most_patches = std::max(most_patches, pairs.most_patches);
       if (most_patches <= slots_) break;
       slots_ = most_patches;
     }
@@ -247,27 +276,35 @@ class ShellContact {
     ContactStepResult result;
     statistics_ = ShellContactStatistics{};
     statistics_.most_patches = most_patches;
-    for (std::size_t a = 0; a < count; ++a) {
-      statistics_.candidate_pairs += candidates_[a];
-      bool touches = false;
-      for (std::size_t k = 0; k < pair_count_[a]; ++k) {
-        const ShellContactPair& pair = pairs_[a * slots_ + k];
-        if (!(pair.penetration > 0.0)) continue;
-        result.spring_energy += 0.5 * pair.stiffness * pair.penetration * pair.penetration;
-        statistics_.largest_penetration = std::max(statistics_.largest_penetration, pair.penetration);
-        touches = true;
+    for (std::size_t block = 0; block < block_count; ++block) {
+      const PairBlock& pairs = blocks_[block];
+      statistics_.candidate_pairs += pairs.candidates;
+      const std::size_t first_particle = block * pair_block_particles;
+      std::size_t begin = 0;
+      for (std::size_t local = 0; local < pairs.pair_end.size(); ++local) {
+        const std::size_t a = first_particle + local, end = pairs.pair_end[local];
+        bool touches = false;
+        for (std::size_t k = begin; k < end; ++k) {
+          const PairLoad& pair = pairs.loads[k];
+          if (!(pair.penetration > 0.0)) continue;
+          result.spring_energy += 0.5 * pair.stiffness * pair.penetration * pair.penetration;
+          statistics_.largest_penetration = std::max(statistics_.largest_penetration, pair.penetration);
+          touches = true;
+        }
+        // Where a touches, every patch it weighs carries a load (the shares'
+        // change is part of the force); where it does not, none does.
+        if (touches) {
+          for (std::size_t k = begin; k < end; ++k) {
+            const PairLoad& pair = pairs.loads[k];
+            const auto b = static_cast<std::size_t>(pairs.sides[k].partner);
+            loads.force[a] += pair.force;
+            loads.force[b] -= pair.force;
+            loads.moment[b] += pair.partner_moment;
+          }
+          ++result.contacts;
+        }
+        begin = end;
       }
-      // Where a touches, every patch it weighs carries a load (the shares'
-      // change is part of the force); where it does not, none does.
-      if (!touches) continue;
-      for (std::size_t k = 0; k < pair_count_[a]; ++k) {
-        const ShellContactPair& pair = pairs_[a * slots_ + k];
-        const auto b = static_cast<std::size_t>(pair.partner);
-        loads.force[a] += pair.force;
-        loads.force[b] -= pair.force;
-        loads.moment[b] += pair.partner_moment;
-      }
-      if (touches) ++result.contacts;
     }
     statistics_.contacts = result.contacts;
     statistics_.spring_energy = result.spring_energy;
@@ -275,27 +312,53 @@ class ShellContact {
   }
 
   const ShellContactStatistics& statistics() const { return statistics_; }
-  // Slots per particle in the pair store: initial_patch_slots, or the most
-  // patches one particle has met since (the store never drops a patch).
+  // Patches a particle's pairs may hold in a search: initial_patch_slots, or
+  // the most patches one particle has met since (no patch is ever dropped).
   std::size_t patch_slots() const { return slots_; }
   // Particle a's pairs of the last compute(): the patches it weighs (those
   // with penetration 0 carry no force).
   std::vector<ShellContactPair> pairs_of(std::size_t a) const {
-    const auto first = pairs_.begin() + static_cast<std::ptrdiff_t>(a * slots_);
-    return {first, first + static_cast<std::ptrdiff_t>(pair_count_.at(a))};
+    if (a >= reference_.size())
+      sphshell::detail::invalid_parameter("shell contact pairs_of: particle", a,
+                                          "must be below the model's particle count " +
+                                              std::to_string(reference_.size()));
+    std::vector<ShellContactPair> result;
+    if (blocks_.empty()) return result;
+    const PairBlock& pairs = blocks_[a / pair_block_particles];
+    const std::size_t local = a % pair_block_particles;
+    for (std::size_t k = local == 0 ? 0 : pairs.pair_end[local - 1]; k < pairs.pair_end[local]; ++k) {
+      ShellContactPair pair;
+      pair.partner = pairs.sides[k].partner;
+      pair.side = pairs.sides[k].side;
+      if (k < pairs.loads.size()) {
+        pair.stiffness = pairs.loads[k].stiffness;
+        pair.penetration = pairs.loads[k].penetration;
+        pair.force = pairs.loads[k].force;
+        pair.partner_moment = pairs.loads[k].partner_moment;
+      }
+      result.push_back(pair);
+    }
+    return result;
   }
 
   // Checkpoints: the history, every particle's pairs of the last compute()
   // (partner and side; the rest is recomputed from the configuration).
   template <class Writer>
   void save(Writer& out) const {
+    std::vector<std::size_t> counts;
     std::vector<std::int32_t> partners, sides;
-    for (std::size_t a = 0; a < pair_count_.size(); ++a)
-      for (std::size_t k = 0; k < pair_count_[a]; ++k) {
-        partners.push_back(pairs_[a * slots_ + k].partner);
-        sides.push_back(pairs_[a * slots_ + k].side);
+    for (const PairBlock& pairs : blocks_) {
+      std::size_t begin = 0;
+      for (const std::size_t end : pairs.pair_end) {
+        counts.push_back(end - begin);
+        begin = end;
       }
-    out(pair_count_, partners, sides);
+      for (const PairSide& pair : pairs.sides) {
+        partners.push_back(pair.partner);
+        sides.push_back(pair.side);
+      }
+    }
+    out(counts, partners, sides);
   }
   template <class Reader>
   void load(Reader& in) {
@@ -317,21 +380,23 @@ class ShellContact {
     if (partners.size() != total || sides.size() != total)
       sphshell::detail::invalid_parameter("checkpoint's shell contact history: pair count", partners.size(),
                                           "must be the sum of the particles' counts " + std::to_string(total));
-    const std::size_t slots = std::max(slots_, most);
-    std::vector<ShellContactPair> pairs(counts.size() * slots);
+    for (std::size_t next = 0; next < total; ++next)
+      if (partners[next] < 0 || static_cast<std::size_t>(partners[next]) >= count ||
+          (sides[next] != 1 && sides[next] != -1))
+        sphshell::detail::invalid_parameter("checkpoint's shell contact history: pair " + std::to_string(next),
+                                            partners[next], "must name a particle with a side of ±1");
+    // The history's blocks: partners and sides only (their loads are the
+    // next compute()'s).
+    std::vector<PairBlock> blocks((counts.size() + pair_block_particles - 1) / pair_block_particles);
     std::size_t next = 0;
-    for (std::size_t a = 0; a < counts.size(); ++a)
-      for (std::size_t k = 0; k < counts[a]; ++k, ++next) {
-        if (partners[next] < 0 || static_cast<std::size_t>(partners[next]) >= count ||
-            (sides[next] != 1 && sides[next] != -1))
-          sphshell::detail::invalid_parameter("checkpoint's shell contact history: pair " + std::to_string(next),
-                                              partners[next], "must name a particle with a side of ±1");
-        pairs[a * slots + k].partner = partners[next];
-        pairs[a * slots + k].side = sides[next];
-      }
-    slots_ = slots;
-    pairs_ = std::move(pairs);
-    pair_count_ = std::move(counts);
+    for (std::size_t a = 0; a < counts.size(); ++a) {
+      PairBlock& pairs = blocks[a / pair_block_particles];
+      for (std::size_t k = 0; k < counts[a]; ++k, ++next)
+        pairs.sides.push_back({partners[next], sides[next]});
+      pairs.pair_end.push_back(pairs.sides.size());
+    }
+    slots_ = std::max(slots_, most);
+    blocks_ = std::move(blocks);
   }
 
  private:
@@ -344,6 +409,39 @@ class ShellContact {
     double sideways = 0.0, sideways_slope = 0.0;  // σ(ρ²) and dσ/dρ²
     double along = 0.0, along_slope = 0.0;        // ν(s g) and dν/d(s g)
     double stiffness = 0.0, stiffness_slope = 0.0;  // k(ρ²) and dk/dρ²
+    double penetration = 0.0;       // δ
+    std::int32_t partner = -1;      // b
+    std::int32_t side = 0;          // s
+  };
+
+  // A candidate's patch as the search reads it (in the cell list's order).
+  struct PatchInCell {
+    Vector3 director;      // d_b
+    double patch_squared;  // R_b²
+  };
+  // A pair's history: whose patch, and on which side of it.
+  struct PairSide {
+    std::int32_t partner;
+    std::int32_t side;
+  };
+  // What a pair puts on a and b in this step (its partner is in sides).
+  struct PairLoad {
+    double stiffness;  // w k, the share of a's spring (N/m)
+    double penetration;  // δ (m)
+    Vector3 force;  // on a; −force on b
+    Vector3 partner_moment;  // on b's rotation
+  };
+  // The pairs of pair_block_particles consecutive particles, in particle and
+  // patch order, side by side with no room left between particles: a step
+  // writes and the next one reads only the pairs found. The blocks are fixed
+  // by the particle count, not by the threads, so the loads summed from
+  // them are the same for any thread count.
+  struct PairBlock {
+    std::vector<std::size_t> pair_end;  // per particle of the block: one past its last pair
+    std::vector<PairSide> sides;        // the next step's history and the checkpoint
+    std::vector<PairLoad> loads;        // this step's forces
+    std::size_t candidates = 0;         // candidate pairs of the block's particles
+    std::size_t most_patches = 0;       // the most patches one of them met
   };
 
   // The side of b's mid-surface a lies on: remembered from the last step if
@@ -354,18 +452,20 @@ class ShellContact {
   // step before); else the side a is on now (method.md §12, eq. 12.5).
   int side_of(const ContactParticles& particles, std::size_t a, int b, double gap,
               double contact_distance) const noexcept {
-    if (a < previous_count_.size()) {
-      const ShellContactPair* previous = &previous_pairs_[a * previous_slots_];
-      const std::size_t count = previous_count_[a];
-      for (std::size_t k = 0; k < count; ++k)
-        if (previous[k].partner == b) return previous[k].side;
+    const std::size_t block = a / pair_block_particles, local = a % pair_block_particles;
+    if (block < previous_blocks_.size()) {
+      const PairBlock& history = previous_blocks_[block];
+      const PairSide* first = history.sides.data() + (local == 0 ? 0 : history.pair_end[local - 1]);
+      const PairSide* last = history.sides.data() + history.pair_end[local];
+      for (const PairSide* previous = first; previous != last; ++previous)
+        if (previous->partner == b) return previous->side;
       const Vector3& db = particles.director[static_cast<std::size_t>(b)];
-      for (std::size_t k = 0; k < count; ++k) {
-        const int other = previous[k].partner;
+      for (const PairSide* previous = first; previous != last; ++previous) {
+        const int other = previous->partner;
         if (!is_material_neighbour(static_cast<std::size_t>(b), other)) continue;
         const double alignment = db.dot(particles.director[static_cast<std::size_t>(other)]);
         if (std::abs(alignment) < side_transfer_alignment) continue;
-        const int side = alignment > 0.0 ? previous[k].side : -previous[k].side;
+        const int side = alignment > 0.0 ? previous->side : -previous->side;
         if (side * gap < -contact_distance) break;
         return side;
       }
@@ -373,25 +473,26 @@ class ShellContact {
     return gap >= 0.0 ? 1 : -1;
   }
 
-  // Particle a's pairs into its slots_ slots (terms: slots_ of scratch); a
-  // patch beyond them is counted, not kept, and compute() searches again.
+  // Particle a's pairs appended to its block (terms: slots_ of scratch); a
+  // particle meeting more patches than slots_ has them counted, none kept,
+  // and compute() searches again. Throws only when out of memory.
   void find_pairs(const ContactParticles& particles, const approx::CellList& cells, double time_step,
-                  std::size_t a, PatchTerm* terms) noexcept {
+                  std::size_t a, PatchTerm* terms, PairBlock& pairs) {
     const Vector3& xa = particles.position[a];
     const double half_a = 0.5 * particles.thickness[a];
-    ShellContactPair* pairs = &pairs_[a * slots_];
     std::size_t found = 0, candidates = 0;
     double weight_sum = 0.0;
-    cells.for_each_within(xa, reach_, [&](int j, double distance_squared) {
+    cells.for_each_slot_within(xa, reach_, [&](std::size_t slot, double distance_squared) {
+      const int j = cells.point_at(slot);
       const auto b = static_cast<std::size_t>(j);
       if (b == a) return;
       ++candidates;
-      const Vector3& db = particles.director[b];
-      const Vector3 arm = xa - particles.position[b];
+      const PatchInCell& patch_b = patch_in_cell_[slot];
+      const Vector3& db = patch_b.director;
+      const Vector3 arm = xa - cells.position_at(slot);
       const double gap = arm.dot(db);
       const double lateral_squared = std::max(0.0, distance_squared - gap * gap);
-      const double patch = options_.patch_spacings * spacing_[b];
-      const double patch_squared = patch * patch;
+      const double patch_squared = patch_b.patch_squared;
       if (!(lateral_squared < patch_squared) || is_material_neighbour(a, j)) return;
       const double contact_distance = half_a + 0.5 * particles.thickness[b];
       const int side = side_of(particles, a, j, gap, contact_distance);
@@ -422,33 +523,41 @@ class ShellContact {
       const double compliance = 1.0 / particles.mass[a] + 1.0 / mass_b + lateral_squared / rotary_inertia_b;
       term.stiffness = penalty_stiffness(1.0 / compliance, time_step, options_.stiffness_scale);
       term.stiffness_slope = -term.stiffness / (compliance * rotary_inertia_b);
-      ShellContactPair& pair = pairs[found];
-      pair.partner = j;
-      pair.side = side;
-      pair.penetration = std::max(0.0, contact_distance - signed_gap);
+      term.partner = j;
+      term.side = side;
+      term.penetration = std::max(0.0, contact_distance - signed_gap);
       weight_sum += term.sideways * term.along;
       ++found;
     });
-    candidates_[a] = candidates;
-    pair_count_[a] = found;
-    if (found > slots_) return;  // compute() grows the store and searches again
+    pairs.candidates += candidates;
+    pairs.most_patches = std::max(pairs.most_patches, found);
+    if (found > slots_) {  // compute() grows the slots and searches again
+      pairs.pair_end.push_back(pairs.sides.size());
+      return;
+    }
     // Shares φ_b = w_b / S, S = max(Σ w, W_sheet) (method.md §12, eq. 12.2),
     // and a's spring energy E_a = Σ ½ k_b φ_b δ_b².
     const double share_sum = std::max(weight_sum, sheet_weight_);
     const bool normalised = weight_sum > sheet_weight_;
+    const std::size_t first = pairs.loads.size();
+    pairs.loads.resize(first + found);
+    PairLoad* loads = pairs.loads.data() + first;
     double energy = 0.0;
     for (std::size_t k = 0; k < found; ++k) {
-      ShellContactPair& pair = pairs[k];
+      PairLoad& pair = loads[k];
       const PatchTerm& term = terms[k];
       const double share = share_sum > 0.0 ? term.sideways * term.along / share_sum : 0.0;
       pair.stiffness = share * term.stiffness;
+      pair.penetration = term.penetration;
       energy += 0.5 * pair.stiffness * pair.penetration * pair.penetration;
+      pairs.sides.push_back({term.partner, term.side});
     }
+    pairs.pair_end.push_back(pairs.sides.size());
     // The loads are −∂E_a/∂(x_a, x_b, θ_b) (eq. 12.4): through δ_b, through
     // the weights (the shares' change as a slides over and off the patches)
     // and through k_b(ρ²).
     for (std::size_t k = 0; k < found; ++k) {
-      ShellContactPair& pair = pairs[k];
+      PairLoad& pair = loads[k];
       const PatchTerm& term = terms[k];
       const double delta = pair.penetration;
       const double share = pair.stiffness > 0.0 ? pair.stiffness / term.stiffness : 0.0;
@@ -459,7 +568,7 @@ class ShellContact {
       const double per_lateral = per_weight * term.sideways_slope * term.along +
                                  0.5 * share * delta * delta * term.stiffness_slope;
       const double per_gap = per_weight * term.sideways * term.along_slope - pair.stiffness * delta;
-      const double side = pair.side;
+      const double side = term.side;
       // ρ² = |r|² − g², g = r · d: ∂ρ²/∂r = 2 (r − g d), ∂ρ²/∂d = −2 g r; ∂(s g)/∂r = s d, ∂(s g)/∂d = s r.
       const Vector3 by_arm =
           (2.0 * per_lateral) * (term.arm - term.gap * term.director) + (per_gap * side) * term.director;
@@ -534,15 +643,13 @@ class ShellContact {
   std::vector<std::size_t> neighbour_begin_;
   std::vector<int> neighbours_;
   std::vector<double> spacing_;
+  std::vector<double> patch_squared_;  // R² per particle, (patch_spacings Δ)²
+  std::vector<PatchInCell> patch_in_cell_;  // the step's candidates' patches, in the cell list's order
   double reach_ = 0.0;
   double sheet_weight_ = 0.0;  // W_sheet, regular_sheet_weight
-  std::size_t slots_ = initial_patch_slots;  // pairs_'s slots per particle
-  std::size_t previous_slots_ = initial_patch_slots;  // previous_pairs_'s
-  std::vector<ShellContactPair> pairs_;  // slots_ slots per particle
-  std::vector<std::size_t> pair_count_;
-  std::vector<ShellContactPair> previous_pairs_;  // the last step's: each pair's side
-  std::vector<std::size_t> previous_count_;
-  std::vector<std::size_t> candidates_;
+  std::size_t slots_ = initial_patch_slots;  // the most patches a particle's pairs may hold in a search
+  std::vector<PairBlock> blocks_;  // this step's pairs
+  std::vector<PairBlock> previous_blocks_;  // the last step's: each pair's side
   ShellContactStatistics statistics_;
 };
 
