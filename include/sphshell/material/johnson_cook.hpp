@@ -375,20 +375,24 @@ struct JohnsonCook {
   // (relative).
   static constexpr double exponential_reach = 2e-2;
 
-  // The binomial series of (1 + δ)ⁿ to δ⁶: its coefficients C(n, k) and its
-  // reach, the largest |δ| (at most 1e-2) with |C(n, 7)δ⁷| ≤ 2⁻⁵⁴ and each
-  // further term below half the one before (|(n − k)δ/(k + 1)| ≤ ½ for k ≥ 7).
+  // The binomial series of (1 + δ)ⁿ to δ¹⁰: its coefficients C(n, k) and its
+  // reach, the largest |δ| (at most 5e-2) with |C(n, 11)δ¹¹| ≤ 2⁻⁵⁴ and each
+  // further term below half the one before (|(n − k)δ/(k + 1)| ≤ ½ for
+  // k ≥ 11, which δ ≤ 6/max(|n − 11|, 12) ensures). 5e-2 keeps nearby_inverse
+  // within δ⁸ < 4e-11.
   struct PowerSeries {
+    static constexpr int terms = 11;
     explicit PowerSeries(double n) {
       double c = 1.0;
-      for (int k = 0; k < 7; ++k) {
+      for (int k = 0; k < terms; ++k) {
         coefficients[k] = c;
         c *= (n - k) / (k + 1);
       }
-      reach = std::min(1e-2, 4.0 / std::max(std::abs(n - 7.0), 1.0));
-      if (c != 0.0) reach = std::min(reach, std::pow(0.25 * std::numeric_limits<double>::epsilon() / std::abs(c), 1.0 / 7.0));
+      reach = std::min(5e-2, 6.0 / std::max(std::abs(n - terms), 12.0));
+      if (c != 0.0)
+        reach = std::min(reach, std::pow(0.25 * std::numeric_limits<double>::epsilon() / std::abs(c), 1.0 / terms));
     }
-    double coefficients[7];
+    double coefficients[terms];
     double reach;
   };
 
@@ -415,8 +419,9 @@ struct JohnsonCook {
     }
     const double* c = series_of.coefficients;
     const double delta_2 = delta * delta, delta_4 = delta_2 * delta_2;
-    const double series = (1.0 + c[1] * delta) + delta_2 * (c[2] + c[3] * delta) +
-                          delta_4 * ((c[4] + c[5] * delta) + delta_2 * c[6]);
+    const double series = ((1.0 + c[1] * delta) + delta_2 * (c[2] + c[3] * delta)) +
+                          delta_4 * (((c[4] + c[5] * delta) + delta_2 * (c[6] + c[7] * delta)) +
+                                     delta_4 * ((c[8] + c[9] * delta) + delta_2 * c[10]));
     return {anchor.value * series, nearby_inverse(anchor, delta)};
   }
   // ln x, from the anchor's by the series of ln(1 + δ) to δ¹¹ (Estrin's
