@@ -474,6 +474,48 @@ TEST_CASE("Johnson-Cook: a small hardening exponent returns from eps_p = 0 onto 
   }
 }
 
+TEST_CASE("Johnson-Cook: a state rebuilt from the fields it lists continues bit for bit", "[material][rate]") {
+  // What a checkpoint stores is what for_each_field lists. The series' anchors
+  // and the earlier rates that start the return are state too: a state whose
+  // listed fields are copied onto one of another history (so that a field
+  // left out keeps that history's value) must continue exactly as the
+  // original along a smoothly swinging tension-shear stream.
+  JohnsonCook::Parameters p = steel_4340();
+  p.A = 235e6;
+  p.taylor_quinney = 0.9;
+  p.density = 7850.0;
+  p.specific_heat = 477.0;
+  const JohnsonCook law(p);
+  const UpdateContext context{1e-7};
+  const auto increment = [](int k, double magnitude) {
+    const double pi = 3.14159265358979323846;
+    const double angle = 0.25 * pi * (1.0 - std::cos(4.0 * pi * k / 500.0));
+    const double size = magnitude * (1.0 + 0.5 * std::sin(6.0 * pi * k / 500.0));
+    return StrainVoigt(size * std::cos(angle), -0.5 * size * std::cos(angle), std::sqrt(3.0) * size * std::sin(angle));
+  };
+  const StrainVoigt preload = 1.2 * p.A / p.E * StrainVoigt(1.0, -0.5, 0.0);
+  JohnsonCook::State state = law.initial_state(), other = law.initial_state();
+  for (int step = 0; step < 10; ++step) law.update(state, preload / 10.0, context);
+  for (int step = 0; step < 15; ++step) law.update(other, 1.3 * preload / 15.0, context);
+  for (int k = 0; k < 200; ++k) law.update(state, increment(k, 5e-6), context);
+  for (int k = 0; k < 150; ++k) law.update(other, increment(k + 40, 8e-6), context);
+  JohnsonCook::State rebuilt = other;
+  JohnsonCook::State::for_each_field(state, [&](const auto&... from) {
+    JohnsonCook::State::for_each_field(rebuilt, [&](auto&... to) { ((to = from), ...); });
+  });
+  int plastic_steps = 0;
+  for (int k = 200; k < 400; ++k) {
+    plastic_steps += law.update(state, increment(k, 5e-6), context).plastic;
+    law.update(rebuilt, increment(k, 5e-6), context);
+    REQUIRE(rebuilt.eps_p == state.eps_p);
+    REQUIRE(rebuilt.D == state.D);
+    REQUIRE(rebuilt.temperature == state.temperature);
+    REQUIRE(rebuilt.yield_stress == state.yield_stress);
+    REQUIRE((rebuilt.stress.array() == state.stress.array()).all());
+  }
+  CHECK(plastic_steps > 150);
+}
+
 TEST_CASE("Cowper-Symonds: uniaxial flow stress at constant strain rates is the CS formula", "[material][rate]") {
   // Mild steel, D = 40.4 /s, q = 5 (Jones, Structural Impact, 2012, Table 8.2);
   // the paper's σs0 = 235 MPa and a plastic modulus of 1 GPa. q = 4.3 takes

@@ -78,6 +78,23 @@ struct JohnsonCook {
     // positive on the plane-stress range σ* ∈ [−⅔, ⅔].
     double D1 = 0.0, D2 = 0.0, D3 = 0.0, D4 = 0.0, D5 = 0.0;
   };
+  // A point where a function was evaluated exactly (argument 0: none yet),
+  // with the reciprocal of its argument. The state keeps the last ones of
+  // ε̄pⁿ, ln ε̇* and T*ᵐ: from one plastic step to the next ε̄p, ε̇* and T*
+  // move by small fractions, and the next step's values follow from them by
+  // the short series of nearby_power and nearby_log (each value a single
+  // series from an exact evaluation, so nothing accumulates over steps).
+  struct NearbyPoint {
+    double argument = 0.0;
+    double inverse = 0.0;
+    double value = 0.0;
+  };
+  // σ* where exp(D3 σ*) of the failure strain was last evaluated exactly, and
+  // that value (initially exp(0) = 1 at σ* = 0).
+  struct ExponentialPoint {
+    double triaxiality = 0.0;
+    double value = 1.0;
+  };
   struct State {
     StressVoigt stress;
     double eps_p;        // equivalent plastic strain ε̄p
@@ -89,11 +106,25 @@ struct JohnsonCook {
     // At the state's T and ε̄p, kept so that an elastic step costs no pow():
     double thermal_softening;  // 1 − T*ᵐ
     double yield_stress;       // quasi-static (A + B ε̄pⁿ)(1 − T*ᵐ): the next step's elastic limit
+    // The anchors of the series (NearbyPoint, ExponentialPoint above): they
+    // change the results only at round-off, and a restart needs them to
+    // repeat the uninterrupted run bit for bit.
+    NearbyPoint power_anchor{};        // ε̄pⁿ
+    NearbyPoint log_anchor{};          // ln ε̇*
+    NearbyPoint thermal_anchor{};      // T*ᵐ
+    ExponentialPoint damage_anchor{};  // exp(D3 σ*)
+    // ε̄̇p of the two steps before the last (0 where elastic): the return's
+    // start extrapolates the rate from the last three steps.
+    double previous_strain_rate = 0.0, before_previous_strain_rate = 0.0;
     // The fields a checkpoint stores (material.hpp).
     template <class S, class F>
     static void for_each_field(S& self, F&& field) {
       field(self.stress, self.eps_p, self.sigma_y, self.strain_rate, self.temperature, self.D, self.failed,
-            self.thermal_softening, self.yield_stress);
+            self.thermal_softening, self.yield_stress, self.power_anchor.argument, self.power_anchor.inverse,
+            self.power_anchor.value, self.log_anchor.argument, self.log_anchor.inverse, self.log_anchor.value,
+            self.thermal_anchor.argument, self.thermal_anchor.inverse, self.thermal_anchor.value,
+            self.damage_anchor.triaxiality, self.damage_anchor.value, self.previous_strain_rate,
+            self.before_previous_strain_rate);
     }
   };
   struct UpdateResult {
@@ -117,7 +148,8 @@ struct JohnsonCook {
         heating_(parameters.taylor_quinney > 0.0
                      ? parameters.taylor_quinney / (parameters.density * parameters.specific_heat)
                      : 0.0),
-        power_series_(parameters.n) {}
+        power_series_(parameters.n),
+        thermal_series_(parameters.m) {}
 
   State initial_state() const {
     const double thermal = thermal_factor(homologous_temperature(parameters_.initial_temperature));
@@ -133,7 +165,7 @@ struct JohnsonCook {
   UpdateResult update(State& state, const StrainVoigt& d_eps, const UpdateContext& context) const {
     if (state.failed) {
       state.stress.setZero();
-      state.strain_rate = 0.0;
+      record_strain_rate(state, 0.0);
       return {false, 0};
     }
     detail::require_finite_strain(d_eps);
@@ -142,7 +174,7 @@ struct JohnsonCook {
     const double trial_squared = von_mises_squared(trial);
     if (trial_squared <= quasi_static * quasi_static) {
       state.stress = trial;
-      state.strain_rate = 0.0;
+      record_strain_rate(state, 0.0);
       return {false, 0};
     }
     detail::require_time_step(context.time_step);
@@ -155,16 +187,17 @@ struct JohnsonCook {
     // which is the one it returns: the hardening of the next elastic limit and
     // the damage's rate term reuse them instead of a second pow() and log().
     double hardening_at_return = parameters_.A, log_rate_at_return = 0.0;
-    // The iterates after the first move by a small fraction of ε̄p and
-    // of Δε̄p: ε̄pⁿ and ln ε̇* follow by short series from their values at the
-    // last iterate evaluated exactly (nearby_power, nearby_log) instead of
+    // The iterates move by a small fraction of ε̄p and of Δε̄p from the last
+    // step's return and from each other: ε̄pⁿ and ln ε̇* follow by short series
+    // from their values at the last argument evaluated exactly (nearby_power,
+    // nearby_log; the anchors are kept in the state across steps) instead of
     // another pow() and log(); each value is within round-off of theirs.
-    NearbyPoint power_anchor, log_anchor;
+    NearbyPoint power_anchor = state.power_anchor, log_anchor = state.log_anchor;
     // Forced inline (its pow() and log() branches keep GCC from it): called, its
     // six results go through memory at each iterate.
     const auto flow = [&](double increment) __attribute__((always_inline)) {
       const double eps_p = eps_p_n + increment;
-      const NearbyValue power = nearby_power(power_anchor, eps_p);
+      const NearbyValue power = nearby_power(power_series_, parameters_.n, power_anchor, eps_p);
       const double hardening = parameters_.A + parameters_.B * power.value;
       // d(Bε̄pⁿ)/dε̄p and its derivative, (n − 1)/ε̄p times it; at ε̄p = 0 the
       // slope is +inf (n < 1), B (n = 1) or 0.
@@ -190,9 +223,10 @@ struct JohnsonCook {
           (hardening_curvature * rate_factor + 2.0 * hardening_slope * rate_slope + hardening * rate_curvature) *
               thermal};
     };
-    // Started from the last step's Δε̄p at the same rate (0 after an elastic step or
-    // in the quasi-static limit: then from the perfectly plastic return).
-    const double guess = state.strain_rate * context.time_step;
+    // Started from Δε̄p at the rate extrapolated from the last three steps
+    // (start_rate), or the last step's rate, or (0 after an elastic step or in
+    // the quasi-static limit) from the perfectly plastic return.
+    const double guess = start_rate(state) * context.time_step;
     const double trial_equivalent = std::sqrt(trial_squared);
     const double excess = trial_equivalent - quasi_static;
     // The steep start (see the top of the file): ε̄p,n and the root both lie
@@ -211,11 +245,17 @@ struct JohnsonCook {
 
     state.eps_p = eps_p_n + increment;
     state.sigma_y = solution.flow_stress;
-    state.strain_rate = increment / context.time_step;
-    state.D += increment / failure_strain_from_log_rate(triaxiality(solution.stress), log_rate_at_return, homologous);
+    record_strain_rate(state, increment / context.time_step);
+    state.power_anchor = power_anchor;
+    state.log_anchor = log_anchor;
+    const double damage_exponential = nearby_exponential(state.damage_anchor, triaxiality(solution.stress));
+    state.D += increment / failure_strain_from_terms(damage_exponential, log_rate_at_return, homologous);
     if (heating_ > 0.0) {
       state.temperature += heating_ * solution.flow_stress * increment;
-      state.thermal_softening = thermal_factor(homologous_temperature(state.temperature));
+      // 1 − T*ᵐ as thermal_factor, T*ᵐ by the series from the last exact one.
+      const double heated = homologous_temperature(state.temperature);
+      state.thermal_softening =
+          heated > 0.0 ? 1.0 - nearby_power(thermal_series_, parameters_.m, state.thermal_anchor, heated).value : 1.0;
     }
     state.yield_stress = hardening_at_return * state.thermal_softening;  // (A + B ε̄pⁿ)(1 − T*ᵐ) at ε̄p,n+1
     if (state.D >= 1.0 || state.temperature >= parameters_.melting_temperature) {
@@ -248,8 +288,7 @@ struct JohnsonCook {
   }
   // The same with ln ε̇* given (0 for ε̇* ≤ 1).
   double failure_strain_from_log_rate(double triaxiality, double log_rate, double homologous) const {
-    return (parameters_.D1 + parameters_.D2 * std::exp(parameters_.D3 * triaxiality)) *
-           (1.0 + parameters_.D4 * log_rate) * (1.0 + parameters_.D5 * homologous);
+    return failure_strain_from_terms(std::exp(parameters_.D3 * triaxiality), log_rate, homologous);
   }
 
   const Parameters& parameters() const { return parameters_; }
@@ -263,7 +302,14 @@ struct JohnsonCook {
     constant("initial temperature", p.initial_temperature), constant("Taylor-Quinney coefficient", p.taylor_quinney);
     constant("density (heating)", p.density), constant("specific heat", p.specific_heat);
     constant("D1", p.D1), constant("D2", p.D2), constant("D3", p.D3), constant("D4", p.D4), constant("D5", p.D5);
+    // Listed last, so that a checkpoint of an earlier State (which lists no
+    // such entry) is refused naming it, not misread field by field.
+    constant("State layout", state_layout);
   }
+  // The layout of State's fields (for_each_field): raised whenever they
+  // change. 2: the series' anchors and the rates of the two steps before
+  // the last (1 had neither).
+  static constexpr double state_layout = 2.0;
   double youngs_modulus() const { return parameters_.E; }
   double poisson_ratio() const { return parameters_.nu; }
   double shear_modulus() const { return elasticity_.shear_modulus(); }
@@ -285,72 +331,131 @@ struct JohnsonCook {
   }
 
  private:
-  // A point where a function was evaluated exactly (argument 0: none yet),
-  // with the reciprocal of its argument.
-  struct NearbyPoint {
-    double argument = 0.0;
-    double inverse = 0.0;
-    double value = 0.0;
-  };
+  // The rate of the step's start. Where the last three steps all flowed, the
+  // parabola through their rates, extrapolated one step: along a loading
+  // that is smooth in time (an explicit run's steps resolve it) its error is
+  // of third order in the step, small enough that one Halley correction
+  // mostly meets the tolerance where the last rate needed two. Where the
+  // parabola is not positive (a rate falling to 0), the last step's rate.
+  // The return's safeguards hold either way: the start only has to lie in
+  // the bracket, and one outside it is replaced (solve_flow_stress).
+  static double start_rate(const State& state) {
+    const double last = state.strain_rate;
+    if (!(last > 0.0 && state.previous_strain_rate > 0.0 && state.before_previous_strain_rate > 0.0)) return last;
+    const double extrapolated =
+        3.0 * (last - state.previous_strain_rate) + state.before_previous_strain_rate;
+    return extrapolated > 0.0 ? extrapolated : last;
+  }
+  static void record_strain_rate(State& state, double rate) {
+    state.before_previous_strain_rate = state.previous_strain_rate;
+    state.previous_strain_rate = state.strain_rate;
+    state.strain_rate = rate;
+  }
+
+  // The same with exp(D3 σ*) given.
+  double failure_strain_from_terms(double damage_exponential, double log_rate, double homologous) const {
+    return (parameters_.D1 + parameters_.D2 * damage_exponential) * (1.0 + parameters_.D4 * log_rate) *
+           (1.0 + parameters_.D5 * homologous);
+  }
+
   // A function's value at x and 1/x (the derivatives' factor), the latter
-  // within δ⁴ ≤ 1e-12 of itself: only the corrections use it.
+  // within δ⁸ ≤ 4e-11 of itself: only the corrections use it.
   struct NearbyValue {
     double value;
     double inverse;
   };
   // Relative distance from the anchor below which the series of ln(1 + δ)
-  // to δ⁵ replaces log(): its first omitted term, δ⁶/6, is then below 2e-19.
-  static constexpr double series_reach = 1e-3;
+  // to δ¹¹ replaces log(): its first omitted term, δ¹²/12, is then below
+  // 2.1e-17 (absolute, in ln ε̇*; a fortieth of ln ε̇*'s last bit where ε̇* ≥ e,
+  // and the rate factor 1 + C ln ε̇* sees C times it). Wide enough for ε̇* of
+  // a step from the last steps' along a smooth loading.
+  static constexpr double series_reach = 5e-2;
+  // |D3 Δσ*| below which exp(D3 σ*) follows from the anchor's by the series of
+  // exp to the 7th power: the first omitted term, x⁸/8!, is then below 6.4e-19
+  // (relative).
+  static constexpr double exponential_reach = 2e-2;
 
-  // The binomial series of (1 + δ)ⁿ to δ⁶: its coefficients C(n, k) and its
-  // reach, the largest |δ| (at most 1e-2) with |C(n, 7)δ⁷| ≤ 2⁻⁵⁴ and each
-  // further term below half the one before (|(n − k)δ/(k + 1)| ≤ ½ for k ≥ 7).
+  // The binomial series of (1 + δ)ⁿ to δ¹⁰: its coefficients C(n, k) and its
+  // reach, the largest |δ| (at most 5e-2) with |C(n, 11)δ¹¹| ≤ 2⁻⁵⁴ and each
+  // further term below half the one before (|(n − k)δ/(k + 1)| ≤ ½ for
+  // k ≥ 11, which δ ≤ 6/max(|n − 11|, 12) ensures). 5e-2 keeps nearby_inverse
+  // within δ⁸ < 4e-11.
   struct PowerSeries {
+    static constexpr int terms = 11;
     explicit PowerSeries(double n) {
       double c = 1.0;
-      for (int k = 0; k < 7; ++k) {
+      for (int k = 0; k < terms; ++k) {
         coefficients[k] = c;
         c *= (n - k) / (k + 1);
       }
-      reach = std::min(1e-2, 4.0 / std::max(std::abs(n - 7.0), 1.0));
-      if (c != 0.0) reach = std::min(reach, std::pow(0.25 * std::numeric_limits<double>::epsilon() / std::abs(c), 1.0 / 7.0));
+      reach = std::min(5e-2, 6.0 / std::max(std::abs(n - terms), 12.0));
+      if (c != 0.0)
+        reach = std::min(reach, std::pow(0.25 * std::numeric_limits<double>::epsilon() / std::abs(c), 1.0 / terms));
     }
-    double coefficients[7];
+    double coefficients[terms];
     double reach;
   };
 
-  // 1/x from the anchor's reciprocal, 1/(a(1 + δ)) = (1/a)(1 − δ + δ² − δ³).
+  // 1/x from the anchor's reciprocal, 1/(a(1 + δ)) = (1/a)(1 − δ + δ² − … − δ⁷)
+  // = (1/a)(1 − δ)(1 + δ²)(1 + δ⁴).
   static double nearby_inverse(const NearbyPoint& anchor, double delta) {
-    return anchor.inverse * (1.0 - delta * (1.0 - delta * (1.0 - delta)));
+    const double delta_2 = delta * delta;
+    return anchor.inverse * ((1.0 - delta) * (1.0 + delta_2)) * (1.0 + delta_2 * delta_2);
   }
-  // xⁿ, from the anchor's value by the binomial series (PowerSeries, in
-  // Estrin's grouping) when x is within its reach, else by std::pow (and x
-  // becomes the anchor).
-  NearbyValue nearby_power(NearbyPoint& anchor, double x) const {
-    if (anchor.argument > 0.0) {
-      const double delta = x * anchor.inverse - 1.0;
-      if (std::abs(delta) <= power_series_.reach) {
-        const double* c = power_series_.coefficients;
-        const double delta_2 = delta * delta, delta_4 = delta_2 * delta_2;
-        const double series = (1.0 + c[1] * delta) + delta_2 * (c[2] + c[3] * delta) +
-                              delta_4 * ((c[4] + c[5] * delta) + delta_2 * c[6]);
-        return {anchor.value * series, nearby_inverse(anchor, delta)};
-      }
+  // x to the power `exponent` (x ≥ 0; series_of is its PowerSeries), from
+  // the anchor's value by the binomial series (in Estrin's grouping) when x
+  // is within its reach. Else std::pow gives the value at a new anchor, put
+  // ahead of x by the reach: the arguments (ε̄p, T*) only grow, so x lies
+  // within reach below it and the growth up to twice the reach follows by
+  // the series.
+  [[gnu::always_inline]] static NearbyValue nearby_power(const PowerSeries& series_of, double exponent,
+                                                         NearbyPoint& anchor, double x) {
+    double delta = x * anchor.inverse - 1.0;  // −1 while there is no anchor
+    if (!(std::abs(delta) <= series_of.reach)) {
+      if (!(x > 0.0)) return {std::pow(x, exponent), 1.0 / x};  // ε̄p = 0: no anchor there
+      const double ahead = x * (1.0 + series_of.reach);
+      anchor = {ahead, 1.0 / ahead, std::pow(ahead, exponent)};
+      delta = x * anchor.inverse - 1.0;  // −reach/(1 + reach), within reach
     }
-    anchor = {x, 1.0 / x, std::pow(x, parameters_.n)};
-    return {anchor.value, anchor.inverse};
+    const double* c = series_of.coefficients;
+    const double delta_2 = delta * delta, delta_4 = delta_2 * delta_2;
+    const double series = ((1.0 + c[1] * delta) + delta_2 * (c[2] + c[3] * delta)) +
+                          delta_4 * (((c[4] + c[5] * delta) + delta_2 * (c[6] + c[7] * delta)) +
+                                     delta_4 * ((c[8] + c[9] * delta) + delta_2 * c[10]));
+    return {anchor.value * series, nearby_inverse(anchor, delta)};
   }
-  // ln x, from the anchor's by the series of ln(1 + δ) to δ⁵ when x is within
-  // series_reach of it, else by std::log (and x becomes the anchor).
-  static NearbyValue nearby_log(NearbyPoint& anchor, double x) {
+  // ln x, from the anchor's by the series of ln(1 + δ) to δ¹¹ (Estrin's
+  // grouping) when x is within series_reach of it, else by std::log (and x
+  // becomes the anchor).
+  [[gnu::always_inline]] static NearbyValue nearby_log(NearbyPoint& anchor, double x) {
     if (anchor.argument > 0.0) {
       const double delta = x * anchor.inverse - 1.0;
-      if (std::abs(delta) <= series_reach)
-        return {anchor.value + delta * (1.0 - delta * (0.5 - delta * (1.0 / 3.0 - delta * (0.25 - delta * 0.2)))),
-                nearby_inverse(anchor, delta)};
+      if (std::abs(delta) <= series_reach) {
+        const double delta_2 = delta * delta, delta_4 = delta_2 * delta_2;
+        // ln(1 + δ) = δ (1 − δ/2 + δ²/3 − δ³/4 + … + δ⁸/9 − δ⁹/10 + δ¹⁰/11 − …)
+        const double series =
+            ((1.0 - 0.5 * delta) + delta_2 * (1.0 / 3.0 - 0.25 * delta)) +
+            delta_4 * (((0.2 - delta * (1.0 / 6.0)) + delta_2 * (1.0 / 7.0 - 0.125 * delta)) +
+                       delta_4 * ((1.0 / 9.0 - 0.1 * delta) + delta_2 * (1.0 / 11.0)));
+        return {anchor.value + delta * series, nearby_inverse(anchor, delta)};
+      }
     }
     anchor = {x, 1.0 / x, std::log(x)};
     return {anchor.value, anchor.inverse};
+  }
+  // exp(D3 σ*), from the anchor's by the series of exp(x), x = D3 (σ* − σ*ₐ),
+  // to x⁷ (Estrin's grouping) when |x| ≤ exponential_reach, else by std::exp
+  // (and σ* becomes the anchor).
+  double nearby_exponential(ExponentialPoint& anchor, double triaxiality) const {
+    const double x = parameters_.D3 * (triaxiality - anchor.triaxiality);
+    if (std::abs(x) <= exponential_reach) {
+      const double x_2 = x * x, x_4 = x_2 * x_2;
+      const double series = ((1.0 + x) + x_2 * (0.5 + x * (1.0 / 6.0))) +
+                            x_4 * ((1.0 / 24.0 + x * (1.0 / 120.0)) + x_2 * (1.0 / 720.0 + x * (1.0 / 5040.0)));
+      return anchor.value * series;
+    }
+    anchor = {triaxiality, std::exp(parameters_.D3 * triaxiality)};
+    return anchor.value;
   }
 
   // 2⁻⁶⁴ of the return's bound on Δε̄p: below it, the iteration in Δε̄p would
@@ -462,6 +567,7 @@ struct JohnsonCook {
   double inverse_temperature_range_;          // 1/(Tm − Tr)
   double heating_;                             // β/(ρ cp), 0 without heating
   PowerSeries power_series_;                   // of ε̄pⁿ near an anchor
+  PowerSeries thermal_series_;                 // of T*ᵐ near an anchor
 };
 
 }  // namespace sphshell::material
