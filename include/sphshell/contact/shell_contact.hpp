@@ -325,8 +325,8 @@ class ShellContact {
     std::vector<ShellContactPair> result;
     if (blocks_.empty()) return result;
     const PairBlock& pairs = blocks_[a / pair_block_particles];
-    const std::size_t local = a % pair_block_particles;
-    for (std::size_t k = local == 0 ? 0 : pairs.pair_end[local - 1]; k < pairs.pair_end[local]; ++k) {
+    const PairRange range = pairs.of(a % pair_block_particles);
+    for (std::size_t k = range.begin; k < range.end; ++k) {
       ShellContactPair pair;
       pair.partner = pairs.sides[k].partner;
       pair.side = pairs.sides[k].side;
@@ -431,6 +431,9 @@ class ShellContact {
     Vector3 force;  // on a; −force on b
     Vector3 partner_moment;  // on b's rotation
   };
+  struct PairRange {
+    std::size_t begin, end;
+  };
   // The pairs of pair_block_particles consecutive particles, in particle and
   // patch order, side by side with no room left between particles: a step
   // writes and the next one reads only the pairs found. The blocks are fixed
@@ -442,6 +445,8 @@ class ShellContact {
     std::vector<PairLoad> loads;        // this step's forces
     std::size_t candidates = 0;         // candidate pairs of the block's particles
     std::size_t most_patches = 0;       // the most patches one of them met
+    // The pairs of the block's local-th particle: [begin, end) in sides and loads.
+    PairRange of(std::size_t local) const { return {local == 0 ? 0 : pair_end[local - 1], pair_end[local]}; }
   };
 
   // The side of b's mid-surface a lies on: remembered from the last step if
@@ -455,8 +460,9 @@ class ShellContact {
     const std::size_t block = a / pair_block_particles, local = a % pair_block_particles;
     if (block < previous_blocks_.size()) {
       const PairBlock& history = previous_blocks_[block];
-      const PairSide* first = history.sides.data() + (local == 0 ? 0 : history.pair_end[local - 1]);
-      const PairSide* last = history.sides.data() + history.pair_end[local];
+      const PairRange range = history.of(local);
+      const PairSide* first = history.sides.data() + range.begin;
+      const PairSide* last = history.sides.data() + range.end;
       for (const PairSide* previous = first; previous != last; ++previous)
         if (previous->partner == b) return previous->side;
       const Vector3& db = particles.director[static_cast<std::size_t>(b)];

@@ -78,12 +78,7 @@ class SparseFactorisation {
         cholesky_ = std::make_unique<Eigen::CholmodSupernodalLLT<Matrix>>();
         cholesky_->cholmod().print = 0;  // a tangent that is not positive definite is handled below, not printed
       }
-      if (!same_pattern || !cholesky_analysed_) {
-        cholesky_->analyzePattern(symmetric);
-        cholesky_analysed_ = true;
-      }
-      cholesky_->factorize(symmetric);
-      if (cholesky_->info() == Eigen::Success) {
+      if (refactorise(*cholesky_, cholesky_analysed_, same_pattern, symmetric)) {
         method_ = FactorisationMethod::cholmod_cholesky;
         return true;
       }
@@ -91,12 +86,7 @@ class SparseFactorisation {
     }
 #endif
     if (!ldlt_) ldlt_ = std::make_unique<Eigen::SimplicialLDLT<Matrix, Eigen::Lower, Eigen::AMDOrdering<int>>>();
-    if (!same_pattern || !ldlt_analysed_) {
-      ldlt_->analyzePattern(symmetric);
-      ldlt_analysed_ = true;
-    }
-    ldlt_->factorize(symmetric);
-    if (ldlt_->info() != Eigen::Success) return false;
+    if (!refactorise(*ldlt_, ldlt_analysed_, same_pattern, symmetric)) return false;
     method_ = FactorisationMethod::simplicial_ldlt;
     return true;
   }
@@ -106,12 +96,7 @@ class SparseFactorisation {
   bool factorise_general(const Matrix& matrix) {
     method_ = FactorisationMethod::none;
     if (!lu_) lu_ = std::make_unique<Eigen::SparseLU<Matrix, Eigen::COLAMDOrdering<int>>>();
-    if (!remember_pattern(matrix, Pattern::general) || !lu_analysed_) {
-      lu_->analyzePattern(matrix);
-      lu_analysed_ = true;
-    }
-    lu_->factorize(matrix);
-    if (lu_->info() != Eigen::Success) return false;
+    if (!refactorise(*lu_, lu_analysed_, remember_pattern(matrix, Pattern::general), matrix)) return false;
     method_ = FactorisationMethod::lu;
     return true;
   }
@@ -137,6 +122,17 @@ class SparseFactorisation {
 
  private:
   enum class Pattern { none, symmetric, general };
+  // Factorises `matrix` by `factoriser`, analysing its pattern first unless
+  // the factoriser has analysed this same pattern already; true on success.
+  template <class Factoriser>
+  static bool refactorise(Factoriser& factoriser, bool& analysed, bool same_pattern, const Matrix& matrix) {
+    if (!same_pattern || !analysed) {
+      factoriser.analyzePattern(matrix);
+      analysed = true;
+    }
+    factoriser.factorize(matrix);
+    return factoriser.info() == Eigen::Success;
+  }
   // Records the pattern of `matrix`; true if it is the pattern (and kind)
   // analysed last.
   bool remember_pattern(const Matrix& matrix, Pattern kind) {
