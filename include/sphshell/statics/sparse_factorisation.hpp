@@ -16,6 +16,12 @@
 //    (docs/performance.md, "Static solutions").
 //  - general (a tangent off equilibrium, or under follower loads): Eigen's
 //    sparse LU (COLAMD ordering).
+// factorise_tangent chooses between the two by the tangent's measured
+// asymmetry (solve_static's Newton). The path following keeps the LU
+// (factorise_general): on the pinched cylinder's octant (8,405 unknowns) its
+// tangents turn indefinite within load steps, and the LU factorised and
+// solved faster than the symmetric part's Cholesky or LDLᵀ
+// (docs/performance-history.md).
 // The fill-reducing ordering and the symbolic analysis depend on the pattern
 // alone: they are redone only when the pattern changes, which gives the same
 // numbers as a fresh factorisation (the pivoting is numeric).
@@ -37,6 +43,15 @@
 #include <vector>
 
 namespace sphshell::statics {
+
+// A tangent counts as symmetric when ‖K − Kᵀ‖_F is below this share of ‖K‖_F:
+// the central differences leave an elastic tangent at equilibrium symmetric
+// to their own error (3e-9 on the pinched cylinder's octant), while a tangent
+// off equilibrium, of a path-dependent law or under follower loads differs
+// from its transpose by far more. Newton on the symmetrised tangent of one
+// that passes converges as on the tangent itself up to this share (one
+// contraction by at most this factor per iteration, below the tolerances).
+inline constexpr double symmetric_tangent_tolerance = 1e-4;
 
 // Which factorisation holds the tangent.
 enum class FactorisationMethod {
@@ -89,6 +104,16 @@ class SparseFactorisation {
     if (!refactorise(*ldlt_, ldlt_analysed_, same_pattern, symmetric)) return false;
     method_ = FactorisationMethod::simplicial_ldlt;
     return true;
+  }
+
+  // Factorises a tangent: its symmetric part (factorise_symmetric) when it is
+  // symmetric to symmetric_tangent_tolerance, else the tangent itself by LU;
+  // false if the factorisation met a zero pivot.
+  bool factorise_tangent(const Matrix& tangent) {
+    const Matrix transpose = tangent.transpose();
+    if ((tangent - transpose).norm() <= symmetric_tangent_tolerance * tangent.norm())
+      return factorise_symmetric(Matrix(0.5 * (tangent + transpose)));
+    return factorise_general(tangent);
   }
 
   // Factorises a general square matrix by LU; false if it met a zero pivot

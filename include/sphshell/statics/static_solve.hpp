@@ -234,9 +234,6 @@ inline constexpr double free_eigenvalue = 0.5;
 inline constexpr double rigid_mode_tolerance = 1e-10;
 // Line search: halve the Newton step at most this many times.
 inline constexpr int max_step_halvings = 12;
-// The tangent counts as symmetric when ‖K − Kᵀ‖ is below this share of ‖K‖
-// (the differences leave an asymmetry of the order of their error).
-inline constexpr double symmetric_tangent_tolerance = 1e-4;
 // m_a = gershgorin_mass_factor × h² Σ_b |K_ab| (see the relaxation below).
 inline constexpr double gershgorin_mass_factor = 0.5;
 // Underwood's damping c = 2 ω₀ with the pseudo step h = 1 is stable for c h < 2.
@@ -431,11 +428,7 @@ class NewtonFactorisation {
   void factorise(const SparseMatrix& K, int load_step, double lambda) {
     load_step_ = load_step;
     lambda_ = lambda;
-    const SparseMatrix transpose = K.transpose();
-    const bool factorised = (K - transpose).norm() <= detail::symmetric_tangent_tolerance * K.norm()
-                                ? factorisation_.factorise_symmetric(SparseMatrix(0.5 * (K + transpose)))
-                                : factorisation_.factorise_general(K);
-    if (!factorised) throw singular();
+    if (!factorisation_.factorise_tangent(K)) throw singular();
   }
   bool valid() const { return factorisation_.valid(); }
   Eigen::Index size() const { return factorisation_.size(); }
