@@ -148,6 +148,8 @@ struct JohnsonCook {
         heating_(parameters.taylor_quinney > 0.0
                      ? parameters.taylor_quinney / (parameters.density * parameters.specific_heat)
                      : 0.0),
+        inverse_reference_strain_rate_(1.0 / parameters.reference_strain_rate),
+        inverse_stress_scale_(1.0 / parameters.A),
         power_series_(parameters.n),
         thermal_series_(parameters.m) {}
 
@@ -180,8 +182,10 @@ struct JohnsonCook {
     detail::require_time_step(context.time_step);
     const double homologous = homologous_temperature(state.temperature);
     const double thermal = state.thermal_softening;
-    // ε̇* per unit Δε̄p; 0 in the quasi-static limit.
-    const double rate_per_increment = 1.0 / (context.time_step * parameters_.reference_strain_rate);
+    // 1/Δt (0 in the quasi-static limit) and ε̇* per unit Δε̄p, 1/(Δt ε̇0): the
+    // step's one division for its rates.
+    const double inverse_time_step = 1.0 / context.time_step;
+    const double rate_per_increment = inverse_time_step * inverse_reference_strain_rate_;
     const double eps_p_n = state.eps_p;
     // A + Bε̄pⁿ and ln ε̇* (0 below ε̇* = 1) at the last Δε̄p the return evaluated,
     // which is the one it returns: the hardening of the next elastic limit and
@@ -234,21 +238,22 @@ struct JohnsonCook {
     // the Δε̄p at which A + Bε̄pⁿ alone reaches σ̄*/θ, where ε̄pⁿ = hardening_limit:
     // the rate factor is ≥ 1 and uᵢ ≥ σs. Only a step from (nearly) ε̄p = 0
     // pays the test's pow().
-    const double steep_reach = steep_fraction * excess / std::min(constants_.kappa_1, constants_.kappa_2);
+    const double steep_reach = steep_fraction * excess * constants_.inverse_min_slope;  // 1/min κᵢ (Ep = 0)
     const bool steep = parameters_.n < 1.0 && parameters_.B > 0.0 && eps_p_n < steep_reach &&
                        hardening_limit(trial_equivalent, thermal) < std::pow(eps_p_n + steep_reach, parameters_.n);
     const return_map::FlowStressSolution solution =
-        steep ? steep_return(trial, quasi_static, trial_equivalent, eps_p_n, thermal, rate_per_increment,
+        steep ? steep_return(trial, trial_equivalent, eps_p_n, thermal, rate_per_increment,
                              hardening_at_return, log_rate_at_return)
-              : return_map::solve_flow_stress(constants_, trial, 1.0 / quasi_static, flow, excess, guess);
+              : return_map::solve_flow_stress(constants_, trial, inverse_stress_scale_, flow, excess, guess);
     const double increment = solution.plastic_strain_increment;
 
     state.eps_p = eps_p_n + increment;
     state.sigma_y = solution.flow_stress;
-    record_strain_rate(state, increment / context.time_step);
+    record_strain_rate(state, increment * inverse_time_step);
     state.power_anchor = power_anchor;
     state.log_anchor = log_anchor;
-    const double damage_exponential = nearby_exponential(state.damage_anchor, triaxiality(solution.stress));
+    const double damage_exponential = nearby_exponential(
+        state.damage_anchor, returned_triaxiality(trial, solution.flow_stress, increment));
     state.D += increment / failure_strain_from_terms(damage_exponential, log_rate_at_return, homologous);
     if (heating_ > 0.0) {
       state.temperature += heating_ * solution.flow_stress * increment;
@@ -281,6 +286,15 @@ struct JohnsonCook {
   static double triaxiality(const StressVoigt& stress) {
     const double equivalent = std::sqrt(von_mises_squared(stress));
     return equivalent > 0.0 ? (stress.x() + stress.y()) / (3.0 * equivalent) : 0.0;
+  }
+  // σ* of the stress returned from `trial` with flow stress σs and increment
+  // Δε̄p, without forming it: σ = L⁻¹σ* scales the trial's σx + σy (the
+  // eigen-direction of κ₁) by σs/u₁, u₁ = σs + κ₁Δε̄p (eq. 2.32–2.33,
+  // flow_stress_return.hpp), and σ̄ = σs·S with |S² − 1| ≤ 1e-12 (the return's
+  // tolerance), so σ* = (σx* + σy*)/(3u₁) up to a factor S within 5e-13 of 1:
+  // no square root, and the division runs beside the stress' own.
+  double returned_triaxiality(const StressVoigt& trial, double flow_stress, double increment) const {
+    return (trial.x() + trial.y()) / (3.0 * (flow_stress + constants_.kappa_1 * increment));
   }
   // εf of the 1985 paper at σ*, ε̇* and T* (ln ε̇* taken as 0 for ε̇* < 1).
   double failure_strain(double triaxiality, double rate, double homologous) const {
@@ -478,7 +492,7 @@ struct JohnsonCook {
   // started at the limit: without the rate term the root lies within κᵢΔε̄p/σ̄*
   // (< 2⁻⁶³ of the excess over σ̄*) of it, so the start meets the tolerance.
   // Sets the hardening A + Bv and ln ε̇* of the returned v, as the update's flow does.
-  return_map::FlowStressSolution steep_return(const StressVoigt& trial, double quasi_static, double trial_equivalent,
+  return_map::FlowStressSolution steep_return(const StressVoigt& trial, double trial_equivalent,
                                               double eps_p_n, double thermal, double rate_per_increment,
                                               double& hardening_at_return, double& log_rate_at_return) const {
     const Parameters& p = parameters_;
@@ -507,7 +521,7 @@ struct JohnsonCook {
     };
     const double upper = hardening_limit(trial_equivalent, thermal);
     const double lower = std::pow(eps_p_n, p.n);
-    return return_map::solve_flow_stress(constants_, trial, 1.0 / quasi_static, flow, upper, lower, upper);
+    return return_map::solve_flow_stress(constants_, trial, inverse_stress_scale_, flow, upper, lower, upper);
   }
 
   static void validate(const Parameters& p) {
@@ -566,6 +580,12 @@ struct JohnsonCook {
   return_map::ClosedFormConstants constants_;  // κᵢ of ΓΞ (Ep unused)
   double inverse_temperature_range_;          // 1/(Tm − Tr)
   double heating_;                             // β/(ρ cp), 0 without heating
+  double inverse_reference_strain_rate_;       // 1/ε̇0
+  // 1/A: the return's stress scale (flow_stress_return.hpp; any stress of the
+  // return's size keeps its numbers far from over- and underflow, and the
+  // residual test is scale-free). A constant, so that no division by the last
+  // step's yield stress stands at the head of the next step's return.
+  double inverse_stress_scale_;
   PowerSeries power_series_;                   // of ε̄pⁿ near an anchor
   PowerSeries thermal_series_;                 // of T*ᵐ near an anchor
 };
