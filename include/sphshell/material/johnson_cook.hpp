@@ -197,11 +197,21 @@ struct JohnsonCook {
     // nearby_log; the anchors are kept in the state across steps) instead of
     // another pow() and log(); each value is within round-off of theirs.
     NearbyPoint power_anchor = state.power_anchor, log_anchor = state.log_anchor;
+    // The return's first iterate (its start) is evaluated by those series; the
+    // correction then moves Δε̄p by a small fraction of itself (the start is
+    // within 2e-4 of the root on a smooth loading), so the later iterates
+    // follow from the first one's exact reciprocals by the shorter series of
+    // step_power and step_log, at the same round-off (PowerSeries::step_reach,
+    // step_log_reach). The reciprocals' divisions depend on the start only and
+    // run beside the first evaluation.
+    NearbyPoint power_step_anchor{}, log_step_anchor{};
     // Forced inline (its pow() and log() branches keep GCC from it): called, its
     // six results go through memory at each iterate.
     const auto flow = [&](double increment) __attribute__((always_inline)) {
       const double eps_p = eps_p_n + increment;
-      const NearbyValue power = nearby_power(power_series_, parameters_.n, power_anchor, eps_p);
+      const NearbyValue power = power_step_anchor.argument > 0.0
+                                    ? step_power(power_series_, parameters_.n, power_anchor, power_step_anchor, eps_p)
+                                    : first_power(power_series_, parameters_.n, power_anchor, power_step_anchor, eps_p);
       const double hardening = parameters_.A + parameters_.B * power.value;
       // d(Bε̄pⁿ)/dε̄p and its derivative, (n − 1)/ε̄p times it; at ε̄p = 0 the
       // slope is +inf (n < 1), B (n = 1) or 0.
@@ -210,7 +220,9 @@ struct JohnsonCook {
       const double hardening_curvature = (parameters_.n - 1.0) * hardening_slope * power.inverse;
       const double rate = increment * rate_per_increment;
       const bool rate_active = rate > 1.0;  // ln ε̇* taken as 0 below ε̇* = 1
-      const NearbyValue log_rate = rate_active ? nearby_log(log_anchor, rate) : NearbyValue{0.0, 0.0};
+      const NearbyValue log_rate = !rate_active ? NearbyValue{0.0, 0.0}
+                                   : log_step_anchor.argument > 0.0 ? step_log(log_anchor, log_step_anchor, rate)
+                                                                    : first_log(log_anchor, log_step_anchor, rate);
       const double rate_factor = 1.0 + parameters_.C * log_rate.value;
       // d(1 + C ln ε̇*)/dΔε̄p = C/Δε̄p and its derivative −C/Δε̄p² (1/Δε̄p from 1/ε̇*).
       const double inverse_increment = rate_per_increment * log_rate.inverse;
@@ -384,6 +396,10 @@ struct JohnsonCook {
   // and the rate factor 1 + C ln ε̇* sees C times it). Wide enough for ε̇* of
   // a step from the last steps' along a smooth loading.
   static constexpr double series_reach = 5e-2;
+  // Relative distance from the step anchor below which ln(1 + δ) to δ⁵
+  // replaces the longer series: the first omitted term, δ⁶/6, is then below
+  // 1.1e-17 (absolute in ln ε̇*), and the terms after it fall by δ each.
+  static constexpr double step_log_reach = 2e-3;
   // |D3 Δσ*| below which exp(D3 σ*) follows from the anchor's by the series of
   // exp to the 7th power: the first omitted term, x⁸/8!, is then below 6.4e-19
   // (relative).
@@ -405,9 +421,18 @@ struct JohnsonCook {
       reach = std::min(5e-2, 6.0 / std::max(std::abs(n - terms), 12.0));
       if (c != 0.0)
         reach = std::min(reach, std::pow(0.25 * std::numeric_limits<double>::epsilon() / std::abs(c), 1.0 / terms));
+      // The series to δ³ (step_power): |C(n, 4)δ⁴| ≤ 2⁻⁵⁵ and each further
+      // term at most half the one before (|(n − k)δ/(k + 1)| ≤ ½ for k ≥ 4,
+      // which |δ| ≤ 1/(2 max(|n|, 1)) ensures), so the remainder stays below
+      // 2⁻⁵⁴; at most 2e-3 (nearby_inverse within δ⁸).
+      const double c_4 = coefficients[4];
+      step_reach = std::min(2e-3, 0.5 / std::max(std::abs(n), 1.0));
+      if (c_4 != 0.0)
+        step_reach = std::min(step_reach, std::pow(0.125 * std::numeric_limits<double>::epsilon() / std::abs(c_4), 0.25));
     }
     double coefficients[terms];
     double reach;
+    double step_reach;  // of the series to δ³ about a step anchor
   };
 
   // 1/x from the anchor's reciprocal, 1/(a(1 + δ)) = (1/a)(1 − δ + δ² − … − δ⁷)
@@ -457,6 +482,48 @@ struct JohnsonCook {
     anchor = {x, 1.0 / x, std::log(x)};
     return {anchor.value, anchor.inverse};
   }
+  // The first iterate's ε̄pⁿ (nearby_power), which also becomes the step
+  // anchor of the later iterates, with the exact reciprocal of its argument
+  // (step_power's relative distance is formed with it, and an error in it
+  // would enter the value). ε̄p = 0 makes no step anchor.
+  [[gnu::always_inline]] static NearbyValue first_power(const PowerSeries& series_of, double exponent,
+                                                        NearbyPoint& anchor, NearbyPoint& step_anchor, double x) {
+    const NearbyValue power = nearby_power(series_of, exponent, anchor, x);
+    if (x > 0.0) step_anchor = {x, 1.0 / x, power.value};
+    return power;
+  }
+  // A later iterate's ε̄pⁿ: within PowerSeries::step_reach of the step anchor
+  // (relative), the binomial series to δ³,
+  //   (1 + δ)ⁿ = 1 + nδ + C(n, 2)δ² + C(n, 3)δ³ + …,
+  // whose remainder is below 2⁻⁵⁴ (PowerSeries::step_reach); further away
+  // nearby_power as for the first.
+  [[gnu::always_inline]] static NearbyValue step_power(const PowerSeries& series_of, double exponent,
+                                                       NearbyPoint& anchor, const NearbyPoint& step_anchor, double x) {
+    const double delta = (x - step_anchor.argument) * step_anchor.inverse;
+    if (!(std::abs(delta) <= series_of.step_reach)) return nearby_power(series_of, exponent, anchor, x);
+    const double* c = series_of.coefficients;
+    const double delta_2 = delta * delta;
+    const double series = (1.0 + c[1] * delta) + delta_2 * (c[2] + c[3] * delta);
+    return {step_anchor.value * series, nearby_inverse(step_anchor, delta)};
+  }
+  // ln ε̇* of the first iterate (nearby_log), which becomes the step anchor
+  // of the later iterates, with the exact reciprocal of ε̇*.
+  [[gnu::always_inline]] static NearbyValue first_log(NearbyPoint& anchor, NearbyPoint& step_anchor, double x) {
+    const NearbyValue log_value = nearby_log(anchor, x);
+    step_anchor = {x, 1.0 / x, log_value.value};
+    return log_value;
+  }
+  // A later iterate's ln ε̇*: within step_log_reach of the step anchor, the
+  // series of ln(1 + δ) to δ⁵; further away nearby_log as for the first.
+  [[gnu::always_inline]] static NearbyValue step_log(NearbyPoint& anchor, const NearbyPoint& step_anchor, double x) {
+    const double delta = (x - step_anchor.argument) * step_anchor.inverse;
+    if (!(std::abs(delta) <= step_log_reach)) return nearby_log(anchor, x);
+    const double delta_2 = delta * delta;
+    // ln(1 + δ) = δ (1 − δ/2 + δ²/3 − δ³/4 + δ⁴/5 − …)
+    const double series = ((1.0 - 0.5 * delta) + delta_2 * (1.0 / 3.0 - 0.25 * delta)) + delta_2 * delta_2 * 0.2;
+    return {step_anchor.value + delta * series, nearby_inverse(step_anchor, delta)};
+  }
+
   // exp(D3 σ*), from the anchor's by the series of exp(x), x = D3 (σ* − σ*ₐ),
   // to x⁷ (Estrin's grouping) when |x| ≤ exponential_reach, else by std::exp
   // (and σ* becomes the anchor).
