@@ -390,12 +390,13 @@ struct JohnsonCook {
     double value;
     double inverse;
   };
-  // Relative distance from the anchor below which the series of ln(1 + δ)
-  // to δ¹¹ replaces log(): its first omitted term, δ¹²/12, is then below
-  // 2.1e-17 (absolute, in ln ε̇*; a fortieth of ln ε̇*'s last bit where ε̇* ≥ e,
-  // and the rate factor 1 + C ln ε̇* sees C times it). Wide enough for ε̇* of
-  // a step from the last steps' along a smooth loading.
-  static constexpr double series_reach = 5e-2;
+  // |z| = |x − a|/(x + a) below which the series of 2 atanh z to z¹¹
+  // replaces log() (nearby_log; x/a within [0.905, 1.105]): its first omitted
+  // term, 2z¹³/13, is then below 1.9e-18 and each further one below z² = 2.5e-3
+  // times the one before (absolute, in ln ε̇*; a four-hundredth of ln ε̇*'s last
+  // bit where ε̇* ≥ e, and the rate factor 1 + C ln ε̇* sees C times it). Wide
+  // enough for ε̇* of several steps along a smooth loading.
+  static constexpr double log_series_reach = 5e-2;
   // Relative distance from the step anchor below which ln(1 + δ) to δ⁵
   // replaces the longer series: the first omitted term, δ⁶/6, is then below
   // 1.1e-17 (absolute in ln ε̇*), and the terms after it fall by δ each.
@@ -463,24 +464,27 @@ struct JohnsonCook {
                                      delta_4 * ((c[8] + c[9] * delta) + delta_2 * c[10]));
     return {anchor.value * series, nearby_inverse(anchor, delta)};
   }
-  // ln x, from the anchor's by the series of ln(1 + δ) to δ¹¹ (Estrin's
-  // grouping) when x is within series_reach of it, else by std::log (and x
-  // becomes the anchor).
+  // ln x and 1/x (exact), ln x from the anchor's as ln a + ln(x/a),
+  //   ln(x/a) = 2 atanh z = 2z (1 + z²/3 + z⁴/5 + … + z¹⁰/11 + …),  z = (x − a)/(x + a),
+  // to z¹¹ (Estrin's grouping in z²) when |z| ≤ log_series_reach, else by
+  // std::log (and x becomes the anchor). In z the series runs in even powers
+  // and falls by z² ≈ δ²/4 a term (δ = x/a − 1), so it reaches twice as far as
+  // the series of ln(1 + δ) to δ¹¹ with half the terms. Its two divisions
+  // depend on x alone: at the return's first iterate (the start) they run
+  // beside the rest of the step; the later iterates use step_log.
   [[gnu::always_inline]] static NearbyValue nearby_log(NearbyPoint& anchor, double x) {
+    const double inverse = 1.0 / x;
     if (anchor.argument > 0.0) {
-      const double delta = x * anchor.inverse - 1.0;
-      if (std::abs(delta) <= series_reach) {
-        const double delta_2 = delta * delta, delta_4 = delta_2 * delta_2;
-        // ln(1 + δ) = δ (1 − δ/2 + δ²/3 − δ³/4 + … + δ⁸/9 − δ⁹/10 + δ¹⁰/11 − …)
-        const double series =
-            ((1.0 - 0.5 * delta) + delta_2 * (1.0 / 3.0 - 0.25 * delta)) +
-            delta_4 * (((0.2 - delta * (1.0 / 6.0)) + delta_2 * (1.0 / 7.0 - 0.125 * delta)) +
-                       delta_4 * ((1.0 / 9.0 - 0.1 * delta) + delta_2 * (1.0 / 11.0)));
-        return {anchor.value + delta * series, nearby_inverse(anchor, delta)};
+      const double z = (x - anchor.argument) / (x + anchor.argument);
+      if (std::abs(z) <= log_series_reach) {
+        const double z_2 = z * z, z_4 = z_2 * z_2;
+        const double series = ((1.0 + z_2 * (1.0 / 3.0)) + z_4 * (0.2 + z_2 * (1.0 / 7.0))) +
+                              z_4 * z_4 * (1.0 / 9.0 + z_2 * (1.0 / 11.0));
+        return {anchor.value + 2.0 * z * series, inverse};
       }
     }
-    anchor = {x, 1.0 / x, std::log(x)};
-    return {anchor.value, anchor.inverse};
+    anchor = {x, inverse, std::log(x)};
+    return {anchor.value, inverse};
   }
   // The first iterate's ε̄pⁿ (nearby_power), which also becomes the step
   // anchor of the later iterates, with the exact reciprocal of its argument
@@ -489,8 +493,9 @@ struct JohnsonCook {
   [[gnu::always_inline]] static NearbyValue first_power(const PowerSeries& series_of, double exponent,
                                                         NearbyPoint& anchor, NearbyPoint& step_anchor, double x) {
     const NearbyValue power = nearby_power(series_of, exponent, anchor, x);
-    if (x > 0.0) step_anchor = {x, 1.0 / x, power.value};
-    return power;
+    if (!(x > 0.0)) return power;
+    step_anchor = {x, 1.0 / x, power.value};
+    return {power.value, step_anchor.inverse};
   }
   // A later iterate's ε̄pⁿ: within PowerSeries::step_reach of the step anchor
   // (relative), the binomial series to δ³,
@@ -507,10 +512,10 @@ struct JohnsonCook {
     return {step_anchor.value * series, nearby_inverse(step_anchor, delta)};
   }
   // ln ε̇* of the first iterate (nearby_log), which becomes the step anchor
-  // of the later iterates, with the exact reciprocal of ε̇*.
+  // of the later iterates with its exact reciprocal of ε̇*.
   [[gnu::always_inline]] static NearbyValue first_log(NearbyPoint& anchor, NearbyPoint& step_anchor, double x) {
     const NearbyValue log_value = nearby_log(anchor, x);
-    step_anchor = {x, 1.0 / x, log_value.value};
+    step_anchor = {x, log_value.inverse, log_value.value};
     return log_value;
   }
   // A later iterate's ln ε̇*: within step_log_reach of the step anchor, the
