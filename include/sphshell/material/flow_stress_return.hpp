@@ -109,23 +109,20 @@ class FlowStressKernel {
            (kappa_1_ * equibiaxial_part_ + kappa_2_ * deviatoric_part_);
   }
 
+  // h and the residual's scale at v; h′ and h″ only in correction(), so that
+  // the iterate that meets the tolerance (most often the first after the
+  // start) pays for no derivatives, and the flow stress' slopes, inlined,
+  // are computed only where a correction uses them.
   [[gnu::always_inline]] void evaluate(double v) {
     value_ = flow_(v);
-    const double f = value_.flow_stress * inverse_scale_, df = value_.flow_slope * inverse_scale_,
-                 ddf = value_.flow_curvature * inverse_scale_;
+    const double f = value_.flow_stress * inverse_scale_;
     u1_ = f + kappa_1_ * value_.increment;
     u2_ = f + kappa_2_ * value_.increment;
-    const double du1 = df + kappa_1_ * value_.increment_slope, du2 = df + kappa_2_ * value_.increment_slope;
-    const double ddu1 = ddf + kappa_1_ * value_.increment_curvature,
-                 ddu2 = ddf + kappa_2_ * value_.increment_curvature;
     const double p1 = u1_ * u1_, p2 = u2_ * u2_;
-    const double dp1 = 2.0 * u1_ * du1, dp2 = 2.0 * u2_ * du2;
-    const double ddp1 = 2.0 * (du1 * du1 + u1_ * ddu1), ddp2 = 2.0 * (du2 * du2 + u2_ * ddu2);
-    const double rest_1 = p1 - equibiaxial_part_, rest_2 = p2 - deviatoric_part_;
+    rest_1_ = p1 - equibiaxial_part_;
+    rest_2_ = p2 - deviatoric_part_;
     scale_ = p1 * p2;
-    h_ = rest_1 * rest_2 - equibiaxial_part_ * deviatoric_part_;
-    dh_ = dp1 * rest_2 + dp2 * rest_1;
-    ddh_ = ddp1 * rest_2 + 2.0 * dp1 * dp2 + ddp2 * rest_1;
+    h_ = rest_1_ * rest_2_ - equibiaxial_part_ * deviatoric_part_;
   }
 
   bool converged() const { return std::abs(h_) <= relative_tolerance * scale_; }
@@ -137,14 +134,23 @@ class FlowStressKernel {
   // S² − 1 (only for the error message).
   double relative_yield_residual() const { return -h_ / scale_; }
 
-  // Halley's correction; where hh″ ≥ h′² (far from the root, where Halley
-  // would more than double Newton's step or reverse it) Newton's, −h/h′.
+  // Halley's correction at the last evaluated v; where hh″ ≥ h′² (far from
+  // the root, where Halley would more than double Newton's step or reverse
+  // it) Newton's, −h/h′.
   [[gnu::always_inline]] double correction() const {
-    const double slope_squared = dh_ * dh_;
-    const double curvature_term = h_ * ddh_;
+    const double df = value_.flow_slope * inverse_scale_, ddf = value_.flow_curvature * inverse_scale_;
+    const double du1 = df + kappa_1_ * value_.increment_slope, du2 = df + kappa_2_ * value_.increment_slope;
+    const double ddu1 = ddf + kappa_1_ * value_.increment_curvature,
+                 ddu2 = ddf + kappa_2_ * value_.increment_curvature;
+    const double dp1 = 2.0 * u1_ * du1, dp2 = 2.0 * u2_ * du2;
+    const double ddp1 = 2.0 * (du1 * du1 + u1_ * ddu1), ddp2 = 2.0 * (du2 * du2 + u2_ * ddu2);
+    const double dh = dp1 * rest_2_ + dp2 * rest_1_;
+    const double ddh = ddp1 * rest_2_ + 2.0 * dp1 * dp2 + ddp2 * rest_1_;
+    const double slope_squared = dh * dh;
+    const double curvature_term = h_ * ddh;
     const double denominator = curvature_term < slope_squared ? 2.0 * slope_squared - curvature_term
                                                               : 2.0 * slope_squared;
-    return -2.0 * h_ * dh_ / denominator;
+    return -2.0 * h_ * dh / denominator;
   }
 
   // σ = L⁻¹σ*: each eigen-component scaled by σs/uᵢ (= f/ũᵢ).
@@ -167,7 +173,8 @@ class FlowStressKernel {
   const FlowStress& flow_;
   FlowStressValue value_{0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
   double u1_ = 0.0, u2_ = 0.0;
-  double scale_ = 0.0, h_ = 0.0, dh_ = 0.0, ddh_ = 0.0;
+  double rest_1_ = 0.0, rest_2_ = 0.0;  // p₁ − a, p₂ − b
+  double scale_ = 0.0, h_ = 0.0;
 };
 
 // return_map.hpp's safeguard around Halley's correction: g(lower) > 0 ≥

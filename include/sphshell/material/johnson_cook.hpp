@@ -269,10 +269,13 @@ struct JohnsonCook {
     state.D += increment / failure_strain_from_terms(damage_exponential, log_rate_at_return, homologous);
     if (heating_ > 0.0) {
       state.temperature += heating_ * solution.flow_stress * increment;
-      // 1 − T*ᵐ as thermal_factor, T*ᵐ by the series from the last exact one.
+      // 1 − T*ᵐ as thermal_factor, T*ᵐ by the series from the last exact one
+      // (T* itself for the common m = 1).
       const double heated = homologous_temperature(state.temperature);
       state.thermal_softening =
-          heated > 0.0 ? 1.0 - nearby_power(thermal_series_, parameters_.m, state.thermal_anchor, heated).value : 1.0;
+          !(heated > 0.0)          ? 1.0
+          : parameters_.m == 1.0 ? 1.0 - heated
+                                 : 1.0 - nearby_power(thermal_series_, parameters_.m, state.thermal_anchor, heated).value;
     }
     state.yield_stress = hardening_at_return * state.thermal_softening;  // (A + B ε̄pⁿ)(1 − T*ᵐ) at ε̄p,n+1
     if (state.D >= 1.0 || state.temperature >= parameters_.melting_temperature) {
