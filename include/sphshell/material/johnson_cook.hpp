@@ -151,7 +151,8 @@ struct JohnsonCook {
         inverse_reference_strain_rate_(1.0 / parameters.reference_strain_rate),
         inverse_stress_scale_(1.0 / parameters.A),
         power_series_(parameters.n),
-        thermal_series_(parameters.m) {}
+        thermal_series_(parameters.m),
+        taylor_reach_(taylor_reach(parameters.n, parameters.C)) {}
 
   State initial_state() const {
     const double thermal = thermal_factor(homologous_temperature(parameters_.initial_temperature));
@@ -197,32 +198,40 @@ struct JohnsonCook {
     // nearby_log; the anchors are kept in the state across steps) instead of
     // another pow() and log(); each value is within round-off of theirs.
     NearbyPoint power_anchor = state.power_anchor, log_anchor = state.log_anchor;
-    // The return's first iterate (its start) is evaluated by those series; the
+    // The return's first iterate (its start) is evaluated by those series,
+    // with the third derivatives of σs and A + Bε̄pⁿ (NearStart). The
     // correction then moves Δε̄p by a small fraction of itself (the start is
-    // within 2e-4 of the root on a smooth loading), so the later iterates
-    // follow from the first one's exact reciprocals by the shorter series of
-    // step_power and step_log, at the same round-off (PowerSeries::step_reach,
-    // step_log_reach). The reciprocals' divisions depend on the start only and
-    // run beside the first evaluation.
-    NearbyPoint power_step_anchor{}, log_step_anchor{};
+    // within ~2e-4 of the root on a smooth loading), and there the cubic
+    // Taylor polynomials about the start give σs, A + Bε̄pⁿ and ln ε̇* within
+    // 2⁻⁵⁴ of themselves (taylor_reach_): a later iterate costs a few
+    // products instead of the series.
+    NearStart near{};
     // Forced inline (its pow() and log() branches keep GCC from it): called, its
     // six results go through memory at each iterate.
     const auto flow = [&](double increment) __attribute__((always_inline)) {
+      const double rate = increment * rate_per_increment;
+      const bool rate_active = rate > 1.0;  // ln ε̇* taken as 0 below ε̇* = 1
+      const double step = increment - near.increment;
+      if (near.set && rate_active == near.rate_active && std::abs(step) <= taylor_reach_ * near.increment) {
+        hardening_at_return = near.hardening.at(step);
+        // ln ε̇* = ln ε̇*₀ + ln(1 + η), η = step/Δε̄p₀, to η⁵ (|η| ≤ 1e-3: the
+        // first omitted term η⁶/6 is below 1.7e-19).
+        const double eta = step * near.inverse_increment, eta_2 = eta * eta;
+        log_rate_at_return =
+            rate_active ? near.log_rate + eta * (((1.0 - 0.5 * eta) + eta_2 * (1.0 / 3.0 - 0.25 * eta)) + eta_2 * eta_2 * 0.2)
+                        : 0.0;
+        return return_map::FlowStressValue{increment, 1.0, 0.0, near.flow.at(step), near.flow.slope_at(step),
+                                           near.flow.curvature_at(step)};
+      }
       const double eps_p = eps_p_n + increment;
-      const NearbyValue power = power_step_anchor.argument > 0.0
-                                    ? step_power(power_series_, parameters_.n, power_anchor, power_step_anchor, eps_p)
-                                    : first_power(power_series_, parameters_.n, power_anchor, power_step_anchor, eps_p);
+      const NearbyValue power = nearby_power(power_series_, parameters_.n, power_anchor, eps_p);
       const double hardening = parameters_.A + parameters_.B * power.value;
       // d(Bε̄pⁿ)/dε̄p and its derivative, (n − 1)/ε̄p times it; at ε̄p = 0 the
       // slope is +inf (n < 1), B (n = 1) or 0.
       const double hardening_slope = eps_p > 0.0 ? parameters_.n * parameters_.B * power.value * power.inverse
                                                  : parameters_.n * parameters_.B * std::pow(eps_p, parameters_.n - 1.0);
       const double hardening_curvature = (parameters_.n - 1.0) * hardening_slope * power.inverse;
-      const double rate = increment * rate_per_increment;
-      const bool rate_active = rate > 1.0;  // ln ε̇* taken as 0 below ε̇* = 1
-      const NearbyValue log_rate = !rate_active ? NearbyValue{0.0, 0.0}
-                                   : log_step_anchor.argument > 0.0 ? step_log(log_anchor, log_step_anchor, rate)
-                                                                    : first_log(log_anchor, log_step_anchor, rate);
+      const NearbyValue log_rate = rate_active ? nearby_log(log_anchor, rate) : NearbyValue{0.0, 0.0};
       const double rate_factor = 1.0 + parameters_.C * log_rate.value;
       // d(1 + C ln ε̇*)/dΔε̄p = C/Δε̄p and its derivative −C/Δε̄p² (1/Δε̄p from 1/ε̇*).
       const double inverse_increment = rate_per_increment * log_rate.inverse;
@@ -230,14 +239,28 @@ struct JohnsonCook {
       const double rate_curvature = -rate_slope * inverse_increment;
       hardening_at_return = hardening;
       log_rate_at_return = log_rate.value;
-      return return_map::FlowStressValue{
-          increment,
-          1.0,
-          0.0,
-          hardening * rate_factor * thermal,
-          (hardening_slope * rate_factor + hardening * rate_slope) * thermal,
+      const double flow_stress = hardening * rate_factor * thermal;
+      const double flow_slope = (hardening_slope * rate_factor + hardening * rate_slope) * thermal;
+      const double flow_curvature =
           (hardening_curvature * rate_factor + 2.0 * hardening_slope * rate_slope + hardening * rate_curvature) *
-              thermal};
+          thermal;
+      if (!near.set && eps_p > 0.0 && increment > 0.0) {
+        // The third derivatives: (Bε̄pⁿ)‴ = (n − 2)/ε̄p · (Bε̄pⁿ)″ and
+        // (C ln Δε̄p)‴ = 2C/Δε̄p³ = −2/Δε̄p · (C ln Δε̄p)″; σs‴ by Leibniz's rule.
+        const double hardening_third = (parameters_.n - 2.0) * hardening_curvature * power.inverse;
+        const double rate_third = -2.0 * rate_curvature * inverse_increment;
+        const double flow_third = (hardening_third * rate_factor + 3.0 * hardening_curvature * rate_slope +
+                                   3.0 * hardening_slope * rate_curvature + hardening * rate_third) *
+                                  thermal;
+        near = NearStart{true,
+                         rate_active,
+                         increment,
+                         inverse_increment,
+                         log_rate.value,
+                         {hardening, hardening_slope, hardening_curvature, hardening_third},
+                         {flow_stress, flow_slope, flow_curvature, flow_third}};
+      }
+      return return_map::FlowStressValue{increment, 1.0, 0.0, flow_stress, flow_slope, flow_curvature};
     };
     // Started from Δε̄p at the rate extrapolated from the last three steps
     // (start_rate), or the last step's rate, or (0 after an elastic step or in
@@ -400,10 +423,6 @@ struct JohnsonCook {
   // bit where ε̇* ≥ e, and the rate factor 1 + C ln ε̇* sees C times it). Wide
   // enough for ε̇* of several steps along a smooth loading.
   static constexpr double log_series_reach = 5e-2;
-  // Relative distance from the step anchor below which ln(1 + δ) to δ⁵
-  // replaces the longer series: the first omitted term, δ⁶/6, is then below
-  // 1.1e-17 (absolute in ln ε̇*), and the terms after it fall by δ each.
-  static constexpr double step_log_reach = 2e-3;
   // |D3 Δσ*| below which exp(D3 σ*) follows from the anchor's by the series of
   // exp to the 7th power: the first omitted term, x⁸/8!, is then below 6.4e-19
   // (relative).
@@ -425,18 +444,9 @@ struct JohnsonCook {
       reach = std::min(5e-2, 6.0 / std::max(std::abs(n - terms), 12.0));
       if (c != 0.0)
         reach = std::min(reach, std::pow(0.25 * std::numeric_limits<double>::epsilon() / std::abs(c), 1.0 / terms));
-      // The series to δ³ (step_power): |C(n, 4)δ⁴| ≤ 2⁻⁵⁵ and each further
-      // term at most half the one before (|(n − k)δ/(k + 1)| ≤ ½ for k ≥ 4,
-      // which |δ| ≤ 1/(2 max(|n|, 1)) ensures), so the remainder stays below
-      // 2⁻⁵⁴; at most 2e-3 (nearby_inverse within δ⁸).
-      const double c_4 = coefficients[4];
-      step_reach = std::min(2e-3, 0.5 / std::max(std::abs(n), 1.0));
-      if (c_4 != 0.0)
-        step_reach = std::min(step_reach, std::pow(0.125 * std::numeric_limits<double>::epsilon() / std::abs(c_4), 0.25));
     }
     double coefficients[terms];
     double reach;
-    double step_reach;  // of the series to δ³ about a step anchor
   };
 
   // 1/x from the anchor's reciprocal, 1/(a(1 + δ)) = (1/a)(1 − δ + δ² − … − δ⁷)
@@ -474,7 +484,8 @@ struct JohnsonCook {
   // and falls by z² ≈ δ²/4 a term (δ = x/a − 1), so it reaches twice as far as
   // the series of ln(1 + δ) to δ¹¹ with half the terms. Its two divisions
   // depend on x alone: at the return's first iterate (the start) they run
-  // beside the rest of the step; the later iterates use step_log.
+  // beside the rest of the step; the later iterates use the start's Taylor
+  // polynomials.
   [[gnu::always_inline]] static NearbyValue nearby_log(NearbyPoint& anchor, double x) {
     const double inverse = 1.0 / x;
     if (anchor.argument > 0.0) {
@@ -489,47 +500,42 @@ struct JohnsonCook {
     anchor = {x, inverse, std::log(x)};
     return {anchor.value, inverse};
   }
-  // The first iterate's ε̄pⁿ (nearby_power), which also becomes the step
-  // anchor of the later iterates, with the exact reciprocal of its argument
-  // (step_power's relative distance is formed with it, and an error in it
-  // would enter the value). ε̄p = 0 makes no step anchor.
-  [[gnu::always_inline]] static NearbyValue first_power(const PowerSeries& series_of, double exponent,
-                                                        NearbyPoint& anchor, NearbyPoint& step_anchor, double x) {
-    const NearbyValue power = nearby_power(series_of, exponent, anchor, x);
-    if (!(x > 0.0)) return power;
-    step_anchor = {x, 1.0 / x, power.value};
-    return {power.value, step_anchor.inverse};
-  }
-  // A later iterate's ε̄pⁿ: within PowerSeries::step_reach of the step anchor
-  // (relative), the binomial series to δ³,
-  //   (1 + δ)ⁿ = 1 + nδ + C(n, 2)δ² + C(n, 3)δ³ + …,
-  // whose remainder is below 2⁻⁵⁴ (PowerSeries::step_reach); further away
-  // nearby_power as for the first.
-  [[gnu::always_inline]] static NearbyValue step_power(const PowerSeries& series_of, double exponent,
-                                                       NearbyPoint& anchor, const NearbyPoint& step_anchor, double x) {
-    const double delta = (x - step_anchor.argument) * step_anchor.inverse;
-    if (!(std::abs(delta) <= series_of.step_reach)) return nearby_power(series_of, exponent, anchor, x);
-    const double* c = series_of.coefficients;
-    const double delta_2 = delta * delta;
-    const double series = (1.0 + c[1] * delta) + delta_2 * (c[2] + c[3] * delta);
-    return {step_anchor.value * series, nearby_inverse(step_anchor, delta)};
-  }
-  // ln ε̇* of the first iterate (nearby_log), which becomes the step anchor
-  // of the later iterates with its exact reciprocal of ε̇*.
-  [[gnu::always_inline]] static NearbyValue first_log(NearbyPoint& anchor, NearbyPoint& step_anchor, double x) {
-    const NearbyValue log_value = nearby_log(anchor, x);
-    step_anchor = {x, log_value.inverse, log_value.value};
-    return log_value;
-  }
-  // A later iterate's ln ε̇*: within step_log_reach of the step anchor, the
-  // series of ln(1 + δ) to δ⁵; further away nearby_log as for the first.
-  [[gnu::always_inline]] static NearbyValue step_log(NearbyPoint& anchor, const NearbyPoint& step_anchor, double x) {
-    const double delta = (x - step_anchor.argument) * step_anchor.inverse;
-    if (!(std::abs(delta) <= step_log_reach)) return nearby_log(anchor, x);
-    const double delta_2 = delta * delta;
-    // ln(1 + δ) = δ (1 − δ/2 + δ²/3 − δ³/4 + δ⁴/5 − …)
-    const double series = ((1.0 - 0.5 * delta) + delta_2 * (1.0 / 3.0 - 0.25 * delta)) + delta_2 * delta_2 * 0.2;
-    return {step_anchor.value + delta * series, nearby_inverse(step_anchor, delta)};
+  // A function's cubic Taylor polynomial about a point: f, f′, f″, f‴ there.
+  struct Cubic {
+    double value, slope, curvature, third;
+    double at(double step) const {
+      return value + step * (slope + step * (0.5 * curvature + step * (third * (1.0 / 6.0))));
+    }
+    double slope_at(double step) const { return slope + step * (curvature + step * (0.5 * third)); }
+    double curvature_at(double step) const { return curvature + step * third; }
+  };
+  // The return's first iterate (set: evaluated, with ε̄p > 0 and Δε̄p > 0):
+  // its Δε̄p, whether the rate term was active there, 1/Δε̄p, ln ε̇*, and the
+  // Taylor polynomials of A + Bε̄pⁿ and of σs in Δε̄p.
+  struct NearStart {
+    bool set = false;
+    bool rate_active = false;
+    double increment = 0.0;
+    double inverse_increment = 0.0;
+    double log_rate = 0.0;
+    Cubic hardening{0.0, 0.0, 0.0, 0.0};
+    Cubic flow{0.0, 0.0, 0.0, 0.0};
+  };
+  // The reach of the cubic Taylor polynomials about the start, as a fraction
+  // η of its Δε̄p. Their remainder is f⁗(ξ)d⁴/24 (d = ηΔε̄p). With
+  // σs = θ·H·R, H = A + Bε̄pⁿ ≥ Bε̄pⁿ, R = 1 + C ln ε̇* ≥ 1, ε̄p ≥ Δε̄p,
+  //   |H⁽ᵏ⁾|/H ≤ |n(n − 1)…(n − k + 1)|/Δε̄pᵏ,  |R⁽ʲ⁾|/R ≤ C (j − 1)!/Δε̄pʲ (j ≥ 1),
+  // so by Leibniz's rule |σs⁗|/σs ≤ 24K/Δε̄p⁴ with
+  //   24K = |n)₄| + 4C|n)₃| + 6C|n)₂| + 8C|n| + 6C,  (n)ₖ the falling factorial,
+  // and the relative remainder is below Kη⁴/(1 − η)⁴ (ξ within ηΔε̄p of the
+  // start); K|n)₄|/24 ≤ K bounds H's too. Kη⁴ ≤ 2⁻⁵⁵ keeps both below 2⁻⁵⁴,
+  // at most 1e-3 (ln(1 + η) to η⁵ then within 1.7e-19).
+  static double taylor_reach(double n, double C) {
+    const double n_2 = std::abs(n * (n - 1.0)), n_3 = n_2 * std::abs(n - 2.0), n_4 = n_3 * std::abs(n - 3.0);
+    const double bound = (n_4 + 4.0 * C * n_3 + 6.0 * C * n_2 + 8.0 * C * std::abs(n) + 6.0 * C) / 24.0;
+    const double largest = 1e-3;
+    return bound > 0.0 ? std::min(largest, std::pow(0.125 * std::numeric_limits<double>::epsilon() / bound, 0.25))
+                       : largest;
   }
 
   // exp(D3 σ*), from the anchor's by the series of exp(x), x = D3 (σ* − σ*ₐ),
@@ -663,6 +669,7 @@ struct JohnsonCook {
   double inverse_stress_scale_;
   PowerSeries power_series_;                   // of ε̄pⁿ near an anchor
   PowerSeries thermal_series_;                 // of T*ᵐ near an anchor
+  double taylor_reach_;                        // of the Taylor polynomials about the return's start
 };
 
 }  // namespace sphshell::material
