@@ -279,7 +279,8 @@ struct JohnsonCook {
     const return_map::FlowStressSolution solution =
         steep ? steep_return(trial, trial_equivalent, eps_p_n, thermal, rate_per_increment,
                              hardening_at_return, log_rate_at_return)
-              : return_map::solve_flow_stress(constants_, trial, inverse_stress_scale_, flow, excess, guess);
+              : return_map::solve_flow_stress<return_map::Derivatives::for_corrections_only>(
+                    constants_, trial, inverse_stress_scale_, flow, excess, guess);
     const double increment = solution.plastic_strain_increment;
 
     state.eps_p = eps_p_n + increment;
