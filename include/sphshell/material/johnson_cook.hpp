@@ -529,8 +529,9 @@ struct JohnsonCook {
   // so by Leibniz's rule |σs⁗|/σs ≤ 24K/Δε̄p⁴ with
   //   24K = |n)₄| + 4C|n)₃| + 6C|n)₂| + 8C|n| + 6C,  (n)ₖ the falling factorial,
   // and the relative remainder is below Kη⁴/(1 − η)⁴ (ξ within ηΔε̄p of the
-  // start); K|n)₄|/24 ≤ K bounds H's too. Kη⁴ ≤ 2⁻⁵⁵ keeps both below 2⁻⁵⁴,
-  // at most 1e-3 (ln(1 + η) to η⁵ then within 1.7e-19).
+  // start); |H⁗|/H ≤ |n)₄|/Δε̄p⁴ ≤ 24K/Δε̄p⁴ bounds A + Bε̄pⁿ's remainder by the
+  // same. The reach keeps Kη⁴ ≤ 2⁻⁵⁵, so both stay below 2⁻⁵⁴ (the series'
+  // round-off), and is at most 1e-3 (ln(1 + η) to η⁵ then within 1.7e-19).
   static double taylor_reach(double n, double C) {
     const double n_2 = std::abs(n * (n - 1.0)), n_3 = n_2 * std::abs(n - 2.0), n_4 = n_3 * std::abs(n - 3.0);
     const double bound = (n_4 + 4.0 * C * n_3 + 6.0 * C * n_2 + 8.0 * C * std::abs(n) + 6.0 * C) / 24.0;
