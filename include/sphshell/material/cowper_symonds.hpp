@@ -73,6 +73,7 @@ struct CowperSymonds {
         elasticity_(parameters.E, parameters.nu),
         constants_(elasticity_, parameters.Ep),
         inverse_exponent_(1.0 / parameters.q),
+        inverse_D_(1.0 / parameters.D),
         integer_exponent_(parameters.q == std::floor(parameters.q) && parameters.q <= max_integer_exponent
                               ? static_cast<int>(parameters.q)
                               : 0),
@@ -101,10 +102,14 @@ struct CowperSymonds {
     const double trial_equivalent = std::sqrt(von_mises_squared(trial));
     const double sigma_y_n = state.sigma_y, plastic_modulus = parameters_.Ep, q = parameters_.q;
     const double rate_time = parameters_.D * context.time_step;  // DΔt: Δε̄p/(DΔt) = ε̄̇p/D
+    // 1/Δt and 1/(DΔt) (0 in the quasi-static limit): the step's one division
+    // for its rates, independent of the trial, so it runs beside the return.
+    const double inverse_time_step = 1.0 / context.time_step;
+    const double inverse_rate_time = inverse_time_step * inverse_D_;
     // J2's Δε̄p is at most excess/min(κᵢ + Ep) (return_map.hpp), and the
     // rate-scaled one lies below J2's; x of that bound, r^(1/q), bounds x.
     const double excess = trial_equivalent - sigma_y_n;
-    const double bound_ratio = excess * constants_.inverse_min_slope / rate_time;
+    const double bound_ratio = excess * constants_.inverse_min_slope * inverse_rate_time;
     if (bound_ratio <= quasi_static_ratio_) {
       // The rate factor is 1 in double at every admissible Δε̄p (always in the
       // quasi-static limit, Δt = +inf): J2's return, bit for bit.
@@ -156,7 +161,7 @@ struct CowperSymonds {
     const double overstress_drop =
         (mean_stiffness + plastic_modulus * (1.0 + relative_excess)) * rate_time * inverse_yield * excess_power;
     const double predicted = relative_excess - overstress_drop;
-    const double last_x = state.flow_stress / state.sigma_y - 1.0;
+    const double last_x = state.flow_stress * inverse_yield - 1.0;
     const double start = !bound_tighter && q * overstress_drop <= 0.25 * relative_excess && predicted > 0.0
                              ? predicted
                              : (last_x > 0.0 && last_x < upper ? last_x : upper);
@@ -167,7 +172,7 @@ struct CowperSymonds {
     state.eps_p += increment;
     state.sigma_y += plastic_modulus * increment;  // eq. (2.34)
     state.flow_stress = solution.flow_stress;
-    state.strain_rate = increment / context.time_step;
+    state.strain_rate = increment * inverse_time_step;
     return {true, solution.iterations};
   }
 
@@ -240,6 +245,7 @@ struct CowperSymonds {
   PlaneStressElasticity elasticity_;
   return_map::ClosedFormConstants constants_;
   double inverse_exponent_;     // 1/q
+  double inverse_D_;            // 1/D
   int integer_exponent_;        // q when it is an integer ≤ max_integer_exponent, else 0
   double quasi_static_ratio_;   // (2⁻⁵³)^q: r at or below it gives x ≤ 2⁻⁵³
 };

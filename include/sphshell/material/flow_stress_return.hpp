@@ -69,6 +69,15 @@ struct FlowStressSolution {
   int iterations;                   // corrections after the initial value
 };
 
+// When the return forms h′ and h″ (FlowStressKernel): with h at every
+// iterate, or only where a correction follows. The latter saves them at the
+// iterate that meets the tolerance (most often the first after the start),
+// and the flow stress' slopes with them, inlined, where those cost much
+// (Johnson–Cook's series); where they are a few products (Cowper–Symonds)
+// forming them beside h keeps them off the path that follows the
+// convergence test.
+enum class Derivatives { with_each_value, for_corrections_only };
+
 namespace detail {
 
 // The consistency condition of the top of the file without divisions or
@@ -86,7 +95,7 @@ namespace detail {
 // Its members are forced inline into the law's update (as closed_form_lane
 // is): called, the kernel lives in memory and each evaluation waits on its
 // stores and loads.
-template <class FlowStress>
+template <class FlowStress, Derivatives derivatives = Derivatives::with_each_value>
 class FlowStressKernel {
  public:
   [[gnu::always_inline]] FlowStressKernel(const ClosedFormConstants& constants, const StressVoigt& trial, double inverse_scale,
@@ -109,23 +118,19 @@ class FlowStressKernel {
            (kappa_1_ * equibiaxial_part_ + kappa_2_ * deviatoric_part_);
   }
 
+  // h and the residual's scale at v; h′ and h″ with them or in correction()
+  // (Derivatives).
   [[gnu::always_inline]] void evaluate(double v) {
     value_ = flow_(v);
-    const double f = value_.flow_stress * inverse_scale_, df = value_.flow_slope * inverse_scale_,
-                 ddf = value_.flow_curvature * inverse_scale_;
+    const double f = value_.flow_stress * inverse_scale_;
     u1_ = f + kappa_1_ * value_.increment;
     u2_ = f + kappa_2_ * value_.increment;
-    const double du1 = df + kappa_1_ * value_.increment_slope, du2 = df + kappa_2_ * value_.increment_slope;
-    const double ddu1 = ddf + kappa_1_ * value_.increment_curvature,
-                 ddu2 = ddf + kappa_2_ * value_.increment_curvature;
     const double p1 = u1_ * u1_, p2 = u2_ * u2_;
-    const double dp1 = 2.0 * u1_ * du1, dp2 = 2.0 * u2_ * du2;
-    const double ddp1 = 2.0 * (du1 * du1 + u1_ * ddu1), ddp2 = 2.0 * (du2 * du2 + u2_ * ddu2);
-    const double rest_1 = p1 - equibiaxial_part_, rest_2 = p2 - deviatoric_part_;
+    rest_1_ = p1 - equibiaxial_part_;
+    rest_2_ = p2 - deviatoric_part_;
     scale_ = p1 * p2;
-    h_ = rest_1 * rest_2 - equibiaxial_part_ * deviatoric_part_;
-    dh_ = dp1 * rest_2 + dp2 * rest_1;
-    ddh_ = ddp1 * rest_2 + 2.0 * dp1 * dp2 + ddp2 * rest_1;
+    h_ = rest_1_ * rest_2_ - equibiaxial_part_ * deviatoric_part_;
+    if constexpr (derivatives == Derivatives::with_each_value) slopes(dh_, ddh_);
   }
 
   bool converged() const { return std::abs(h_) <= relative_tolerance * scale_; }
@@ -137,14 +142,17 @@ class FlowStressKernel {
   // S² − 1 (only for the error message).
   double relative_yield_residual() const { return -h_ / scale_; }
 
-  // Halley's correction; where hh″ ≥ h′² (far from the root, where Halley
-  // would more than double Newton's step or reverse it) Newton's, −h/h′.
+  // Halley's correction at the last evaluated v; where hh″ ≥ h′² (far from
+  // the root, where Halley would more than double Newton's step or reverse
+  // it) Newton's, −h/h′.
   [[gnu::always_inline]] double correction() const {
-    const double slope_squared = dh_ * dh_;
-    const double curvature_term = h_ * ddh_;
+    double dh = dh_, ddh = ddh_;
+    if constexpr (derivatives == Derivatives::for_corrections_only) slopes(dh, ddh);
+    const double slope_squared = dh * dh;
+    const double curvature_term = h_ * ddh;
     const double denominator = curvature_term < slope_squared ? 2.0 * slope_squared - curvature_term
                                                               : 2.0 * slope_squared;
-    return -2.0 * h_ * dh_ / denominator;
+    return -2.0 * h_ * dh / denominator;
   }
 
   // σ = L⁻¹σ*: each eigen-component scaled by σs/uᵢ (= f/ũᵢ).
@@ -160,6 +168,18 @@ class FlowStressKernel {
   const FlowStressValue& value() const { return value_; }
 
  private:
+  // h′ and h″ at the last evaluated v (the top of the class).
+  [[gnu::always_inline]] void slopes(double& dh, double& ddh) const {
+    const double df = value_.flow_slope * inverse_scale_, ddf = value_.flow_curvature * inverse_scale_;
+    const double du1 = df + kappa_1_ * value_.increment_slope, du2 = df + kappa_2_ * value_.increment_slope;
+    const double ddu1 = ddf + kappa_1_ * value_.increment_curvature,
+                 ddu2 = ddf + kappa_2_ * value_.increment_curvature;
+    const double dp1 = 2.0 * u1_ * du1, dp2 = 2.0 * u2_ * du2;
+    const double ddp1 = 2.0 * (du1 * du1 + u1_ * ddu1), ddp2 = 2.0 * (du2 * du2 + u2_ * ddu2);
+    dh = dp1 * rest_2_ + dp2 * rest_1_;
+    ddh = ddp1 * rest_2_ + 2.0 * dp1 * dp2 + ddp2 * rest_1_;
+  }
+
   double sum_, diff_, shear_;
   double inverse_scale_;                     // s
   double equibiaxial_part_, deviatoric_part_;  // a, b
@@ -167,7 +187,9 @@ class FlowStressKernel {
   const FlowStress& flow_;
   FlowStressValue value_{0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
   double u1_ = 0.0, u2_ = 0.0;
-  double scale_ = 0.0, h_ = 0.0, dh_ = 0.0, ddh_ = 0.0;
+  double rest_1_ = 0.0, rest_2_ = 0.0;  // p₁ − a, p₂ − b
+  double scale_ = 0.0, h_ = 0.0;
+  double dh_ = 0.0, ddh_ = 0.0;  // with_each_value only
 };
 
 // return_map.hpp's safeguard around Halley's correction: g(lower) > 0 ≥
@@ -202,11 +224,11 @@ template <class Kernel>
 // inverse_scale, 1/s: the reciprocal of a stress of the return's size), by safeguarded Halley iteration from v = start inside
 // the bracket [lower, upper] of the iteration variable, where g(lower) > 0 ≥
 // g(upper) (the caller's bounds; see the laws).
-template <class FlowStress>
+template <Derivatives derivatives = Derivatives::with_each_value, class FlowStress>
 [[gnu::always_inline]] inline FlowStressSolution solve_flow_stress(const ClosedFormConstants& constants, const StressVoigt& trial,
                                      double inverse_scale, const FlowStress& flow, double start, double lower,
                                      double upper) {
-  detail::FlowStressKernel<FlowStress> kernel(constants, trial, inverse_scale, flow);
+  detail::FlowStressKernel<FlowStress, derivatives> kernel(constants, trial, inverse_scale, flow);
   double v = start;
   kernel.evaluate(v);
   const int iterations = detail::solve_bracketed(kernel, v, lower, upper);
@@ -219,11 +241,11 @@ template <class FlowStress>
 // min κᵢ Δε̄p, so S ≤ 1 there). The start is `guess` when it lies inside (a
 // law passes the last step's Δε̄p at the same rate: in steady flow the root
 // hardly moves), else the perfectly plastic return (eq. B.8 with Ep = 0).
-template <class FlowStress>
+template <Derivatives derivatives = Derivatives::with_each_value, class FlowStress>
 [[gnu::always_inline]] inline FlowStressSolution solve_flow_stress(const ClosedFormConstants& constants, const StressVoigt& trial,
                                      double inverse_scale, const FlowStress& flow, double excess,
                                      double guess = 0.0) {
-  detail::FlowStressKernel<FlowStress> kernel(constants, trial, inverse_scale, flow);
+  detail::FlowStressKernel<FlowStress, derivatives> kernel(constants, trial, inverse_scale, flow);
   const double upper = excess / std::min(constants.kappa_1, constants.kappa_2);
   double increment = guess > 0.0 && guess < upper ? guess : std::min(kernel.perfectly_plastic_start(excess), upper);
   kernel.evaluate(increment);

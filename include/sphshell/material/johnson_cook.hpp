@@ -148,8 +148,11 @@ struct JohnsonCook {
         heating_(parameters.taylor_quinney > 0.0
                      ? parameters.taylor_quinney / (parameters.density * parameters.specific_heat)
                      : 0.0),
+        inverse_reference_strain_rate_(1.0 / parameters.reference_strain_rate),
+        inverse_stress_scale_(1.0 / parameters.A),
         power_series_(parameters.n),
-        thermal_series_(parameters.m) {}
+        thermal_series_(parameters.m),
+        taylor_reach_(taylor_reach(parameters.n, parameters.C)) {}
 
   State initial_state() const {
     const double thermal = thermal_factor(homologous_temperature(parameters_.initial_temperature));
@@ -180,8 +183,10 @@ struct JohnsonCook {
     detail::require_time_step(context.time_step);
     const double homologous = homologous_temperature(state.temperature);
     const double thermal = state.thermal_softening;
-    // ε̇* per unit Δε̄p; 0 in the quasi-static limit.
-    const double rate_per_increment = 1.0 / (context.time_step * parameters_.reference_strain_rate);
+    // 1/Δt (0 in the quasi-static limit) and ε̇* per unit Δε̄p, 1/(Δt ε̇0): the
+    // step's one division for its rates.
+    const double inverse_time_step = 1.0 / context.time_step;
+    const double rate_per_increment = inverse_time_step * inverse_reference_strain_rate_;
     const double eps_p_n = state.eps_p;
     // A + Bε̄pⁿ and ln ε̇* (0 below ε̇* = 1) at the last Δε̄p the return evaluated,
     // which is the one it returns: the hardening of the next elastic limit and
@@ -193,9 +198,31 @@ struct JohnsonCook {
     // nearby_log; the anchors are kept in the state across steps) instead of
     // another pow() and log(); each value is within round-off of theirs.
     NearbyPoint power_anchor = state.power_anchor, log_anchor = state.log_anchor;
+    // The return's first iterate (its start) is evaluated by those series,
+    // with the third derivatives of σs and A + Bε̄pⁿ (NearStart). The
+    // correction then moves Δε̄p by a small fraction of itself (the start is
+    // within ~2e-4 of the root on a smooth loading), and there the cubic
+    // Taylor polynomials about the start give σs, A + Bε̄pⁿ and ln ε̇* within
+    // 2⁻⁵⁴ of themselves (taylor_reach_): a later iterate costs a few
+    // products instead of the series.
+    NearStart near{};
     // Forced inline (its pow() and log() branches keep GCC from it): called, its
     // six results go through memory at each iterate.
     const auto flow = [&](double increment) __attribute__((always_inline)) {
+      const double rate = increment * rate_per_increment;
+      const bool rate_active = rate > 1.0;  // ln ε̇* taken as 0 below ε̇* = 1
+      const double step = increment - near.increment;
+      if (near.set && rate_active == near.rate_active && std::abs(step) <= taylor_reach_ * near.increment) {
+        hardening_at_return = near.hardening.at(step);
+        // ln ε̇* = ln ε̇*₀ + ln(1 + η), η = step/Δε̄p₀, to η⁵ (|η| ≤ 1e-3: the
+        // first omitted term η⁶/6 is below 1.7e-19).
+        const double eta = step * near.inverse_increment, eta_2 = eta * eta;
+        log_rate_at_return =
+            rate_active ? near.log_rate + eta * (((1.0 - 0.5 * eta) + eta_2 * (1.0 / 3.0 - 0.25 * eta)) + eta_2 * eta_2 * 0.2)
+                        : 0.0;
+        return return_map::FlowStressValue{increment, 1.0, 0.0, near.flow.at(step), near.flow.slope_at(step),
+                                           near.flow.curvature_at(step)};
+      }
       const double eps_p = eps_p_n + increment;
       const NearbyValue power = nearby_power(power_series_, parameters_.n, power_anchor, eps_p);
       const double hardening = parameters_.A + parameters_.B * power.value;
@@ -204,8 +231,6 @@ struct JohnsonCook {
       const double hardening_slope = eps_p > 0.0 ? parameters_.n * parameters_.B * power.value * power.inverse
                                                  : parameters_.n * parameters_.B * std::pow(eps_p, parameters_.n - 1.0);
       const double hardening_curvature = (parameters_.n - 1.0) * hardening_slope * power.inverse;
-      const double rate = increment * rate_per_increment;
-      const bool rate_active = rate > 1.0;  // ln ε̇* taken as 0 below ε̇* = 1
       const NearbyValue log_rate = rate_active ? nearby_log(log_anchor, rate) : NearbyValue{0.0, 0.0};
       const double rate_factor = 1.0 + parameters_.C * log_rate.value;
       // d(1 + C ln ε̇*)/dΔε̄p = C/Δε̄p and its derivative −C/Δε̄p² (1/Δε̄p from 1/ε̇*).
@@ -214,14 +239,28 @@ struct JohnsonCook {
       const double rate_curvature = -rate_slope * inverse_increment;
       hardening_at_return = hardening;
       log_rate_at_return = log_rate.value;
-      return return_map::FlowStressValue{
-          increment,
-          1.0,
-          0.0,
-          hardening * rate_factor * thermal,
-          (hardening_slope * rate_factor + hardening * rate_slope) * thermal,
+      const double flow_stress = hardening * rate_factor * thermal;
+      const double flow_slope = (hardening_slope * rate_factor + hardening * rate_slope) * thermal;
+      const double flow_curvature =
           (hardening_curvature * rate_factor + 2.0 * hardening_slope * rate_slope + hardening * rate_curvature) *
-              thermal};
+          thermal;
+      if (!near.set && eps_p > 0.0 && increment > 0.0) {
+        // The third derivatives: (Bε̄pⁿ)‴ = (n − 2)/ε̄p · (Bε̄pⁿ)″ and
+        // (C ln Δε̄p)‴ = 2C/Δε̄p³ = −2/Δε̄p · (C ln Δε̄p)″; σs‴ by Leibniz's rule.
+        const double hardening_third = (parameters_.n - 2.0) * hardening_curvature * power.inverse;
+        const double rate_third = -2.0 * rate_curvature * inverse_increment;
+        const double flow_third = (hardening_third * rate_factor + 3.0 * hardening_curvature * rate_slope +
+                                   3.0 * hardening_slope * rate_curvature + hardening * rate_third) *
+                                  thermal;
+        near = NearStart{true,
+                         rate_active,
+                         increment,
+                         inverse_increment,
+                         log_rate.value,
+                         {hardening, hardening_slope, hardening_curvature, hardening_third},
+                         {flow_stress, flow_slope, flow_curvature, flow_third}};
+      }
+      return return_map::FlowStressValue{increment, 1.0, 0.0, flow_stress, flow_slope, flow_curvature};
     };
     // Started from Δε̄p at the rate extrapolated from the last three steps
     // (start_rate), or the last step's rate, or (0 after an elastic step or in
@@ -234,28 +273,33 @@ struct JohnsonCook {
     // the Δε̄p at which A + Bε̄pⁿ alone reaches σ̄*/θ, where ε̄pⁿ = hardening_limit:
     // the rate factor is ≥ 1 and uᵢ ≥ σs. Only a step from (nearly) ε̄p = 0
     // pays the test's pow().
-    const double steep_reach = steep_fraction * excess / std::min(constants_.kappa_1, constants_.kappa_2);
+    const double steep_reach = steep_fraction * excess * constants_.inverse_min_slope;  // 1/min κᵢ (Ep = 0)
     const bool steep = parameters_.n < 1.0 && parameters_.B > 0.0 && eps_p_n < steep_reach &&
                        hardening_limit(trial_equivalent, thermal) < std::pow(eps_p_n + steep_reach, parameters_.n);
     const return_map::FlowStressSolution solution =
-        steep ? steep_return(trial, quasi_static, trial_equivalent, eps_p_n, thermal, rate_per_increment,
+        steep ? steep_return(trial, trial_equivalent, eps_p_n, thermal, rate_per_increment,
                              hardening_at_return, log_rate_at_return)
-              : return_map::solve_flow_stress(constants_, trial, 1.0 / quasi_static, flow, excess, guess);
+              : return_map::solve_flow_stress<return_map::Derivatives::for_corrections_only>(
+                    constants_, trial, inverse_stress_scale_, flow, excess, guess);
     const double increment = solution.plastic_strain_increment;
 
     state.eps_p = eps_p_n + increment;
     state.sigma_y = solution.flow_stress;
-    record_strain_rate(state, increment / context.time_step);
+    record_strain_rate(state, increment * inverse_time_step);
     state.power_anchor = power_anchor;
     state.log_anchor = log_anchor;
-    const double damage_exponential = nearby_exponential(state.damage_anchor, triaxiality(solution.stress));
+    const double damage_exponential = nearby_exponential(
+        state.damage_anchor, returned_triaxiality(trial, solution.flow_stress, increment));
     state.D += increment / failure_strain_from_terms(damage_exponential, log_rate_at_return, homologous);
     if (heating_ > 0.0) {
       state.temperature += heating_ * solution.flow_stress * increment;
-      // 1 − T*ᵐ as thermal_factor, T*ᵐ by the series from the last exact one.
+      // 1 − T*ᵐ as thermal_factor, T*ᵐ by the series from the last exact one
+      // (T* itself for the common m = 1).
       const double heated = homologous_temperature(state.temperature);
       state.thermal_softening =
-          heated > 0.0 ? 1.0 - nearby_power(thermal_series_, parameters_.m, state.thermal_anchor, heated).value : 1.0;
+          !(heated > 0.0)          ? 1.0
+          : parameters_.m == 1.0 ? 1.0 - heated
+                                 : 1.0 - nearby_power(thermal_series_, parameters_.m, state.thermal_anchor, heated).value;
     }
     state.yield_stress = hardening_at_return * state.thermal_softening;  // (A + B ε̄pⁿ)(1 − T*ᵐ) at ε̄p,n+1
     if (state.D >= 1.0 || state.temperature >= parameters_.melting_temperature) {
@@ -281,6 +325,15 @@ struct JohnsonCook {
   static double triaxiality(const StressVoigt& stress) {
     const double equivalent = std::sqrt(von_mises_squared(stress));
     return equivalent > 0.0 ? (stress.x() + stress.y()) / (3.0 * equivalent) : 0.0;
+  }
+  // σ* of the stress returned from `trial` with flow stress σs and increment
+  // Δε̄p, without forming it: σ = L⁻¹σ* scales the trial's σx + σy (the
+  // eigen-direction of κ₁) by σs/u₁, u₁ = σs + κ₁Δε̄p (eq. 2.32–2.33,
+  // flow_stress_return.hpp), and σ̄ = σs·S with |S² − 1| ≤ 1e-12 (the return's
+  // tolerance), so σ* = (σx* + σy*)/(3u₁) up to a factor S within 5e-13 of 1:
+  // no square root, and the division runs beside the stress' own.
+  double returned_triaxiality(const StressVoigt& trial, double flow_stress, double increment) const {
+    return (trial.x() + trial.y()) / (3.0 * (flow_stress + constants_.kappa_1 * increment));
   }
   // εf of the 1985 paper at σ*, ε̇* and T* (ln ε̇* taken as 0 for ε̇* < 1).
   double failure_strain(double triaxiality, double rate, double homologous) const {
@@ -364,12 +417,13 @@ struct JohnsonCook {
     double value;
     double inverse;
   };
-  // Relative distance from the anchor below which the series of ln(1 + δ)
-  // to δ¹¹ replaces log(): its first omitted term, δ¹²/12, is then below
-  // 2.1e-17 (absolute, in ln ε̇*; a fortieth of ln ε̇*'s last bit where ε̇* ≥ e,
-  // and the rate factor 1 + C ln ε̇* sees C times it). Wide enough for ε̇* of
-  // a step from the last steps' along a smooth loading.
-  static constexpr double series_reach = 5e-2;
+  // |z| = |x − a|/(x + a) below which the series of 2 atanh z to z¹¹
+  // replaces log() (nearby_log; x/a within [0.905, 1.105]): its first omitted
+  // term, 2z¹³/13, is then below 1.9e-18 and each further one below z² = 2.5e-3
+  // times the one before (absolute, in ln ε̇*; a four-hundredth of ln ε̇*'s last
+  // bit where ε̇* ≥ e, and the rate factor 1 + C ln ε̇* sees C times it). Wide
+  // enough for ε̇* of several steps along a smooth loading.
+  static constexpr double log_series_reach = 5e-2;
   // |D3 Δσ*| below which exp(D3 σ*) follows from the anchor's by the series of
   // exp to the 7th power: the first omitted term, x⁸/8!, is then below 6.4e-19
   // (relative).
@@ -424,25 +478,68 @@ struct JohnsonCook {
                                      delta_4 * ((c[8] + c[9] * delta) + delta_2 * c[10]));
     return {anchor.value * series, nearby_inverse(anchor, delta)};
   }
-  // ln x, from the anchor's by the series of ln(1 + δ) to δ¹¹ (Estrin's
-  // grouping) when x is within series_reach of it, else by std::log (and x
-  // becomes the anchor).
+  // ln x and 1/x (exact), ln x from the anchor's as ln a + ln(x/a),
+  //   ln(x/a) = 2 atanh z = 2z (1 + z²/3 + z⁴/5 + … + z¹⁰/11 + …),  z = (x − a)/(x + a),
+  // to z¹¹ (Estrin's grouping in z²) when |z| ≤ log_series_reach, else by
+  // std::log (and x becomes the anchor). In z the series runs in even powers
+  // and falls by z² ≈ δ²/4 a term (δ = x/a − 1), so it reaches twice as far as
+  // the series of ln(1 + δ) to δ¹¹ with half the terms. Its two divisions
+  // depend on x alone: at the return's first iterate (the start) they run
+  // beside the rest of the step; the later iterates use the start's Taylor
+  // polynomials.
   [[gnu::always_inline]] static NearbyValue nearby_log(NearbyPoint& anchor, double x) {
+    const double inverse = 1.0 / x;
     if (anchor.argument > 0.0) {
-      const double delta = x * anchor.inverse - 1.0;
-      if (std::abs(delta) <= series_reach) {
-        const double delta_2 = delta * delta, delta_4 = delta_2 * delta_2;
-        // ln(1 + δ) = δ (1 − δ/2 + δ²/3 − δ³/4 + … + δ⁸/9 − δ⁹/10 + δ¹⁰/11 − …)
-        const double series =
-            ((1.0 - 0.5 * delta) + delta_2 * (1.0 / 3.0 - 0.25 * delta)) +
-            delta_4 * (((0.2 - delta * (1.0 / 6.0)) + delta_2 * (1.0 / 7.0 - 0.125 * delta)) +
-                       delta_4 * ((1.0 / 9.0 - 0.1 * delta) + delta_2 * (1.0 / 11.0)));
-        return {anchor.value + delta * series, nearby_inverse(anchor, delta)};
+      const double z = (x - anchor.argument) / (x + anchor.argument);
+      if (std::abs(z) <= log_series_reach) {
+        const double z_2 = z * z, z_4 = z_2 * z_2;
+        const double series = ((1.0 + z_2 * (1.0 / 3.0)) + z_4 * (0.2 + z_2 * (1.0 / 7.0))) +
+                              z_4 * z_4 * (1.0 / 9.0 + z_2 * (1.0 / 11.0));
+        return {anchor.value + 2.0 * z * series, inverse};
       }
     }
-    anchor = {x, 1.0 / x, std::log(x)};
-    return {anchor.value, anchor.inverse};
+    anchor = {x, inverse, std::log(x)};
+    return {anchor.value, inverse};
   }
+  // A function's cubic Taylor polynomial about a point: f, f′, f″, f‴ there.
+  struct Cubic {
+    double value, slope, curvature, third;
+    double at(double step) const {
+      return value + step * (slope + step * (0.5 * curvature + step * (third * (1.0 / 6.0))));
+    }
+    double slope_at(double step) const { return slope + step * (curvature + step * (0.5 * third)); }
+    double curvature_at(double step) const { return curvature + step * third; }
+  };
+  // The return's first iterate (set: evaluated, with ε̄p > 0 and Δε̄p > 0):
+  // its Δε̄p, whether the rate term was active there, 1/Δε̄p, ln ε̇*, and the
+  // Taylor polynomials of A + Bε̄pⁿ and of σs in Δε̄p.
+  struct NearStart {
+    bool set = false;
+    bool rate_active = false;
+    double increment = 0.0;
+    double inverse_increment = 0.0;
+    double log_rate = 0.0;
+    Cubic hardening{0.0, 0.0, 0.0, 0.0};
+    Cubic flow{0.0, 0.0, 0.0, 0.0};
+  };
+  // The reach of the cubic Taylor polynomials about the start, as a fraction
+  // η of its Δε̄p. Their remainder is f⁗(ξ)d⁴/24 (d = ηΔε̄p). With
+  // σs = θ·H·R, H = A + Bε̄pⁿ ≥ Bε̄pⁿ, R = 1 + C ln ε̇* ≥ 1, ε̄p ≥ Δε̄p,
+  //   |H⁽ᵏ⁾|/H ≤ |n(n − 1)…(n − k + 1)|/Δε̄pᵏ,  |R⁽ʲ⁾|/R ≤ C (j − 1)!/Δε̄pʲ (j ≥ 1),
+  // so by Leibniz's rule |σs⁗|/σs ≤ 24K/Δε̄p⁴ with
+  //   24K = |n)₄| + 4C|n)₃| + 6C|n)₂| + 8C|n| + 6C,  (n)ₖ the falling factorial,
+  // and the relative remainder is below Kη⁴/(1 − η)⁴ (ξ within ηΔε̄p of the
+  // start); |H⁗|/H ≤ |n)₄|/Δε̄p⁴ ≤ 24K/Δε̄p⁴ bounds A + Bε̄pⁿ's remainder by the
+  // same. The reach keeps Kη⁴ ≤ 2⁻⁵⁵, so both stay below 2⁻⁵⁴ (the series'
+  // round-off), and is at most 1e-3 (ln(1 + η) to η⁵ then within 1.7e-19).
+  static double taylor_reach(double n, double C) {
+    const double n_2 = std::abs(n * (n - 1.0)), n_3 = n_2 * std::abs(n - 2.0), n_4 = n_3 * std::abs(n - 3.0);
+    const double bound = (n_4 + 4.0 * C * n_3 + 6.0 * C * n_2 + 8.0 * C * std::abs(n) + 6.0 * C) / 24.0;
+    const double largest = 1e-3;
+    return bound > 0.0 ? std::min(largest, std::pow(0.125 * std::numeric_limits<double>::epsilon() / bound, 0.25))
+                       : largest;
+  }
+
   // exp(D3 σ*), from the anchor's by the series of exp(x), x = D3 (σ* − σ*ₐ),
   // to x⁷ (Estrin's grouping) when |x| ≤ exponential_reach, else by std::exp
   // (and σ* becomes the anchor).
@@ -478,7 +575,7 @@ struct JohnsonCook {
   // started at the limit: without the rate term the root lies within κᵢΔε̄p/σ̄*
   // (< 2⁻⁶³ of the excess over σ̄*) of it, so the start meets the tolerance.
   // Sets the hardening A + Bv and ln ε̇* of the returned v, as the update's flow does.
-  return_map::FlowStressSolution steep_return(const StressVoigt& trial, double quasi_static, double trial_equivalent,
+  return_map::FlowStressSolution steep_return(const StressVoigt& trial, double trial_equivalent,
                                               double eps_p_n, double thermal, double rate_per_increment,
                                               double& hardening_at_return, double& log_rate_at_return) const {
     const Parameters& p = parameters_;
@@ -507,7 +604,7 @@ struct JohnsonCook {
     };
     const double upper = hardening_limit(trial_equivalent, thermal);
     const double lower = std::pow(eps_p_n, p.n);
-    return return_map::solve_flow_stress(constants_, trial, 1.0 / quasi_static, flow, upper, lower, upper);
+    return return_map::solve_flow_stress(constants_, trial, inverse_stress_scale_, flow, upper, lower, upper);
   }
 
   static void validate(const Parameters& p) {
@@ -566,8 +663,15 @@ struct JohnsonCook {
   return_map::ClosedFormConstants constants_;  // κᵢ of ΓΞ (Ep unused)
   double inverse_temperature_range_;          // 1/(Tm − Tr)
   double heating_;                             // β/(ρ cp), 0 without heating
+  double inverse_reference_strain_rate_;       // 1/ε̇0
+  // 1/A: the return's stress scale (flow_stress_return.hpp; any stress of the
+  // return's size keeps its numbers far from over- and underflow, and the
+  // residual test is scale-free). A constant, so that no division by the last
+  // step's yield stress stands at the head of the next step's return.
+  double inverse_stress_scale_;
   PowerSeries power_series_;                   // of ε̄pⁿ near an anchor
   PowerSeries thermal_series_;                 // of T*ᵐ near an anchor
+  double taylor_reach_;                        // of the Taylor polynomials about the return's start
 };
 
 }  // namespace sphshell::material
