@@ -152,7 +152,9 @@ using ConjugateForceLanes = SurfaceGradientLanes<L>;
 
 // Green strains (nonlinear analysis) at every lane, from the reference's products.
 template <int L>
-inline void green_strains(const SurfaceGradientLanes<L>& g, const ReferenceProductLanes<L>& r, StrainLanes<L>& s) {
+inline void green_strains(const SurfaceGradientLanes<L>& g, const ReferenceProductLanes<L>& r, StrainLanes<L>& out) {
+  // Formed in a local, which the inputs cannot alias, so that the loop vectorises.
+  StrainLanes<L> s;
   for (int l = 0; l < L; ++l) {
     s.membrane.c[0][l] = 0.5 * (dot_at(g.a1, g.a1, l) - r.a1a1[l]);
     s.membrane.c[1][l] = 0.5 * (dot_at(g.a2, g.a2, l) - r.a2a2[l]);
@@ -163,12 +165,14 @@ inline void green_strains(const SurfaceGradientLanes<L>& g, const ReferenceProdu
     s.shear.c[0][l] = dot_at(g.a1, g.n, l) - r.a1n[l];
     s.shear.c[1][l] = dot_at(g.a2, g.n, l) - r.a2n[l];
   }
+  out = s;
 }
 
 // Small-strain, small-rotation strains at every lane: the first-order part
 // of green_strains in the displacement (a − A) and the director change (n − N).
 template <int L>
-inline void linear_strains(const SurfaceGradientLanes<L>& g, const SurfaceGradientLanes<L>& r, StrainLanes<L>& s) {
+inline void linear_strains(const SurfaceGradientLanes<L>& g, const SurfaceGradientLanes<L>& r, StrainLanes<L>& out) {
+  StrainLanes<L> s;  // as in green_strains
   for (int l = 0; l < L; ++l) {
     // The reference's vectors at lane l, u_α = a_α − A_α and the changes of n, n_α.
     double A1[3], A2[3], N[3], N1[3], N2[3], u1[3], u2[3], dn[3], dn1[3], dn2[3];
@@ -194,6 +198,7 @@ inline void linear_strains(const SurfaceGradientLanes<L>& g, const SurfaceGradie
     s.shear.c[0][l] = dot(A1, dn) + dot(u1, N);
     s.shear.c[1][l] = dot(A2, dn) + dot(u2, N);
   }
+  out = s;
 }
 
 // The conjugate forces at every lane; `b` holds the vectors the strain
@@ -201,7 +206,8 @@ inline void linear_strains(const SurfaceGradientLanes<L>& g, const SurfaceGradie
 // reference ones in the linear analysis.
 template <int L>
 inline void conjugate_forces(const SurfaceGradientLanes<L>& b, const WeightedStressLanes<L>& w,
-                             ConjugateForceLanes<L>& f) {
+                             ConjugateForceLanes<L>& out) {
+  ConjugateForceLanes<L> f;  // as in green_strains
   for (int l = 0; l < L; ++l) {
     const double N0 = w.membrane.c[0][l], N1 = w.membrane.c[1][l], N2 = w.membrane.c[2][l];
     const double M0 = w.curvature.c[0][l], M1 = w.curvature.c[1][l], M2 = w.curvature.c[2][l];
@@ -215,6 +221,7 @@ inline void conjugate_forces(const SurfaceGradientLanes<L>& b, const WeightedStr
       f.n.c[i][l] = Q0 * a1 + Q1 * a2;
     }
   }
+  out = f;
 }
 
 // ---------------------------------------------------------------------------
