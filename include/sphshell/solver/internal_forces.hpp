@@ -4,10 +4,13 @@
 // (Green or linear, shell/kinematics.hpp) → material update through the
 // thickness (Section) → resultants → the point's five conjugate forces (and
 // the corner forces of its edge-tied shear) kept per point. The points go
-// through this in groups of thickness::points_per_group (SectionGroup,
-// section_group.hpp): the material update of a group's points runs side by
-// side, a vector lane a pair of point and integral point; a point alone is
-// the group of one. Then each particle
+// through this in groups of thickness::points_per_group: the strains, their
+// increments, the resultants' bookkeeping and the conjugate forces of a
+// group run side by side, a vector lane a point (GroupLanes below), and its
+// material update a vector lane a pair of point and integral point
+// (SectionGroup, section_group.hpp); a point alone is the group of one. Each
+// point's gather sums its slots on its own (a slot loop over a group's lanes
+// would read a scattered particle per lane) into its lane. Then each particle
 // sums, over the shape-function slots that refer to it and in a fixed order
 // (IntegrationPoints::force_entries), the slot's share of its point's forces
 // (the deterministic sum: no atomic additions, identical results for any thread
