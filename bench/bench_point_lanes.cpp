@@ -138,3 +138,5 @@ void in_lanes(benchmark::State& state) {
 BENCHMARK(by_point);
 BENCHMARK_TEMPLATE(in_lanes, true)->Name("lanes");
 BENCHMARK_TEMPLATE(in_lanes, false)->Name("lanes_resident");
+
+BENCHMARK_MAIN();
