@@ -256,22 +256,16 @@ class IntegrationPoints {
   }
 
   // The same from the packed positions and directors (solver/particles.hpp):
-  // the step's hot gather, written into lane `lane` of a group's gradients
-  // (the assembler integrates points in groups, shell::SurfaceGradientLanes).
-  // The slots are summed point by point: a slot loop over the lanes of a
-  // group would read a scattered particle per lane (measured slower in every
-  // instruction set, docs/performance-history.md). The sums are kept in
-  // locals and the arrays are read through local pointers: a store into the
-  // result might alias the arrays for all the compiler knows, so it would
+  // the step's hot gather. The sums are kept in locals, not in the returned
+  // structure, and the arrays are read through local pointers: a store into
+  // the result might alias the arrays for all the compiler knows, so it would
   // write the sums back and reload every array's address at every slot. A
   // neighbour's position and director are read as one 6-vector, so that each
   // of ∂Φ/∂X1, ∂Φ/∂X2 scales both at once (a1 with n1, a2 with n2): three
   // SSE2 pairs instead of a pair and a single for each 3-vector, 4-6 % of the
   // paper plate's step (docs/performance.md). Every component's sum is the
   // same, in the same order.
-  template <int L>
-  void gather(PointGroup group, std::size_t row, const std::vector<PackedKinematics>& packed,
-              shell::SurfaceGradientLanes<L>& lanes, int lane) const {
+  shell::SurfaceGradients gather(PointGroup group, std::size_t row, const std::vector<PackedKinematics>& packed) const {
     const approx::ShapeFunctions& sf = shape(group);
     const int* const neighbour = sf.neighbour.data();
     const approx::ShapeValue* const value = sf.value.data();
@@ -287,17 +281,13 @@ class IntegrationPoints {
       d2_sum += dphi_d2 * particle;
       n += phi * particle.template tail<3>();
     }
-    lanes.a1.set(lane, d1_sum.head<3>());
-    lanes.a2.set(lane, d2_sum.head<3>());
-    lanes.n.set(lane, n);
-    lanes.n1.set(lane, d1_sum.tail<3>());
-    lanes.n2.set(lane, d2_sum.tail<3>());
-  }
-  // One point's: the group of one.
-  shell::SurfaceGradients gather(PointGroup group, std::size_t row, const std::vector<PackedKinematics>& packed) const {
-    shell::SurfaceGradientLanes<1> one;
-    gather(group, row, packed, one, 0);
-    return one.at(0);
+    shell::SurfaceGradients g;
+    g.a1 = d1_sum.head<3>();
+    g.a2 = d2_sum.head<3>();
+    g.n = n;
+    g.n1 = d1_sum.tail<3>();
+    g.n2 = d2_sum.tail<3>();
+    return g;
   }
 
   // Recomputes one row with a visibility predicate visible(row, particle)

@@ -4,13 +4,10 @@
 // (Green or linear, shell/kinematics.hpp) → material update through the
 // thickness (Section) → resultants → the point's five conjugate forces (and
 // the corner forces of its edge-tied shear) kept per point. The points go
-// through this in groups of thickness::points_per_group: the strains, their
-// increments, the resultants' bookkeeping and the conjugate forces of a
-// group run side by side, a vector lane a point (GroupLanes below), and its
-// material update a vector lane a pair of point and integral point
-// (SectionGroup, section_group.hpp); a point alone is the group of one. Each
-// point's gather sums its slots on its own (a slot loop over a group's lanes
-// would read a scattered particle per lane) into its lane. Then each particle
+// through this in groups of thickness::points_per_group (SectionGroup,
+// section_group.hpp): the material update of a group's points runs side by
+// side, a vector lane a pair of point and integral point; a point alone is
+// the group of one. Then each particle
 // sums, over the shape-function slots that refer to it and in a fixed order
 // (IntegrationPoints::force_entries), the slot's share of its point's forces
 // (the deterministic sum: no atomic additions, identical results for any thread
@@ -372,192 +369,109 @@ class InternalForceAssembler {
     }
   }
 
-  // A group's points side by side from their gather to their conjugate
-  // forces, a lane a point (lane m: the group's m-th active point). Lanes
-  // past the group's count hold an earlier group's numbers (or zeros): the
-  // loops run over all G lanes, so that their trip count is fixed and they
-  // vectorise, and nothing of those lanes is written back.
-  template <int G>
-  struct GroupLanes {
-    std::array<std::size_t, std::size_t(G)> row;
-    shell::SurfaceGradientLanes<G> current;
-    shell::SurfaceGradientLanes<G> reference;               // linear analysis
-    shell::ReferenceProductLanes<G> reference_products;     // nonlinear analysis
-    shell::StrainLanes<G> strains;
-    shell::StrainLanes<G> increments;                       // the strains before the step, until the increments
-    shell::StrainLanes<G> before;                           // N, M, Q before the step (unweighted N, M)
-    shell::StrainLanes<G> after;                            // N, M of the update, Q
-    alignas(64) double membrane_bending_weight[G], shear_weight[G], work[G];
-    shell::WeightedStressLanes<G> weighted;
-    shell::ConjugateForceLanes<G> conjugate;
+  // What a point of a group keeps between its gather and its update.
+  struct GroupMember {
+    std::size_t row;
+    shell::SurfaceGradients current;
+    shell::Strains strains;
+    StrainVoigt d_membrane, d_curvature;
+    Vector2 d_shear;
   };
 
-  // Integrates the rows [first_row, end_row) of a group of points, up to
-  // points_per_group active points at a time (across points: the active
-  // points of one block of the SectionStates, updated in place): each point's
-  // gather into the group's lanes; the strains and their increments over the
-  // lanes; the group's material update through the thickness
-  // (section_group.hpp); the resultants, work and conjugate forces over the
-  // lanes; then each point's states, forces and tied shear. A failing point
-  // is kept in `failure` (the lowest row) and leaves the others of its group
-  // unaffected.
+  // Integrates the rows [first_row, end_row) of a group of points, a
+  // SectionGroup of up to points_per_group active points at a time (across
+  // points: the active points of one block of the SectionStates, updated in
+  // place): each point's gather and strains, then the group's material update
+  // through the thickness (section_group.hpp), then each point's resultants,
+  // work, conjugate forces and tied shear. A failing point is kept in
+  // `failure` (the lowest row) and leaves the others of its group unaffected.
   template <class Approx, class Rule, class Law>
   void integrate_rows(PointGroup group, std::size_t first_row, std::size_t end_row,
                       const IntegrationPoints<Approx>& points, SectionStates<Rule, Law>& states,
                       assembler_parts::PointFailure& failure) {
     using Group = thickness::SectionGroup<Rule, Law>;
-    constexpr int G = Group::group_size;
     // The runs start at a chunk's first row, so that a block of the states
     // (section_states.hpp) is never shared by two runs, which two threads
     // may integrate at once.
-    static_assert(PointChunks::rows % std::size_t(G) == 0,
+    static_assert(PointChunks::rows % std::size_t(Group::group_size) == 0,
                   "sphshell::solver: PointChunks::rows must be a multiple of points_per_group");
     Group section_group;
-    GroupLanes<G> lanes{};
+    std::array<GroupMember, std::size_t(Group::group_size)> members;
     for (std::size_t row = first_row; row < end_row;) {
       section_group.clear();
       // Across points the group is one block's points: the rows up to the block's end.
       std::size_t group_end = end_row;
       if constexpr (Group::across_points) {
         const std::size_t p = points.point(group, row);
-        group_end = std::min(end_row, row + std::size_t(G - states.lane_of(p)));
+        group_end = std::min(end_row, row + std::size_t(Group::group_size - states.lane_of(p)));
         section_group.use_block(states.block(p));
       }
-      // Each point's gather (its slots point by point) and what the lanes
-      // read of its states, into its lane. Nothing here throws.
-      int count = 0;
-      for (; row < group_end && count < G; ++row) {
+      for (; row < group_end && !section_group.full(); ++row) {
         const std::size_t p = points.point(group, row);
         if (!states.active(p)) {
           work_increment_[p] = 0.0;
           continue;
         }
-        const int m = count++;
-        lanes.row[std::size_t(m)] = row;
-        points.gather(group, row, packed_, lanes.current, m);
-        if (nonlinear_)
-          lanes.reference_products.set(m, points.reference_products(p));
-        else
-          lanes.reference.set(m, points.reference(p));
-        lanes.increments.membrane.set(m, states.membrane_strain(p));
-        lanes.increments.curvature.set(m, states.curvature(p));
-        lanes.increments.shear.set(m, states.shear_strain(p));
-        lanes.before.membrane.set(m, states.membrane_force(p));
-        lanes.before.curvature.set(m, states.bending_moment(p));
-        lanes.before.shear.set(m, states.shear_force(p));
-        lanes.membrane_bending_weight[m] = points.membrane_bending_weight(p);
-        lanes.shear_weight[m] = points.shear_weight(p);
-      }
-      if (count == 0) continue;
-      if (nonlinear_)
-        shell::green_strains(lanes.current, lanes.reference_products, lanes.strains);
-      else
-        shell::linear_strains(lanes.current, lanes.reference, lanes.strains);
-      subtract_strains_before(lanes);
-      for (int m = 0; m < count; ++m) {
-        const std::size_t p = points.point(group, lanes.row[std::size_t(m)]);
-        const StrainVoigt d_membrane = lanes.increments.membrane.at(m), d_curvature = lanes.increments.curvature.at(m);
-        if constexpr (Group::across_points)
-          section_group.add(states.lane_of(p), states.section(p), d_membrane, d_curvature);
-        else
-          section_group.add(states.section(p), states.stored_state(p), d_membrane, d_curvature);
+        try {
+          GroupMember& member = members[std::size_t(section_group.size())];
+          member.row = row;
+          member.current = points.gather(group, row, packed_);
+          member.strains = strains_of(member.current, points, p);
+          member.d_membrane = member.strains.membrane - states.membrane_strain(p);
+          member.d_curvature = member.strains.curvature - states.curvature(p);
+          member.d_shear = member.strains.shear - states.shear_strain(p);
+          if constexpr (Group::across_points)
+            section_group.add(states.lane_of(p), states.section(p), member.d_membrane, member.d_curvature);
+          else
+            section_group.add(states.section(p), states.stored_state(p), member.d_membrane, member.d_curvature);
+        } catch (...) {
+          failure.keep_lowest(group, row, std::current_exception());
+        }
       }
       // A rate-dependent law's sections get the step's context; every other
       // section is called as it always was (a Section of the user's own need
       // not take the context).
       section_group.update(update_context_);
-      for (int m = 0; m < count; ++m)
-        if (!section_group.failure(m)) {
-          lanes.after.membrane.set(m, section_group.resultants(m).membrane);
-          lanes.after.curvature.set(m, section_group.resultants(m).moment);
-        }
-      resultants_and_forces(lanes);
-      for (int m = 0; m < count; ++m) {
-        const std::size_t row_m = lanes.row[std::size_t(m)];
-        if (section_group.failure(m)) {
-          failure.keep_lowest(group, row_m, section_group.failure(m));
+      for (int g = 0; g < section_group.size(); ++g) {
+        const GroupMember& member = members[std::size_t(g)];
+        if (section_group.failure(g)) {
+          failure.keep_lowest(group, member.row, section_group.failure(g));
           continue;
         }
         try {
-          finish_point(group, row_m, m, lanes, points, states);
+          finish_point(group, member, section_group.resultants(g), points, states);
         } catch (...) {
-          failure.keep_lowest(group, row_m, std::current_exception());
+          failure.keep_lowest(group, member.row, std::current_exception());
         }
       }
     }
   }
 
-  // The strain increments over the step at every lane (the strains before it
-  // replaced by the increments).
-  template <int G>
-  static void subtract_strains_before(GroupLanes<G>& lanes) {
-    shell::StrainLanes<G>& d = lanes.increments;
-    const shell::StrainLanes<G>& s = lanes.strains;
-    for (int l = 0; l < G; ++l) {
-      for (int i = 0; i < 3; ++i) {
-        d.membrane.c[i][l] = s.membrane.c[i][l] - d.membrane.c[i][l];
-        d.curvature.c[i][l] = s.curvature.c[i][l] - d.curvature.c[i][l];
-      }
-      for (int i = 0; i < 2; ++i) d.shear.c[i][l] = s.shear.c[i][l] - d.shear.c[i][l];
-    }
-  }
-
-  // At every lane after the material update: the transverse shear force, the
-  // work of the generalized stresses over the step, the weighted stresses and
-  // the conjugate forces.
-  template <int G>
-  void resultants_and_forces(GroupLanes<G>& lanes) const {
-    const shell::StrainLanes<G>& d = lanes.increments;
-    const shell::StrainLanes<G>& before = lanes.before;
-    shell::StrainLanes<G>& after = lanes.after;
-    for (int l = 0; l < G; ++l) {
-      // The elastic transverse shear force (weighted: the shear weight holds
-      // κs G d A) is updated incrementally like the other resultants, so a
-      // change of shape functions (after a crack) leaves it continuous.
-      for (int i = 0; i < 2; ++i) after.shear.c[i][l] = before.shear.c[i][l] + lanes.shear_weight[l] * d.shear.c[i][l];
-      // Trapezoidal work of the generalized stresses over the strain
-      // increment, each dot product in Eigen's order.
-      const auto membrane_term = [&](int i) {
-        return (before.membrane.c[i][l] + after.membrane.c[i][l]) * d.membrane.c[i][l];
-      };
-      const auto bending_term = [&](int i) {
-        return (before.curvature.c[i][l] + after.curvature.c[i][l]) * d.curvature.c[i][l];
-      };
-      const double membrane_work = membrane_term(0) + membrane_term(1) + membrane_term(2);
-      const double bending_work = bending_term(0) + bending_term(1) + bending_term(2);
-      const double shear_work = (before.shear.c[0][l] + after.shear.c[0][l]) * d.shear.c[0][l] +
-                                (before.shear.c[1][l] + after.shear.c[1][l]) * d.shear.c[1][l];
-      const double w = lanes.membrane_bending_weight[l];
-      lanes.work[l] = w * (0.5 * membrane_work + 0.5 * bending_work) + 0.5 * shear_work;
-      for (int i = 0; i < 3; ++i) {
-        lanes.weighted.membrane.c[i][l] = w * after.membrane.c[i][l];
-        lanes.weighted.curvature.c[i][l] = w * after.curvature.c[i][l];
-      }
-      for (int i = 0; i < 2; ++i) lanes.weighted.shear.c[i][l] = after.shear.c[i][l];
-    }
-    shell::conjugate_forces(nonlinear_ ? lanes.current : lanes.reference, lanes.weighted, lanes.conjugate);
-  }
-
-  // A point's bookkeeping after its lanes: the new resultants and strains
-  // kept, its work over the step and conjugate forces, its tied shear.
-  template <class Approx, class Rule, class Law, int G>
-  void finish_point(PointGroup group, std::size_t row, int m, const GroupLanes<G>& lanes,
+  // A point's bookkeeping after its material update: the new resultants and
+  // strains kept, the work over the step, its conjugate forces and tied shear.
+  template <class Approx, class Rule, class Law>
+  void finish_point(PointGroup group, const GroupMember& member, const thickness::Resultants& resultants,
                     const IntegrationPoints<Approx>& points, SectionStates<Rule, Law>& states) {
-    const std::size_t p = points.point(group, row);
-    work_increment_[p] = lanes.work[m];
-    states.restart_strains(p, lanes.strains.at(m));
-    states.membrane_force(p) = lanes.after.membrane.at(m);
-    states.bending_moment(p) = lanes.after.curvature.at(m);
-    states.shear_force(p) = lanes.after.shear.at(m);
-    conjugate_[p] = shell::ConjugateForces{lanes.conjugate.a1.at(m), lanes.conjugate.a2.at(m),
-                                           lanes.conjugate.n.at(m), lanes.conjugate.n1.at(m),
-                                           lanes.conjugate.n2.at(m)};
+    const std::size_t p = points.point(group, member.row);
+    // The elastic transverse shear force (weighted: the shear weight holds
+    // κs G d A) is updated incrementally like the other resultants, so a
+    // change of shape functions (after a crack) leaves it continuous.
+    const Vector2 shear_force = states.shear_force(p) + points.shear_weight(p) * member.d_shear;
+    const double w = points.membrane_bending_weight(p);
+    // Trapezoidal work of the generalized stresses over the strain increment.
+    work_increment_[p] = w * (0.5 * (states.membrane_force(p) + resultants.membrane).dot(member.d_membrane) +
+                              0.5 * (states.bending_moment(p) + resultants.moment).dot(member.d_curvature)) +
+                         0.5 * (states.shear_force(p) + shear_force).dot(member.d_shear);
+    states.restart_strains(p, member.strains);
+    states.membrane_force(p) = resultants.membrane;
+    states.bending_moment(p) = resultants.moment;
+    states.shear_force(p) = shear_force;
     // The tied shear reads the corners from this step's packed kinematics
     // (the same numbers as the particle state's).
     const double tied_energy =
-        tied_shear_of(group, row, points,
-                      [&](int j) -> const Vector3& { return packed_[std::size_t(j)].position; },
-                      [&](int j) -> const Vector3& { return packed_[std::size_t(j)].director; });
+        scatter(group, member.row, member.current, points, states,
+                [&](int j) -> const Vector3& { return packed_[std::size_t(j)].position; },
+                [&](int j) -> const Vector3& { return packed_[std::size_t(j)].director; });
     // The tied shear is elastic and quadratic: its work over the step is
     // exactly the change of its energy.
     work_increment_[p] += tied_energy - states.tied_shear_energy(p);
@@ -575,14 +489,6 @@ class InternalForceAssembler {
     const shell::WeightedStresses weighted{w * states.membrane_force(p), w * states.bending_moment(p),
                                            states.shear_force(p)};
     conjugate_[p] = shell::conjugate_forces(nonlinear_ ? current : points.reference(p), weighted);
-    return tied_shear_of(group, row, points, position, director);
-  }
-
-  // The energy of a point's edge-tied shear, its corner forces kept (0 for a
-  // point whose shear is not tied).
-  template <class Approx, class Position, class Director>
-  double tied_shear_of(PointGroup group, std::size_t row, const IntegrationPoints<Approx>& points,
-                       const Position& position, const Director& director) {
     return points.shear_tied(group, row) ? tied_shear(row, points, position, director) : 0.0;
   }
 
