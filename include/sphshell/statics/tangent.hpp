@@ -330,8 +330,7 @@ class TangentAssembly {
   void set_moved_configuration(const DegreesOfFreedom& dofs, std::vector<Vector3> x0, std::vector<Vector3> d0,
                                const Eigen::VectorXd& update) {
     moved(dofs, update, x0, d0);
-    solver_.set_configuration(std::move(x0), std::move(d0));
-    ++report_.force_evaluations;
+    set_configuration(std::move(x0), std::move(d0));
   }
 
   // The tangent stiffness at the configuration (x0, d0) applied to v, K v
@@ -344,10 +343,7 @@ class TangentAssembly {
     return difference_product(
         v, [&](Eigen::Index k) { return step_of(dofs, static_cast<int>(k)); },
         [&](const Eigen::VectorXd& update) {
-          std::vector<Vector3> x = x0, d = d0;
-          moved(dofs, update, x, d);
-          solver_.set_configuration(std::move(x), std::move(d));
-          ++report_.force_evaluations;
+          set_moved_configuration(dofs, x0, d0, update);
           return Eigen::VectorXd(-residual(dofs, 0.0));
         });
   }
